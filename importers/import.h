@@ -1,0 +1,47 @@
+/* Importers: turn OBJ(+MTL), PLY and glTF 2.0 files into an iris_scene.
+ * iris_import_file picks the importer from the file extension. Every importer
+ * parses leniently, then validates strictly; errors name the file and the line
+ * or element; present-but-ignored features produce one warning. */
+#ifndef IRIS_IMPORTERS_IMPORT_H
+#define IRIS_IMPORTERS_IMPORT_H
+
+#include <stdbool.h>
+
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct iris_import_options {
+  const char *camera_name; /* glTF: pick this camera (default: the first one) */
+  bool weld;               /* weld coincident vertices (OpenMesh) */
+  bool compute_normals;    /* compute angle-weighted normals where absent (default true) */
+} iris_import_options;
+
+iris_import_options iris_import_options_default(void);
+
+/* Dispatches on the extension (.obj, .ply, .gltf, .glb, .json = iris scene). */
+iris_status iris_import_file(const char *path, const iris_import_options *opts, iris_scene **out,
+                             iris_error *err);
+
+iris_status iris_import_obj(const char *path, const iris_import_options *opts, iris_scene **out,
+                            iris_error *err);
+iris_status iris_import_ply(const char *path, const iris_import_options *opts, iris_scene **out,
+                            iris_error *err);
+iris_status iris_import_gltf(const char *path, const iris_import_options *opts, iris_scene **out,
+                             iris_error *err);
+
+/* Parsing straight from memory (used by the fuzzers; `path` is for messages and
+ * for resolving relative references, which fuzzers disable by passing NULL). */
+iris_status iris_import_obj_memory(const char *data, size_t size, const char *path,
+                                   const iris_import_options *opts, iris_scene **out, iris_error *err);
+iris_status iris_import_ply_memory(const char *data, size_t size, const char *path,
+                                   const iris_import_options *opts, iris_scene **out, iris_error *err);
+iris_status iris_import_gltf_memory(const char *data, size_t size, const char *path,
+                                    const iris_import_options *opts, iris_scene **out, iris_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,1 @@
+/* placeholder */ typedef int iris_placeholder_unit_;

@@ -1,0 +1,210 @@
+/* The iris scene: what every importer produces, the renderer consumes and the
+ * exporters translate. In memory it is plain arrays + indices; on disk it is a
+ * JSON description plus one binary mesh file per mesh (docs/format.md).
+ * Only what a scene has is stored: optional attributes are NULL when absent
+ * and material fields that do not apply to a material's type are ignored. */
+#ifndef IRIS_SCENE_SCENE_H
+#define IRIS_SCENE_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IRIS_SCENE_FORMAT_VERSION 1
+
+/* ---- textures ---------------------------------------------------------- */
+
+typedef enum iris_wrap { IRIS_WRAP_REPEAT = 0, IRIS_WRAP_CLAMP, IRIS_WRAP_MIRROR } iris_wrap;
+
+/* An encoded image (PNG or JPEG). Either `path` names the file (absolute, or
+ * relative to the scene JSON's folder after loading it is made absolute), or the
+ * encoded bytes are held in memory (glTF data URIs and GLB buffer views); when
+ * written, in-memory images become files next to the scene JSON. */
+typedef struct iris_texture {
+  char *name;           /* may be NULL */
+  char *path;           /* NULL when held in memory */
+  uint8_t *data;        /* encoded bytes, owned; NULL when `path` is set */
+  size_t data_size;
+  char mime[16];        /* "image/png" or "image/jpeg" */
+  iris_wrap wrap_s, wrap_t;
+  bool nearest;         /* magnification filter NEAREST instead of bilinear */
+} iris_texture;
+
+/* ---- materials --------------------------------------------------------- */
+
+typedef enum iris_material_type {
+  IRIS_MATERIAL_DIFFUSE = 0, /* Lambert: color = albedo                      <-> Cycles Diffuse BSDF */
+  IRIS_MATERIAL_GLOSSY,      /* GGX, alpha = roughness^2, tint, no Fresnel <-> Glossy BSDF (GGX) */
+  IRIS_MATERIAL_GLASS,       /* dielectric, exact Fresnel, GGX if rough    <-> Glass BSDF (GGX) */
+  IRIS_MATERIAL_GLTF         /* glTF 2.0 metallic-roughness (Appendix B)   <-> Principled BSDF */
+} iris_material_type;
+
+typedef struct iris_material {
+  char *name;
+  iris_material_type type;
+  float color[3];          /* albedo / tint / base colour (linear) */
+  int32_t color_texture;   /* texture index or -1; multiplies color (sRGB-decoded) */
+  float roughness;         /* glossy, glass, gltf: perceptual roughness in [0,1] */
+  float ior;               /* glass, gltf */
+  float metallic;          /* gltf */
+  int32_t metallic_roughness_texture; /* gltf: B = metallic, G = roughness; -1 none */
+  float specular;          /* gltf KHR_materials_specular specularFactor (1 default) */
+  float specular_color[3]; /* gltf specularColorFactor (1,1,1 default) */
+  float transmission;      /* gltf KHR_materials_transmission factor */
+  float emission[3];       /* emitted radiance = colour x strength; all 0: not emissive */
+  int32_t emission_texture;/* multiplies emission (sRGB-decoded); -1 none */
+  bool emission_two_sided; /* true: emits from both faces (Cycles' behaviour) */
+  bool double_sided;       /* glTF doubleSided (informational for back-face shading) */
+} iris_material;
+
+/* ---- meshes and instances --------------------------------------------- */
+
+/* A triangle mesh with one material. Attribute arrays are NULL when the
+ * source did not have them. Arrays are either owned (malloc'ed) or borrowed
+ * from a memory map held by the scene; `owned` tells which. */
+typedef struct iris_mesh {
+  char *name;
+  uint32_t vertex_count;
+  uint32_t triangle_count;
+  float *positions;   /* 3 * vertex_count */
+  float *normals;     /* 3 * vertex_count or NULL */
+  float *uvs;         /* 2 * vertex_count or NULL (glTF convention: v down, (0,0) top-left of the image) */
+  float *colors;      /* 3 * vertex_count or NULL (linear RGB) */
+  uint32_t *indices;  /* 3 * triangle_count, counter-clockwise = front */
+  int32_t material;   /* index or -1 for the default material (diffuse 0.8) */
+  bool owned;
+} iris_mesh;
+
+typedef struct iris_instance {
+  uint32_t mesh;
+  iris_mat4 transform; /* object to world */
+} iris_instance;
+
+/* ---- cameras, lights, environment ------------------------------------- */
+
+typedef struct iris_camera {
+  char *name;
+  iris_mat4 to_world; /* camera looks along its local -Z, +Y up (glTF/Blender) */
+  float yfov;         /* vertical field of view, radians */
+  float aspect;       /* width / height; 0 when the source does not say */
+} iris_camera;
+
+typedef enum iris_light_type {
+  IRIS_LIGHT_POINT = 0,
+  IRIS_LIGHT_SPOT,
+  IRIS_LIGHT_DIRECTIONAL
+} iris_light_type;
+
+/* KHR_lights_punctual light in world space. Units as glTF: point and spot
+ * `intensity` in candela (W/sr in iris's radiometric reading), directional in
+ * lux (W/m^2). docs/materials.md gives the conversion to Cycles. */
+typedef struct iris_light {
+  char *name;
+  iris_light_type type;
+  float color[3];
+  float intensity;
+  float position[3];  /* point, spot */
+  float direction[3]; /* spot, directional: unit vector the light travels along */
+  float range;        /* 0 = infinite */
+  float inner_cone;   /* spot, radians */
+  float outer_cone;   /* spot, radians */
+} iris_light;
+
+typedef struct iris_render_settings {
+  int width, height;  /* 0 = derive */
+  int spp;            /* 0 = default */
+  int max_depth;      /* -1 = default (64) */
+  char method[32];    /* "" = default */
+  uint64_t seed;
+  bool has_seed;
+} iris_render_settings;
+
+typedef struct iris_scene {
+  char units[16]; /* "m" unless the source says otherwise */
+
+  iris_texture *textures;
+  size_t texture_count;
+  iris_material *materials;
+  size_t material_count;
+  iris_mesh *meshes;
+  size_t mesh_count;
+  iris_instance *instances;
+  size_t instance_count;
+  iris_camera *cameras;
+  size_t camera_count;
+  iris_light *lights;
+  size_t light_count;
+
+  bool has_environment;
+  float environment[3]; /* constant radiance of the world */
+
+  iris_render_settings render;
+
+  /* Source path (for messages) and memory maps that borrowed arrays point into. */
+  char *source_path;
+  void *maps;
+  size_t map_count;
+} iris_scene;
+
+/* ---- lifetime and building -------------------------------------------- */
+
+iris_scene *iris_scene_create(void);
+void iris_scene_destroy(iris_scene *scene);
+
+/* Appenders return the new element's index, or -1 when out of memory. The
+ * scene takes ownership of every pointer stored in the appended element
+ * (names, arrays); strings are copied by the _str helper. */
+int32_t iris_scene_add_texture(iris_scene *scene, const iris_texture *tex);
+int32_t iris_scene_add_material(iris_scene *scene, const iris_material *mat);
+int32_t iris_scene_add_mesh(iris_scene *scene, const iris_mesh *mesh);
+int32_t iris_scene_add_instance(iris_scene *scene, const iris_instance *inst);
+int32_t iris_scene_add_camera(iris_scene *scene, const iris_camera *cam);
+int32_t iris_scene_add_light(iris_scene *scene, const iris_light *light);
+char *iris_strdup(const char *s);
+
+/* A material with the defaults for its type (colour 0.8, roughness 0.5,
+ * ior 1.5, specular 1, textures -1, not emissive, emission two-sided). */
+iris_material iris_material_default(iris_material_type type);
+
+/* Appends all of `src` to `dst` (indices remapped), taking src's contents;
+ * src is destroyed. Used to combine several imported files. */
+iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err);
+
+/* ---- validation and files --------------------------------------------- */
+
+/* Checks every invariant: indices in range, finite numbers, references valid,
+ * counts consistent. `file` names the source in messages. */
+iris_status iris_scene_validate(const iris_scene *scene, const char *file, iris_error *err);
+
+/* Loads a scene JSON and its mesh files (memory-mapped), validating everything. */
+iris_status iris_scene_load(const char *json_path, iris_scene **out, iris_error *err);
+
+/* Writes the JSON and one mesh file per mesh ("<stem>.meshes/<i>.irmesh" next
+ * to the JSON) and in-memory textures, all atomically. Writing the same scene
+ * twice gives identical bytes. */
+iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iris_error *err);
+
+/* World-space bounds of all instances; returns false for an empty scene. */
+bool iris_scene_bounds(const iris_scene *scene, iris_vec3 *lo, iris_vec3 *hi);
+/* Total world-space triangle count (instances counted separately). */
+uint64_t iris_scene_triangle_count(const iris_scene *scene);
+
+/* Binary mesh files on their own (used by write/load, the fuzzer and tests). */
+iris_status iris_mesh_write_file(const iris_mesh *mesh, const char *path, iris_error *err);
+/* Validates header, sizes against the file length, checksum, finite values and
+ * index range. On success the mesh's arrays point into *map (borrowed). */
+typedef struct iris_file_map iris_file_map;
+iris_status iris_mesh_read_map(const iris_file_map *map, const char *path, iris_mesh *mesh,
+                               iris_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
