@@ -38,5 +38,7 @@ typedef struct iris_command {
 
 int iris_cmd_import(int argc, char **argv);
 int iris_cmd_info(int argc, char **argv);
+int iris_cmd_render(int argc, char **argv);
+int iris_cmd_export(int argc, char **argv);
 
 #endif

@@ -8,6 +8,8 @@
 static const iris_command COMMANDS[] = {
     {"import", "convert OBJ/PLY/glTF files into an iris scene", iris_cmd_import},
     {"info", "describe a scene or importable file", iris_cmd_info},
+    {"render", "render a scene (or any importable file) to EXR/PNG", iris_cmd_render},
+    {"export", "export a scene to Blender (Python) or POV-Ray (SDL)", iris_cmd_export},
 };
 static const size_t COMMAND_COUNT = sizeof COMMANDS / sizeof COMMANDS[0];
 
