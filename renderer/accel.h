@@ -1,0 +1,93 @@
+/* Ray casting over the whole scene through Embree 3. Every instance is
+ * flattened into world-space triangles (docs/rendering.md gives the measured
+ * reason), and a hit becomes a surface interaction: position, geometric and
+ * shading normals, uv, vertex colour and material. */
+#ifndef IRIS_RENDERER_ACCEL_H
+#define IRIS_RENDERER_ACCEL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* d need not be unit length; t is measured in units of |d|. */
+typedef struct iris_ray {
+  iris_vec3 o;
+  float tmin;
+  iris_vec3 d;
+  float tmax;
+} iris_ray;
+
+/* A hit: distance, barycentrics of vertices 1 and 2, and the global triangle
+ * index (over all instances, in instance order). */
+typedef struct iris_hit {
+  float t, u, v;
+  uint32_t prim;
+} iris_hit;
+
+/* What the renderer needs to know about a surface point. */
+typedef struct iris_interaction {
+  iris_vec3 p;       /* world position (from barycentrics, not o + t d) */
+  iris_vec3 ng;      /* unit geometric normal of the front (counter-clockwise) face */
+  iris_vec3 ns;      /* unit shading normal, flipped onto ng's side */
+  float uv[2];       /* (0, 0) when the mesh has none */
+  iris_vec3 color;   /* vertex colour; (1, 1, 1) when the mesh has none */
+  int32_t material;  /* index into scene->materials, -1 = default */
+  uint32_t prim;     /* global triangle index */
+  uint32_t instance; /* scene instance */
+  bool front;        /* the ray arrived on the front side (dot(d, ng) < 0) */
+} iris_interaction;
+
+typedef struct iris_accel iris_accel;
+
+/* Builds the Embree scene (world-space copies of every instance's vertices;
+ * index buffers are shared with the scene, which must outlive the accel). */
+iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err);
+void iris_accel_destroy(iris_accel *accel);
+
+/* Closest hit in (tmin, tmax); false on a miss. */
+bool iris_accel_intersect(const iris_accel *accel, const iris_ray *ray, iris_hit *hit);
+/* Any hit in (tmin, tmax). */
+bool iris_accel_occluded(const iris_accel *accel, const iris_ray *ray);
+
+/* The surface interaction of a hit; `d` is the direction of the ray that hit. */
+void iris_accel_interaction(const iris_accel *accel, iris_vec3 d, const iris_hit *hit,
+                            iris_interaction *si);
+/* The interaction at barycentrics (b1, b2) of triangle `prim`, as seen from
+ * the front (used by light sampling). */
+void iris_accel_surface_at(const iris_accel *accel, uint32_t prim, float b1, float b2,
+                           iris_interaction *si);
+
+/* Ray origin that cannot re-hit the surface of `p`: p pushed a few ulps along
+ * the geometric normal towards the side `w` leaves on (Waechter & Binder,
+ * Ray Tracing Gems ch. 6), so the error is relative to the magnitude of p. */
+iris_vec3 iris_offset_origin(iris_vec3 p, iris_vec3 ng, iris_vec3 w);
+/* Ray from a surface point leaving along w (unit). */
+iris_ray iris_spawn_ray(const iris_interaction *si, iris_vec3 w);
+/* Shadow ray between two surface points, each offset along its normal
+ * towards the other; the ray ends at t = 1 just before the target. */
+iris_ray iris_spawn_ray_to(iris_vec3 p, iris_vec3 ng, iris_vec3 target, iris_vec3 target_ng);
+
+/* Scene facts the lights and the camera need. */
+uint32_t iris_accel_triangle_count(const iris_accel *accel);
+/* World-space vertices of a triangle. */
+void iris_accel_triangle(const iris_accel *accel, uint32_t prim, iris_vec3 v[3]);
+int32_t iris_accel_triangle_material(const iris_accel *accel, uint32_t prim);
+/* World bounds of all triangles (false when there are none). */
+bool iris_accel_bounds(const iris_accel *accel, iris_vec3 *lo, iris_vec3 *hi);
+/* Bytes held by iris (vertex copies, tables); Embree's BVH is reported by
+ * iris_accel_embree_bytes (from Embree's memory monitor). */
+size_t iris_accel_memory_bytes(const iris_accel *accel);
+size_t iris_accel_embree_bytes(const iris_accel *accel);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,48 @@
+/* The pinhole perspective camera: from a scene camera (vertical field of view,
+ * looks along its local -Z with +Y up, as glTF and Blender) or framed
+ * automatically around the scene bounds. Film coordinates are pixels with x to
+ * the right and y down, (0, 0) the top-left corner of the image. */
+#ifndef IRIS_RENDERER_CAMERA_H
+#define IRIS_RENDERER_CAMERA_H
+
+#include <stdbool.h>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "renderer/accel.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Height used when neither the flags nor the scene give a resolution. */
+#define IRIS_CAMERA_DEFAULT_HEIGHT 512
+/* Vertical field of view of an automatically framed camera (radians, 40 deg). */
+#define IRIS_CAMERA_AUTO_YFOV 0.6981317f
+
+typedef struct iris_pinhole {
+  iris_vec3 origin;
+  iris_vec3 right, up, forward; /* unit world vectors */
+  float tan_half_yfov;
+  float aspect;                 /* width / height of the film */
+  int width, height;
+  float yfov;                   /* radians */
+  bool automatic;               /* framed from the bounds, not from the scene */
+  char name[64];
+} iris_pinhole;
+
+/* Picks the scene camera called `name` (NULL: the first one; none in the scene:
+ * auto-framing) and resolves the resolution: width/height <= 0 come from the
+ * scene's render settings, then from the camera's aspect ratio, with
+ * IRIS_CAMERA_DEFAULT_HEIGHT pixels high as the last resort. */
+iris_status iris_pinhole_setup(const iris_scene *scene, const char *name, int width, int height,
+                               iris_pinhole *out, iris_error *err);
+
+/* Primary ray through film position (fx, fy) in pixels; d is unit length. */
+iris_ray iris_pinhole_ray(const iris_pinhole *cam, float fx, float fy);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

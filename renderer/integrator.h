@@ -1,0 +1,129 @@
+/* Unidirectional path tracing with three estimators of direct light
+ * (--method bsdf | nee | mis) and room for the guided ones. The path loop
+ * chooses every next direction through ONE function,
+ * iris_integrator_sample_direction, and MIS with light sampling asks ONE
+ * function, iris_integrator_direction_pdf, how likely the path's direction
+ * sampler was to produce a given direction. Guiding plugs in there through an
+ * iris_direction_sampler (a small table of function pointers), nowhere else.
+ * Formulas, Russian roulette and the bounce convention: docs/rendering.md. */
+#ifndef IRIS_RENDERER_INTEGRATOR_H
+#define IRIS_RENDERER_INTEGRATOR_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "renderer/accel.h"
+#include "renderer/bsdf.h"
+#include "renderer/lights.h"
+#include "renderer/texture.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum iris_method {
+  IRIS_METHOD_BSDF = 0,   /* BSDF sampling only; emitters count when hit */
+  IRIS_METHOD_NEE,        /* light sampling for direct light; hits count only from the
+                             camera and after delta bounces */
+  IRIS_METHOD_MIS,        /* both, power heuristic (default) */
+  IRIS_METHOD_GUIDED,     /* guided direction sampling, emitters count when hit */
+  IRIS_METHOD_GUIDED_NEE, /* guided direction sampling + light sampling with MIS */
+  IRIS_METHOD_COUNT
+} iris_method;
+
+/* "bsdf", "nee", "mis", "guided", "guided-nee". */
+const char *iris_method_name(iris_method method);
+/* False when `name` is not a method name. */
+bool iris_method_parse(const char *name, iris_method *out);
+/* Whether a method samples lights explicitly / samples directions with a guide. */
+bool iris_method_uses_nee(iris_method method);
+bool iris_method_uses_guiding(iris_method method);
+
+/* A shading point: the interaction, its shading frame (z = shading normal,
+ * turned towards wo for non-transmissive BSDFs), the BSDF, wo in both frames. */
+typedef struct iris_shading_point {
+  iris_interaction si;
+  iris_frame frame;
+  iris_bsdf bsdf;
+  iris_vec3 wo;       /* world, unit, towards the previous vertex */
+  iris_vec3 wo_local;
+  uint32_t lobes;     /* iris_bsdf_lobes */
+  bool delta;         /* iris_bsdf_is_delta */
+  int depth;          /* bounces so far (0 at the first hit from the camera) */
+} iris_shading_point;
+
+/* A direction chosen by the path's direction sampler. */
+typedef struct iris_direction_sample {
+  iris_vec3 wi;       /* world, unit */
+  iris_vec3 f;        /* BSDF value (for delta lobes including 1/|cos|) */
+  float pdf;          /* solid-angle pdf of the WHOLE direction sampler (the mixture,
+                         when guiding mixes BSDF and guide); for delta lobes the
+                         discrete probability */
+  uint32_t lobe;      /* IRIS_LOBE_* of the sample */
+  bool delta;
+} iris_direction_sample;
+
+/* Pluggable direction sampler (the guiding module provides one). `sample`
+ * must fill out->f with the BSDF value and out->pdf with the density of the
+ * whole strategy; `pdf` returns that same density for any world direction
+ * (0 for directions only a delta lobe reaches). Both must be thread-safe. */
+typedef struct iris_direction_sampler {
+  void *ctx;
+  bool (*sample)(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
+                 iris_direction_sample *out);
+  float (*pdf)(void *ctx, const iris_shading_point *sp, iris_vec3 wi);
+} iris_direction_sampler;
+
+/* Everything a path needs, shared read-only by all threads. */
+typedef struct iris_integrator {
+  const iris_scene *scene;
+  const iris_accel *accel;
+  const iris_lights *lights;
+  const iris_textures *textures;
+  iris_method method;
+  int max_depth;      /* Cycles' bounces: 0 = direct light only, B = B+1 surface hits */
+  int rr_depth;       /* Russian roulette from this bounce on (default 3) */
+  iris_direction_sampler guide; /* used by the guided methods; sample == NULL: BSDF */
+} iris_integrator;
+
+/* Per-thread counters (summed after the render; integer sums do not depend on
+ * the order, so they are deterministic too). */
+typedef struct iris_path_stats {
+  uint64_t paths;
+  uint64_t rays;        /* closest-hit rays */
+  uint64_t shadow_rays; /* occlusion rays */
+  uint64_t nan_count;   /* samples rejected as NaN/Inf */
+} iris_path_stats;
+
+#define IRIS_DEFAULT_MAX_DEPTH 64
+#define IRIS_DEFAULT_RR_DEPTH 3
+
+/* Defaults: mis, max depth 64, Russian roulette from bounce 3, no guide. */
+iris_integrator iris_integrator_default(const iris_scene *scene, const iris_accel *accel,
+                                        const iris_lights *lights, const iris_textures *textures);
+
+/* Fills the shading point for a hit (material, textures, vertex colour, frame). */
+void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
+                           int depth, iris_shading_point *sp);
+
+/* THE direction choice of a path: the BSDF's sampling routine, or the guide for
+ * guided methods. False ends the path. */
+bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shading_point *sp,
+                                      iris_sampler *rng, iris_direction_sample *out);
+/* THE density of that choice for a given world direction (for MIS weights of
+ * light samples and of emitters hit by the path). */
+float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shading_point *sp,
+                                    iris_vec3 wi);
+
+/* Radiance along a camera ray. Never returns NaN/Inf: such samples are
+ * replaced by 0 and counted in stats->nan_count. */
+iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                                   iris_path_stats *stats);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

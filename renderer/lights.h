@@ -1,0 +1,128 @@
+/* Everything that emits: emissive triangles (chosen in proportion to their
+ * power, sampled uniformly by area), KHR_lights_punctual point, spot and
+ * directional lights, and the constant environment ("world"). One discrete
+ * distribution over all of them serves next-event estimation (with the pdfs
+ * MIS needs when a BSDF-sampled ray hits an emitter) and photon emission for
+ * the guiding preprocess. Units are radiometric: docs/rendering.md, "Lights".
+ * Emissive-triangle radiance is the material's emission (times its emission
+ * texture) on the front face, and on both faces when emission_two_sided. */
+#ifndef IRIS_RENDERER_LIGHTS_H
+#define IRIS_RENDERER_LIGHTS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "renderer/accel.h"
+#include "renderer/texture.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum iris_light_kind {
+  IRIS_LIGHT_KIND_TRIANGLE = 0, /* an emissive triangle (area light) */
+  IRIS_LIGHT_KIND_POINT,
+  IRIS_LIGHT_KIND_SPOT,
+  IRIS_LIGHT_KIND_DIRECTIONAL,
+  IRIS_LIGHT_KIND_ENVIRONMENT
+} iris_light_kind;
+
+/* One entry of the light list. */
+typedef struct iris_light_entry {
+  iris_light_kind kind;
+  uint32_t prim;      /* triangle: global triangle index; punctual: scene light index */
+  float power;        /* selection weight: luminance of the emitted power (W) */
+  float area;         /* triangle area (0 for the others) */
+  bool two_sided;     /* triangle emits from both faces */
+  iris_vec3 radiance; /* triangle: emission factor (untextured); environment: radiance;
+                         point/spot: radiant intensity (W/sr); directional: irradiance (W/m^2) */
+} iris_light_entry;
+
+typedef struct iris_lights {
+  const iris_scene *scene;
+  const iris_accel *accel;
+  const iris_textures *textures;
+  iris_light_entry *entries;
+  size_t count;
+  float *cdf;             /* count + 1 entries, cdf[0] = 0, cdf[count] = 1 */
+  uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
+  int32_t environment;    /* entry index of the environment, or -1 */
+  iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */
+  float radius;
+  double total_power;
+} iris_lights;
+
+/* Builds the light list. A scene without emitters gives count == 0 (renders black
+ * unless something is added). */
+iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
+                              const iris_textures *textures, iris_lights *out, iris_error *err);
+void iris_lights_destroy(iris_lights *lights);
+
+/* Probability with which iris_lights_sample picks entry `index`. */
+float iris_lights_select_pmf(const iris_lights *lights, uint32_t index);
+/* Picks an entry in proportion to power with one uniform number; returns its
+ * index and the pmf (0 when there is no light). */
+uint32_t iris_lights_select(const iris_lights *lights, float u, float *pmf);
+
+/* ---- next-event estimation -------------------------------------------- */
+
+typedef struct iris_light_sample {
+  iris_vec3 wi;      /* unit direction from the reference point to the light */
+  float dist;        /* distance to the light point; INFINITY for directional/environment */
+  iris_vec3 p;       /* point on the light (triangle, point, spot) */
+  iris_vec3 n;       /* light's geometric normal at p (triangle), else -wi */
+  iris_vec3 L;       /* incident radiance (area, environment) or, for delta lights,
+                        the irradiance-producing value I / dist^2 resp. E */
+  float pdf;         /* solid-angle pdf including the selection pmf; for delta
+                        lights the selection pmf alone */
+  bool delta;        /* point, spot, directional: cannot be hit by BSDF sampling */
+  uint32_t light;    /* entry index */
+} iris_light_sample;
+
+/* Samples a light as seen from `ref` (a surface point) with three uniform
+ * numbers. Returns false when nothing was sampled (no lights, back face of a
+ * one-sided emitter, zero-area triangle, outside a spot cone...). */
+bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
+                        float u1, iris_light_sample *s);
+
+/* Radiance leaving surface point `si` towards -d (the direction of the ray
+ * that hit it); zero for non-emissive materials and for the back face of
+ * one-sided emitters. */
+iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction *si, iris_vec3 d);
+/* Solid-angle pdf (selection included) that iris_lights_sample, called at
+ * `ref`, returns the point si->p of an emissive triangle. */
+float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
+                               const iris_interaction *si);
+/* Environment radiance along direction d (a ray that escaped), and the
+ * solid-angle pdf that iris_lights_sample returns d. */
+iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
+float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 d);
+
+/* ---- photon emission (guiding preprocess) ----------------------------- */
+
+typedef struct iris_photon_emission {
+  iris_vec3 p;       /* origin of the photon ray (offset off the emitter surface) */
+  iris_vec3 dir;     /* unit direction */
+  iris_vec3 n;       /* emitter normal at p (the side emitted from), or dir */
+  iris_vec3 power;   /* photon energy Le cos / (pmf * pdf_pos * pdf_dir): the
+                        average over many photons is the lights' total power */
+  uint32_t light;    /* entry index */
+  uint32_t prim;     /* triangle: global triangle index; else the entry's prim */
+  float pdf_pos;     /* area density of p (1 for point/spot) */
+  float pdf_dir;     /* solid-angle density of dir */
+} iris_photon_emission;
+
+/* Samples a light in proportion to power, a point on it and an emission
+ * direction (cosine-weighted for triangles, uniform for point/spot, a disk
+ * covering the scene for directional/environment) from five uniform numbers. */
+bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
+                                 float u2, float u3, iris_photon_emission *e);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

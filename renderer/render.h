@@ -1,0 +1,94 @@
+/* The renderer's entry point: scene + params -> film. It runs the sequence
+ * build_accel -> load_textures -> build_lights -> [prepare guide] -> passes of
+ * samples over all pixels -> result, and writes EXR/PNG files. The `iris
+ * render` command is a thin layer that fills iris_render_params. */
+#ifndef IRIS_RENDERER_RENDER_H
+#define IRIS_RENDERER_RENDER_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "renderer/camera.h"
+#include "renderer/film.h"
+#include "renderer/integrator.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IRIS_RENDER_DEFAULT_SPP 64
+
+/* Everything the guided methods need to build their guide before the passes. */
+typedef struct iris_guide_setup {
+  const iris_scene *scene;
+  const iris_accel *accel;
+  const iris_lights *lights;
+  const iris_textures *textures;
+  const iris_pinhole *camera;
+  const iris_integrator *integrator; /* for iris_integrator_shade */
+  uint64_t seed;
+  int threads;
+} iris_guide_setup;
+
+/* Builds a direction sampler (and its state) for the guided methods;
+ * `destroy` frees the state. Provided by the guiding module. */
+typedef struct iris_guide_provider {
+  iris_status (*build)(const iris_guide_setup *setup, iris_direction_sampler *out,
+                       void **state, iris_error *err);
+  void (*destroy)(void *state);
+} iris_guide_provider;
+
+typedef struct iris_render_params {
+  int width, height;        /* <= 0: derive (camera.h) */
+  int spp;                  /* samples per pixel (used when time_budget <= 0) */
+  double time_budget;       /* > 0: whole passes until this many seconds */
+  uint64_t seed;
+  int threads;              /* <= 0: all cores */
+  iris_method method;
+  int max_depth;            /* Cycles' bounce count */
+  int rr_depth;             /* first bounce with Russian roulette */
+  const char *camera_name;  /* NULL: the scene's first camera */
+  /* Set asynchronously (e.g. by a signal handler) to stop after the current pass. */
+  volatile sig_atomic_t *cancel;
+  /* Called after each pass from the calling thread (may be NULL). */
+  void (*progress)(void *ctx, int spp_done, int spp_total, double elapsed, double eta);
+  void *progress_ctx;
+  const iris_guide_provider *guide; /* needed by the guided methods */
+} iris_render_params;
+
+/* Defaults: 64 spp, seed 0, all cores, mis, max depth 64, RR from bounce 3. */
+iris_render_params iris_render_params_default(void);
+/* Fills unset params (spp, max depth, method) from the scene's render settings. */
+void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scene);
+
+typedef struct iris_render_result {
+  iris_film film;
+  iris_pinhole camera;
+  iris_method method;
+  int spp;               /* samples per pixel completed */
+  uint64_t seed;
+  int threads;
+  double seconds;        /* path tracing time (the passes) */
+  double setup_seconds;  /* accel, textures, lights, guide */
+  iris_path_stats stats;
+  bool interrupted;
+} iris_render_result;
+
+iris_status iris_render(const iris_scene *scene, const iris_render_params *params,
+                        iris_render_result *result, iris_error *err);
+void iris_render_result_destroy(iris_render_result *result);
+
+/* EXR with R, G, B (+ var.R/G/B when `variance`) and iris:version, scene,
+ * method, spp, seed, render_seconds, interrupted, ... metadata. */
+iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
+                                  const char *scene_name, bool variance, iris_error *err);
+iris_status iris_render_write_png(const iris_render_result *r, const char *path, float exposure,
+                                  iris_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
