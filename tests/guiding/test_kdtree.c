@@ -1,0 +1,85 @@
+/* kd-tree k-NN against brute force, including duplicates and ties. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "core/rng.h"
+#include "renderer/guiding/kdtree.h"
+
+static int failures = 0;
+
+static int cmp_pair(const void *a, const void *b) {
+  const float *x = a, *y = b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return x[1] < y[1] ? -1 : (x[1] > y[1]);
+}
+
+static void run(uint32_t n, int grid, uint64_t seed) {
+  iris_vec3 *pts = malloc(sizeof(iris_vec3) * n);
+  for (uint32_t i = 0; i < n; ++i) {
+    iris_sampler s = iris_sampler_start(seed, i, 0);
+    float x = iris_sampler_next(&s), y = iris_sampler_next(&s), z = iris_sampler_next(&s);
+    if (grid) { /* many duplicates and equal distances */
+      x = floorf(x * 4) / 4;
+      y = floorf(y * 4) / 4;
+      z = 0.0f;
+    }
+    pts[i] = iris_v3(x, y, z);
+  }
+  iris_kdtree t;
+  if (iris_kdtree_build(&t, pts, sizeof(iris_vec3), n, NULL) != IRIS_OK) {
+    ++failures;
+    return;
+  }
+  float (*brute)[2] = malloc(sizeof(float) * 2 * n);
+  uint32_t ids[40];
+  float d2[40];
+  for (int q = 0; q < 200; ++q) {
+    iris_sampler s = iris_sampler_start(seed + 1, (uint64_t)q, 0);
+    iris_vec3 p = iris_v3(iris_sampler_next(&s) * 1.2f - 0.1f, iris_sampler_next(&s), grid ? 0.0f : iris_sampler_next(&s));
+    uint32_t k = 1 + (uint32_t)q % 40;
+    float maxd2 = (q % 3 == 0) ? 0.05f : INFINITY;
+    uint32_t got = iris_kdtree_knn(&t, p, k, maxd2, ids, d2);
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      iris_vec3 d = iris_sub(pts[i], p);
+      float dd = d.x * d.x + d.y * d.y + d.z * d.z;
+      if (dd <= maxd2) {
+        brute[m][0] = dd;
+        brute[m][1] = (float)i;
+        ++m;
+      }
+    }
+    qsort(brute, m, sizeof brute[0], cmp_pair);
+    uint32_t want = m < k ? m : k;
+    if (got != want) {
+      fprintf(stderr, "FAIL n=%u q=%d: got %u neighbours, want %u\n", n, q, got, want);
+      ++failures;
+      continue;
+    }
+    for (uint32_t i = 0; i < got; ++i) {
+      if (ids[i] != (uint32_t)brute[i][1] || d2[i] != brute[i][0]) {
+        fprintf(stderr, "FAIL n=%u q=%d rank %u: id %u d2 %g, want %u %g\n", n, q, i, ids[i], d2[i],
+                (uint32_t)brute[i][1], brute[i][0]);
+        ++failures;
+        break;
+      }
+    }
+  }
+  free(brute);
+  iris_kdtree_destroy(&t);
+  free(pts);
+}
+
+int main(void) {
+  run(1, 0, 1);
+  run(2, 0, 2);
+  run(37, 0, 3);
+  run(5000, 0, 4);
+  run(3000, 1, 5); /* ties broken by index, as documented */
+  iris_kdtree t;
+  if (iris_kdtree_build(&t, NULL, 12, 0, NULL) != IRIS_OK || iris_kdtree_knn(&t, iris_v3(0, 0, 0), 3, INFINITY, NULL, NULL) != 0)
+    ++failures;
+  if (failures) fprintf(stderr, "%d failures\n", failures);
+  return failures ? 1 : 0;
+}
