@@ -1,2 +1,406 @@
-/* placeholder: implemented by the module's issue work */
-typedef int iris_placeholder_unit_;
+/* The in-memory scene: lifetime, appenders, merging, validation and the
+ * derived quantities (bounds, triangle counts). The file format is in
+ * scene_io.c; docs/format.md describes both. */
+#include "scene/scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/fileio.h"
+
+/* ---- lifetime ---------------------------------------------------------- */
+
+iris_scene *iris_scene_create(void) {
+  iris_scene *scene = calloc(1, sizeof *scene);
+  if (!scene) return NULL;
+  memcpy(scene->units, "m", 2);
+  scene->render.max_depth = -1;
+  return scene;
+}
+
+static void free_mesh(iris_mesh *m) {
+  free(m->name);
+  if (m->owned) {
+    free(m->positions);
+    free(m->normals);
+    free(m->uvs);
+    free(m->colors);
+    free(m->indices);
+  }
+}
+
+void iris_scene_destroy(iris_scene *scene) {
+  if (!scene) return;
+  for (size_t i = 0; i < scene->texture_count; i++) {
+    free(scene->textures[i].name);
+    free(scene->textures[i].path);
+    free(scene->textures[i].data);
+  }
+  for (size_t i = 0; i < scene->material_count; i++) free(scene->materials[i].name);
+  for (size_t i = 0; i < scene->mesh_count; i++) free_mesh(&scene->meshes[i]);
+  for (size_t i = 0; i < scene->camera_count; i++) free(scene->cameras[i].name);
+  for (size_t i = 0; i < scene->light_count; i++) free(scene->lights[i].name);
+  iris_file_map *maps = scene->maps;
+  for (size_t i = 0; i < scene->map_count; i++) iris_file_map_close(&maps[i]);
+  free(scene->maps);
+  free(scene->textures);
+  free(scene->materials);
+  free(scene->meshes);
+  free(scene->instances);
+  free(scene->cameras);
+  free(scene->lights);
+  free(scene->source_path);
+  free(scene);
+}
+
+char *iris_strdup(const char *s) {
+  if (!s) return NULL;
+  size_t n = strlen(s) + 1;
+  char *d = malloc(n);
+  if (d) memcpy(d, s, n);
+  return d;
+}
+
+/* Grows *array by one element of `size` bytes and copies `elem` into it.
+ * Arrays have no capacity field, so each append reallocs; glibc extends in
+ * place or remaps large blocks, which keeps imports of many meshes linear. */
+static int32_t append(void **array, size_t *count, size_t size, const void *elem) {
+  if (*count >= (size_t)INT32_MAX) return -1;
+  void *grown = realloc(*array, (*count + 1) * size);
+  if (!grown) return -1;
+  *array = grown;
+  memcpy((char *)grown + *count * size, elem, size);
+  return (int32_t)(*count)++;
+}
+
+int32_t iris_scene_add_texture(iris_scene *scene, const iris_texture *tex) {
+  return append((void **)&scene->textures, &scene->texture_count, sizeof *tex, tex);
+}
+int32_t iris_scene_add_material(iris_scene *scene, const iris_material *mat) {
+  return append((void **)&scene->materials, &scene->material_count, sizeof *mat, mat);
+}
+int32_t iris_scene_add_mesh(iris_scene *scene, const iris_mesh *mesh) {
+  return append((void **)&scene->meshes, &scene->mesh_count, sizeof *mesh, mesh);
+}
+int32_t iris_scene_add_instance(iris_scene *scene, const iris_instance *inst) {
+  return append((void **)&scene->instances, &scene->instance_count, sizeof *inst, inst);
+}
+int32_t iris_scene_add_camera(iris_scene *scene, const iris_camera *cam) {
+  return append((void **)&scene->cameras, &scene->camera_count, sizeof *cam, cam);
+}
+int32_t iris_scene_add_light(iris_scene *scene, const iris_light *light) {
+  return append((void **)&scene->lights, &scene->light_count, sizeof *light, light);
+}
+
+iris_material iris_material_default(iris_material_type type) {
+  iris_material m;
+  memset(&m, 0, sizeof m);
+  m.type = type;
+  m.color[0] = m.color[1] = m.color[2] = 0.8f;
+  m.color_texture = -1;
+  m.roughness = 0.5f;
+  m.ior = 1.5f;
+  m.metallic = 0.0f;
+  m.metallic_roughness_texture = -1;
+  m.specular = 1.0f;
+  m.specular_color[0] = m.specular_color[1] = m.specular_color[2] = 1.0f;
+  m.transmission = 0.0f;
+  m.emission_texture = -1;
+  m.emission_two_sided = true;
+  m.double_sided = false;
+  return m;
+}
+
+/* ---- merging ----------------------------------------------------------- */
+
+/* Appends n elements of `size` bytes from src to *dst (all or nothing). */
+static bool extend(void **dst, size_t *dst_count, const void *src, size_t n, size_t size) {
+  if (n == 0) return true;
+  if (*dst_count > (size_t)INT32_MAX - n) return false;
+  void *grown = realloc(*dst, (*dst_count + n) * size);
+  if (!grown) return false;
+  *dst = grown;
+  memcpy((char *)grown + *dst_count * size, src, n * size);
+  *dst_count += n;
+  return true;
+}
+
+static int32_t shift_ref(int32_t ref, size_t offset) {
+  return ref < 0 ? ref : (int32_t)((size_t)ref + offset);
+}
+
+iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) {
+  if (!src) return IRIS_OK;
+  if (strcmp(dst->units, src->units) != 0) {
+    iris_status st = iris_error_set(err, IRIS_ERR_INVALID, src->source_path, 0, NULL,
+                                    "cannot merge a scene in units '%s' into one in '%s'",
+                                    src->units, dst->units);
+    iris_scene_destroy(src);
+    return st;
+  }
+  size_t tex0 = dst->texture_count, mat0 = dst->material_count, mesh0 = dst->mesh_count;
+  for (size_t i = 0; i < src->material_count; i++) {
+    iris_material *m = &src->materials[i];
+    m->color_texture = shift_ref(m->color_texture, tex0);
+    m->metallic_roughness_texture = shift_ref(m->metallic_roughness_texture, tex0);
+    m->emission_texture = shift_ref(m->emission_texture, tex0);
+  }
+  for (size_t i = 0; i < src->mesh_count; i++)
+    src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
+  for (size_t i = 0; i < src->instance_count; i++) src->instances[i].mesh += (uint32_t)mesh0;
+
+  /* Reserve everything first so that a failed allocation leaves dst intact
+   * (its counts unchanged) and src still owning its contents. */
+  size_t saved[7] = {dst->texture_count, dst->material_count, dst->mesh_count,
+                     dst->instance_count, dst->camera_count, dst->light_count, dst->map_count};
+  bool ok = extend((void **)&dst->textures, &dst->texture_count, src->textures,
+                   src->texture_count, sizeof *src->textures) &&
+            extend((void **)&dst->materials, &dst->material_count, src->materials,
+                   src->material_count, sizeof *src->materials) &&
+            extend((void **)&dst->meshes, &dst->mesh_count, src->meshes, src->mesh_count,
+                   sizeof *src->meshes) &&
+            extend((void **)&dst->instances, &dst->instance_count, src->instances,
+                   src->instance_count, sizeof *src->instances) &&
+            extend((void **)&dst->cameras, &dst->camera_count, src->cameras, src->camera_count,
+                   sizeof *src->cameras) &&
+            extend((void **)&dst->lights, &dst->light_count, src->lights, src->light_count,
+                   sizeof *src->lights) &&
+            extend(&dst->maps, &dst->map_count, src->maps, src->map_count, sizeof(iris_file_map));
+  if (!ok) {
+    dst->texture_count = saved[0];
+    dst->material_count = saved[1];
+    dst->mesh_count = saved[2];
+    dst->instance_count = saved[3];
+    dst->camera_count = saved[4];
+    dst->light_count = saved[5];
+    dst->map_count = saved[6];
+    iris_scene_destroy(src);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory merging scenes");
+  }
+  if (!dst->has_environment && src->has_environment) {
+    dst->has_environment = true;
+    memcpy(dst->environment, src->environment, sizeof dst->environment);
+  }
+  /* dst's render settings win; src fills only what dst leaves at its default. */
+  iris_render_settings *r = &dst->render;
+  const iris_render_settings *s = &src->render;
+  if (!r->width && !r->height) {
+    r->width = s->width;
+    r->height = s->height;
+  }
+  if (!r->spp) r->spp = s->spp;
+  if (r->max_depth < 0) r->max_depth = s->max_depth;
+  if (!r->method[0]) memcpy(r->method, s->method, sizeof r->method);
+  if (!r->has_seed && s->has_seed) {
+    r->seed = s->seed;
+    r->has_seed = true;
+  }
+  /* dst now owns every pointer; release only src's arrays. */
+  src->texture_count = src->material_count = src->mesh_count = 0;
+  src->camera_count = src->light_count = src->map_count = 0;
+  iris_scene_destroy(src);
+  return IRIS_OK;
+}
+
+/* ---- validation -------------------------------------------------------- */
+
+static bool finite_n(const float *v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return false;
+  return true;
+}
+
+static bool nonneg_finite_n(const float *v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i]) || v[i] < 0.0f) return false;
+  return true;
+}
+
+/* First index i in [0, n) with !isfinite(v[i]), or n. */
+static size_t first_nonfinite(const float *v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return i;
+  return n;
+}
+
+static bool mat4_finite(const iris_mat4 *m) { return finite_n(&m->m[0][0], 16); }
+
+#define FAIL(...) return iris_error_set(err, IRIS_ERR_INVALID, file, 0, element, __VA_ARGS__)
+
+static iris_status check_texture_ref(int32_t ref, size_t count, const char *what,
+                                     const char *file, const char *element, iris_error *err) {
+  if (ref < -1 || (ref >= 0 && (size_t)ref >= count))
+    FAIL("%s %d out of range (texture count %zu)", what, (int)ref, count);
+  return IRIS_OK;
+}
+
+static iris_status validate_material(const iris_scene *s, const iris_material *m,
+                                     const char *file, const char *element, iris_error *err) {
+  if ((unsigned)m->type > IRIS_MATERIAL_GLTF) FAIL("unknown material type %d", (int)m->type);
+  if (!nonneg_finite_n(m->color, 3)) FAIL("color must be finite and non-negative");
+  if (!isfinite(m->roughness) || m->roughness < 0.0f || m->roughness > 1.0f)
+    FAIL("roughness %g outside [0, 1]", (double)m->roughness);
+  if (!isfinite(m->ior) || m->ior <= 0.0f) FAIL("ior %g must be finite and positive", (double)m->ior);
+  if (!isfinite(m->metallic) || m->metallic < 0.0f || m->metallic > 1.0f)
+    FAIL("metallic %g outside [0, 1]", (double)m->metallic);
+  if (!isfinite(m->specular) || m->specular < 0.0f)
+    FAIL("specular %g must be finite and non-negative", (double)m->specular);
+  if (!nonneg_finite_n(m->specular_color, 3)) FAIL("specular_color must be finite and non-negative");
+  if (!isfinite(m->transmission) || m->transmission < 0.0f || m->transmission > 1.0f)
+    FAIL("transmission %g outside [0, 1]", (double)m->transmission);
+  if (!nonneg_finite_n(m->emission, 3)) FAIL("emission must be finite and non-negative");
+  iris_status st;
+  if ((st = check_texture_ref(m->color_texture, s->texture_count, "color_texture", file, element, err)))
+    return st;
+  if ((st = check_texture_ref(m->metallic_roughness_texture, s->texture_count,
+                              "metallic_roughness_texture", file, element, err)))
+    return st;
+  return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,
+                           element, err);
+}
+
+static iris_status validate_mesh(const iris_scene *s, const iris_mesh *m, const char *file,
+                                 const char *element, iris_error *err) {
+  if (m->vertex_count == 0) FAIL("mesh has no vertices");
+  if (m->triangle_count == 0) FAIL("mesh has no triangles");
+  if (!m->positions || !m->indices) FAIL("mesh has no position or index array");
+  if (m->material < -1 || (m->material >= 0 && (size_t)m->material >= s->material_count))
+    FAIL("material %d out of range (material count %zu)", (int)m->material, s->material_count);
+  size_t nv = m->vertex_count;
+  size_t bad;
+  if ((bad = first_nonfinite(m->positions, 3 * nv)) < 3 * nv)
+    FAIL("position of vertex %zu is not finite", bad / 3);
+  if (m->normals && (bad = first_nonfinite(m->normals, 3 * nv)) < 3 * nv)
+    FAIL("normal of vertex %zu is not finite", bad / 3);
+  if (m->uvs && (bad = first_nonfinite(m->uvs, 2 * nv)) < 2 * nv)
+    FAIL("uv of vertex %zu is not finite", bad / 2);
+  if (m->colors && (bad = first_nonfinite(m->colors, 3 * nv)) < 3 * nv)
+    FAIL("color of vertex %zu is not finite", bad / 3);
+  size_t ni = 3 * (size_t)m->triangle_count;
+  for (size_t i = 0; i < ni; i++)
+    if (m->indices[i] >= m->vertex_count)
+      FAIL("index %u out of range (vertex count %u) in triangle %zu", (unsigned)m->indices[i],
+           (unsigned)m->vertex_count, i / 3);
+  return IRIS_OK;
+}
+
+static iris_status validate_light(const iris_light *l, const char *file, const char *element,
+                                  iris_error *err) {
+  if ((unsigned)l->type > IRIS_LIGHT_DIRECTIONAL) FAIL("unknown light type %d", (int)l->type);
+  if (!nonneg_finite_n(l->color, 3)) FAIL("color must be finite and non-negative");
+  if (!isfinite(l->intensity) || l->intensity < 0.0f)
+    FAIL("intensity %g must be finite and non-negative", (double)l->intensity);
+  if (!finite_n(l->position, 3)) FAIL("position is not finite");
+  if (!finite_n(l->direction, 3)) FAIL("direction is not finite");
+  if (!isfinite(l->range) || l->range < 0.0f) FAIL("range %g must be finite and non-negative", (double)l->range);
+  if (l->type != IRIS_LIGHT_POINT && !(iris_length(iris_v3_load(l->direction)) > 0.0f))
+    FAIL("direction must be a non-zero vector");
+  if (l->type == IRIS_LIGHT_SPOT) {
+    if (!isfinite(l->inner_cone) || !isfinite(l->outer_cone) || l->inner_cone < 0.0f ||
+        l->inner_cone > l->outer_cone || l->outer_cone <= 0.0f || l->outer_cone > 0.5f * IRIS_PI)
+      FAIL("cone angles must satisfy 0 <= inner (%g) <= outer (%g) <= pi/2, outer > 0",
+           (double)l->inner_cone, (double)l->outer_cone);
+  }
+  return IRIS_OK;
+}
+
+iris_status iris_scene_validate(const iris_scene *s, const char *file, iris_error *err) {
+  char element[64];
+  iris_status st;
+  if (!s->units[0] || !memchr(s->units, '\0', sizeof s->units)) {
+    snprintf(element, sizeof element, "units");
+    FAIL("units must be a non-empty string");
+  }
+  for (size_t i = 0; i < s->texture_count; i++) {
+    const iris_texture *t = &s->textures[i];
+    snprintf(element, sizeof element, "textures[%zu]", i);
+    if (!t->path && !t->data) FAIL("texture has neither a file nor data");
+    if (t->path && t->data) FAIL("texture has both a file and data");
+    if (t->data && t->data_size == 0) FAIL("texture data is empty");
+    if ((unsigned)t->wrap_s > IRIS_WRAP_MIRROR || (unsigned)t->wrap_t > IRIS_WRAP_MIRROR)
+      FAIL("unknown wrap mode");
+    if (t->data && strcmp(t->mime, "image/png") != 0 && strcmp(t->mime, "image/jpeg") != 0)
+      FAIL("unsupported image type '%.16s' (PNG and JPEG are supported)", t->mime);
+  }
+  for (size_t i = 0; i < s->material_count; i++) {
+    snprintf(element, sizeof element, "materials[%zu]", i);
+    if ((st = validate_material(s, &s->materials[i], file, element, err))) return st;
+  }
+  for (size_t i = 0; i < s->mesh_count; i++) {
+    snprintf(element, sizeof element, "meshes[%zu]", i);
+    if ((st = validate_mesh(s, &s->meshes[i], file, element, err))) return st;
+  }
+  for (size_t i = 0; i < s->instance_count; i++) {
+    const iris_instance *inst = &s->instances[i];
+    snprintf(element, sizeof element, "instances[%zu]", i);
+    if (inst->mesh >= s->mesh_count)
+      FAIL("mesh %u out of range (mesh count %zu)", (unsigned)inst->mesh, s->mesh_count);
+    if (!mat4_finite(&inst->transform)) FAIL("transform is not finite");
+  }
+  for (size_t i = 0; i < s->camera_count; i++) {
+    const iris_camera *c = &s->cameras[i];
+    snprintf(element, sizeof element, "cameras[%zu]", i);
+    if (!mat4_finite(&c->to_world)) FAIL("to_world is not finite");
+    iris_mat4 inv;
+    if (!iris_mat4_inverse(&c->to_world, &inv)) FAIL("to_world is singular");
+    if (!isfinite(c->yfov) || c->yfov <= 0.0f || c->yfov >= IRIS_PI)
+      FAIL("yfov %g rad outside (0, pi)", (double)c->yfov);
+    if (!isfinite(c->aspect) || c->aspect < 0.0f) FAIL("aspect %g must be finite and >= 0", (double)c->aspect);
+  }
+  for (size_t i = 0; i < s->light_count; i++) {
+    snprintf(element, sizeof element, "lights[%zu]", i);
+    if ((st = validate_light(&s->lights[i], file, element, err))) return st;
+  }
+  if (s->has_environment && !nonneg_finite_n(s->environment, 3)) {
+    snprintf(element, sizeof element, "environment");
+    FAIL("environment must be finite and non-negative");
+  }
+  const iris_render_settings *r = &s->render;
+  snprintf(element, sizeof element, "render");
+  if (r->width < 0 || r->height < 0 || r->width > 65536 || r->height > 65536)
+    FAIL("image size %dx%d outside [0, 65536]", r->width, r->height);
+  if (r->spp < 0) FAIL("spp %d is negative", r->spp);
+  if (r->max_depth < -1) FAIL("max_depth %d is below -1", r->max_depth);
+  if (!memchr(r->method, '\0', sizeof r->method)) FAIL("method is not a terminated string");
+  return IRIS_OK;
+}
+#undef FAIL
+
+/* ---- derived quantities ------------------------------------------------ */
+
+bool iris_scene_bounds(const iris_scene *s, iris_vec3 *lo, iris_vec3 *hi) {
+  iris_vec3 a = iris_v3(INFINITY, INFINITY, INFINITY), b = iris_v3(-INFINITY, -INFINITY, -INFINITY);
+  bool any = false;
+  /* Object-space boxes per mesh, then the 8 transformed corners per instance:
+   * exact for translations and axis permutations, conservative otherwise. */
+  for (size_t i = 0; i < s->instance_count; i++) {
+    const iris_instance *inst = &s->instances[i];
+    if (inst->mesh >= s->mesh_count) continue;
+    const iris_mesh *m = &s->meshes[inst->mesh];
+    if (!m->positions || m->vertex_count == 0) continue;
+    iris_vec3 mlo = iris_v3(INFINITY, INFINITY, INFINITY), mhi = iris_neg(mlo);
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+      iris_vec3 p = iris_v3_load(m->positions + 3 * (size_t)v);
+      mlo = iris_v3(fminf(mlo.x, p.x), fminf(mlo.y, p.y), fminf(mlo.z, p.z));
+      mhi = iris_v3(fmaxf(mhi.x, p.x), fmaxf(mhi.y, p.y), fmaxf(mhi.z, p.z));
+    }
+    for (int c = 0; c < 8; c++) {
+      iris_vec3 p = iris_v3(c & 1 ? mhi.x : mlo.x, c & 2 ? mhi.y : mlo.y, c & 4 ? mhi.z : mlo.z);
+      p = iris_mat4_point(&inst->transform, p);
+      a = iris_v3(fminf(a.x, p.x), fminf(a.y, p.y), fminf(a.z, p.z));
+      b = iris_v3(fmaxf(b.x, p.x), fmaxf(b.y, p.y), fmaxf(b.z, p.z));
+    }
+    any = true;
+  }
+  if (!any) return false;
+  if (lo) *lo = a;
+  if (hi) *hi = b;
+  return true;
+}
+
+uint64_t iris_scene_triangle_count(const iris_scene *s) {
+  uint64_t n = 0;
+  for (size_t i = 0; i < s->instance_count; i++)
+    if (s->instances[i].mesh < s->mesh_count) n += s->meshes[s->instances[i].mesh].triangle_count;
+  return n;
+}

@@ -1,2 +1,937 @@
-/* placeholder: implemented by the module's issue work */
-typedef int iris_placeholder_unit_;
+/* The scene JSON (docs/format.md): writing and loading, with the mesh files
+ * (mesh_file.c) next to it. Loading parses leniently into the scene model
+ * (types checked, unknown keys warned about), then iris_scene_validate checks
+ * every invariant. Writing is deterministic: the same scene gives the same
+ * bytes, so import -> write -> load -> write reproduces every file. */
+/* realpath() is an X/Open extension in the glibc headers. */
+#define _XOPEN_SOURCE 700
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <float.h>
+#include <limits.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
+#include "scene/mesh_file.h"
+#include "scene/scene.h"
+
+#define SCENE_FORMAT_NAME "iris-scene"
+#define MAX_JSON_BYTES ((size_t)256 << 20)
+#define PI_D 3.14159265358979323846
+
+static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
+static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
+static const char *const WRAP_MODES[] = {"repeat", "clamp", "mirror"};
+static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors"};
+
+/* ====================================================================== */
+/* Numbers                                                                 */
+/* ====================================================================== */
+
+/* The shortest decimal (as a double) that reads back as exactly `f`. cJSON
+ * prints doubles with up to 15 significant digits when that is exact, so the
+ * JSON shows "0.8" for 0.8f instead of 0.800000011920929 and still parses
+ * back to the same float. */
+static double shortest_float(float f) {
+  char buf[48];
+  for (int p = 1; p <= 9; p++) {
+    snprintf(buf, sizeof buf, "%.*g", p, (double)f);
+    if (strtof(buf, NULL) == f) return strtod(buf, NULL);
+  }
+  return (double)f;
+}
+
+static float deg_to_rad(double deg) { return (float)(deg * (PI_D / 180.0)); }
+
+/* Shortest decimal number of degrees that deg_to_rad maps back to `rad`. */
+static double shortest_degrees(float rad) {
+  char buf[48];
+  double deg = (double)rad * (180.0 / PI_D);
+  for (int p = 1; p <= 17; p++) {
+    snprintf(buf, sizeof buf, "%.*g", p, deg);
+    double d = strtod(buf, NULL);
+    if (deg_to_rad(d) == rad) return d;
+  }
+  return deg;
+}
+
+/* ====================================================================== */
+/* Writing                                                                 */
+/* ====================================================================== */
+
+static cJSON *json_floats(const float *v, int n) {
+  cJSON *a = cJSON_CreateArray();
+  for (int i = 0; a && i < n; i++) cJSON_AddItemToArray(a, cJSON_CreateNumber(shortest_float(v[i])));
+  return a;
+}
+
+static void add_float(cJSON *o, const char *key, float v) {
+  cJSON_AddNumberToObject(o, key, shortest_float(v));
+}
+static void add_floats(cJSON *o, const char *key, const float *v, int n) {
+  cJSON_AddItemToObject(o, key, json_floats(v, n));
+}
+static bool floats_equal(const float *a, const float *b, int n) {
+  for (int i = 0; i < n; i++)
+    if (a[i] != b[i]) return false;
+  return true;
+}
+
+/* Splits an absolute, normalised path into '/'-separated components. */
+static int split_path(char *path, char **parts, int max) {
+  int n = 0;
+  char *save = NULL;
+  for (char *tok = strtok_r(path, "/", &save); tok && n < max; tok = strtok_r(NULL, "/", &save))
+    parts[n++] = tok;
+  return n;
+}
+
+/* Relative path from absolute folder `from` to absolute file `to`. */
+static void relative_path(const char *from, const char *to, char *out, size_t size) {
+  char a[PATH_MAX], b[PATH_MAX];
+  char *pa[256], *pb[256];
+  snprintf(a, sizeof a, "%s", from);
+  snprintf(b, sizeof b, "%s", to);
+  int na = split_path(a, pa, 256), nb = split_path(b, pb, 256);
+  int common = 0;
+  while (common < na && common < nb - 1 && strcmp(pa[common], pb[common]) == 0) common++;
+  size_t used = 0;
+  out[0] = '\0';
+  for (int i = common; i < na; i++) used += (size_t)snprintf(out + used, used < size ? size - used : 0, "../");
+  for (int i = common; i < nb; i++)
+    used += (size_t)snprintf(out + used, used < size ? size - used : 0, "%s%s", pb[i], i + 1 < nb ? "/" : "");
+}
+
+/* The camera as position/target/up when iris_mat4_look_at rebuilds exactly
+ * the same matrix from them (true for most hand-placed cameras); otherwise
+ * the raw matrix, so a written scene always loads back bit for bit. */
+static void add_camera_placement(cJSON *o, const iris_mat4 *m) {
+  /* +0.0f turns -0 into +0, as the JSON would. */
+  iris_vec3 eye = iris_v3(m->m[0][3] + 0.0f, m->m[1][3] + 0.0f, m->m[2][3] + 0.0f);
+  iris_vec3 back = iris_v3(m->m[0][2], m->m[1][2], m->m[2][2]);
+  iris_vec3 target = iris_sub(eye, back);
+  target = iris_v3(target.x + 0.0f, target.y + 0.0f, target.z + 0.0f);
+  iris_vec3 ups[3] = {iris_v3(0, 1, 0), iris_v3(0, 0, 1),
+                      iris_v3(m->m[0][1] + 0.0f, m->m[1][1] + 0.0f, m->m[2][1] + 0.0f)};
+  for (int u = 0; u < 3; u++) {
+    iris_mat4 r = iris_mat4_look_at(eye, target, ups[u]);
+    if (floats_equal(&r.m[0][0], &m->m[0][0], 16)) {
+      float e[3], t[3], up[3];
+      iris_v3_store(eye, e);
+      iris_v3_store(target, t);
+      iris_v3_store(ups[u], up);
+      add_floats(o, "position", e, 3);
+      add_floats(o, "target", t, 3);
+      add_floats(o, "up", up, 3);
+      return;
+    }
+  }
+  add_floats(o, "to_world", &m->m[0][0], 16);
+}
+
+static cJSON *write_material(const iris_material *m) {
+  const iris_material d = iris_material_default(m->type);
+  bool rough = m->type != IRIS_MATERIAL_DIFFUSE;
+  bool ior = m->type == IRIS_MATERIAL_GLASS || m->type == IRIS_MATERIAL_GLTF;
+  bool gltf = m->type == IRIS_MATERIAL_GLTF;
+  cJSON *o = cJSON_CreateObject();
+  if (m->name) cJSON_AddStringToObject(o, "name", m->name);
+  cJSON_AddStringToObject(o, "type", MATERIAL_TYPES[m->type]);
+  if (!floats_equal(m->color, d.color, 3)) add_floats(o, "color", m->color, 3);
+  if (m->color_texture >= 0) cJSON_AddNumberToObject(o, "color_texture", m->color_texture);
+  if (rough && m->roughness != d.roughness) add_float(o, "roughness", m->roughness);
+  if (ior && m->ior != d.ior) add_float(o, "ior", m->ior);
+  if (gltf) {
+    if (m->metallic != d.metallic) add_float(o, "metallic", m->metallic);
+    if (m->metallic_roughness_texture >= 0)
+      cJSON_AddNumberToObject(o, "metallic_roughness_texture", m->metallic_roughness_texture);
+    if (m->specular != d.specular) add_float(o, "specular", m->specular);
+    if (!floats_equal(m->specular_color, d.specular_color, 3))
+      add_floats(o, "specular_color", m->specular_color, 3);
+    if (m->transmission != d.transmission) add_float(o, "transmission", m->transmission);
+  }
+  if (!floats_equal(m->emission, d.emission, 3)) add_floats(o, "emission", m->emission, 3);
+  if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
+  if (m->emission_two_sided != d.emission_two_sided)
+    cJSON_AddBoolToObject(o, "emission_two_sided", m->emission_two_sided);
+  if (m->double_sided != d.double_sided) cJSON_AddBoolToObject(o, "double_sided", m->double_sided);
+  return o;
+}
+
+static cJSON *write_light(const iris_light *l) {
+  cJSON *o = cJSON_CreateObject();
+  if (l->name) cJSON_AddStringToObject(o, "name", l->name);
+  cJSON_AddStringToObject(o, "type", LIGHT_TYPES[l->type]);
+  static const float white[3] = {1, 1, 1};
+  if (!floats_equal(l->color, white, 3)) add_floats(o, "color", l->color, 3);
+  add_float(o, "intensity", l->intensity);
+  if (l->type != IRIS_LIGHT_DIRECTIONAL) add_floats(o, "position", l->position, 3);
+  if (l->type != IRIS_LIGHT_POINT) add_floats(o, "direction", l->direction, 3);
+  if (l->range != 0.0f) add_float(o, "range", l->range);
+  if (l->type == IRIS_LIGHT_SPOT) {
+    cJSON_AddNumberToObject(o, "inner_cone_deg", shortest_degrees(l->inner_cone));
+    cJSON_AddNumberToObject(o, "outer_cone_deg", shortest_degrees(l->outer_cone));
+  }
+  return o;
+}
+
+static bool is_identity(const iris_mat4 *m) {
+  iris_mat4 id = iris_mat4_identity();
+  return floats_equal(&m->m[0][0], &id.m[0][0], 16);
+}
+
+static cJSON *write_render(const iris_render_settings *r) {
+  cJSON *o = cJSON_CreateObject();
+  if (r->width) cJSON_AddNumberToObject(o, "width", r->width);
+  if (r->height) cJSON_AddNumberToObject(o, "height", r->height);
+  if (r->spp) cJSON_AddNumberToObject(o, "spp", r->spp);
+  if (r->max_depth >= 0) cJSON_AddNumberToObject(o, "max_depth", r->max_depth);
+  if (r->method[0]) cJSON_AddStringToObject(o, "method", r->method);
+  if (r->has_seed) {
+    /* JSON numbers are doubles: seeds beyond 2^53 are written as strings. */
+    if (r->seed <= (UINT64_C(1) << 53)) {
+      cJSON_AddNumberToObject(o, "seed", (double)r->seed);
+    } else {
+      char buf[32];
+      snprintf(buf, sizeof buf, "%llu", (unsigned long long)r->seed);
+      cJSON_AddStringToObject(o, "seed", buf);
+    }
+  }
+  if (!o->child) {
+    cJSON_Delete(o);
+    return NULL;
+  }
+  return o;
+}
+
+/* Writes the in-memory texture `t` as "<stem>.textures/<i>.<ext>" and stores
+ * that name in `file`; path-based textures get their path relative to dir. */
+static iris_status write_texture_file(const iris_texture *t, size_t i, const char *dir,
+                                      const char *dir_abs, const char *stem, const char *scene_name,
+                                      char *file, size_t file_size, iris_error *err) {
+  char path[PATH_MAX], sub[PATH_MAX];
+  if (t->data) {
+    const char *ext = strcmp(t->mime, "image/jpeg") == 0 ? "jpg" : "png";
+    snprintf(file, file_size, "%s.textures/%zu.%s", stem, i, ext);
+    snprintf(sub, sizeof sub, "%s.textures", stem);
+    iris_path_join(dir, sub, path, sizeof path);
+    iris_status st = iris_mkdir_p(path, err);
+    if (st != IRIS_OK) return st;
+    iris_path_join(dir, file, path, sizeof path);
+    return iris_file_write_atomic(path, t->data, t->data_size, err);
+  }
+  char *abs = realpath(t->path, NULL);
+  if (!abs) {
+    char element[48];
+    snprintf(element, sizeof element, "textures[%zu]", i);
+    return iris_error_set(err, IRIS_ERR_IO, scene_name, 0, element, "cannot find texture file '%s': %s",
+                          t->path, strerror(errno));
+  }
+  relative_path(dir_abs, abs, file, file_size);
+  free(abs);
+  return IRIS_OK;
+}
+
+iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iris_error *err) {
+  const char *scene_name = scene->source_path ? scene->source_path : "scene";
+  iris_status st = iris_scene_validate(scene, scene_name, err);
+  if (st != IRIS_OK) return st;
+
+  char dir[PATH_MAX], stem[256], sub[PATH_MAX], path[PATH_MAX], file[PATH_MAX];
+  iris_path_dir(json_path, dir, sizeof dir);
+  iris_path_stem(json_path, stem, sizeof stem);
+  if ((st = iris_mkdir_p(dir, err)) != IRIS_OK) return st;
+  char *dir_abs = realpath(dir, NULL);
+  if (!dir_abs) return iris_error_set(err, IRIS_ERR_IO, dir, 0, NULL, "cannot resolve folder: %s", strerror(errno));
+
+  cJSON *root = cJSON_CreateObject();
+  cJSON_AddStringToObject(root, "format", SCENE_FORMAT_NAME);
+  cJSON_AddNumberToObject(root, "version", IRIS_SCENE_FORMAT_VERSION);
+  cJSON_AddStringToObject(root, "units", scene->units);
+
+  if (scene->camera_count) {
+    cJSON *a = cJSON_AddArrayToObject(root, "cameras");
+    for (size_t i = 0; i < scene->camera_count; i++) {
+      const iris_camera *c = &scene->cameras[i];
+      cJSON *o = cJSON_CreateObject();
+      if (c->name) cJSON_AddStringToObject(o, "name", c->name);
+      add_camera_placement(o, &c->to_world);
+      cJSON_AddNumberToObject(o, "yfov_deg", shortest_degrees(c->yfov));
+      if (c->aspect != 0.0f) add_float(o, "aspect", c->aspect);
+      cJSON_AddItemToArray(a, o);
+    }
+  }
+  if (scene->texture_count) {
+    cJSON *a = cJSON_AddArrayToObject(root, "textures");
+    for (size_t i = 0; i < scene->texture_count && st == IRIS_OK; i++) {
+      const iris_texture *t = &scene->textures[i];
+      st = write_texture_file(t, i, dir, dir_abs, stem, scene_name, file, sizeof file, err);
+      cJSON *o = cJSON_CreateObject();
+      if (t->name) cJSON_AddStringToObject(o, "name", t->name);
+      cJSON_AddStringToObject(o, "file", file);
+      if (t->wrap_s != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_s", WRAP_MODES[t->wrap_s]);
+      if (t->wrap_t != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_t", WRAP_MODES[t->wrap_t]);
+      if (t->nearest) cJSON_AddStringToObject(o, "filter", "nearest");
+      cJSON_AddItemToArray(a, o);
+    }
+  }
+  if (scene->material_count) {
+    cJSON *a = cJSON_AddArrayToObject(root, "materials");
+    for (size_t i = 0; i < scene->material_count; i++)
+      cJSON_AddItemToArray(a, write_material(&scene->materials[i]));
+  }
+  if (scene->mesh_count && st == IRIS_OK) {
+    snprintf(sub, sizeof sub, "%s.meshes", stem);
+    iris_path_join(dir, sub, path, sizeof path);
+    st = iris_mkdir_p(path, err);
+  }
+  cJSON *meshes = cJSON_AddArrayToObject(root, "meshes");
+  for (size_t i = 0; i < scene->mesh_count && st == IRIS_OK; i++) {
+    const iris_mesh *m = &scene->meshes[i];
+    snprintf(file, sizeof file, "%s.meshes/%zu.irmesh", stem, i);
+    iris_path_join(dir, file, path, sizeof path);
+    st = iris_mesh_write_file(m, path, err);
+    cJSON *o = cJSON_CreateObject();
+    if (m->name) cJSON_AddStringToObject(o, "name", m->name);
+    cJSON_AddStringToObject(o, "file", file);
+    if (m->material >= 0) cJSON_AddNumberToObject(o, "material", m->material);
+    cJSON_AddNumberToObject(o, "vertices", m->vertex_count);
+    cJSON_AddNumberToObject(o, "triangles", m->triangle_count);
+    cJSON *attrs = cJSON_AddArrayToObject(o, "attributes");
+    const void *present[3] = {m->normals, m->uvs, m->colors};
+    for (int k = 0; k < 3; k++)
+      if (present[k]) cJSON_AddItemToArray(attrs, cJSON_CreateString(ATTRIBUTE_NAMES[k]));
+    cJSON_AddItemToArray(meshes, o);
+  }
+  cJSON *instances = cJSON_AddArrayToObject(root, "instances");
+  for (size_t i = 0; i < scene->instance_count; i++) {
+    const iris_instance *inst = &scene->instances[i];
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "mesh", inst->mesh);
+    if (!is_identity(&inst->transform)) add_floats(o, "transform", &inst->transform.m[0][0], 16);
+    cJSON_AddItemToArray(instances, o);
+  }
+  if (scene->light_count) {
+    cJSON *a = cJSON_AddArrayToObject(root, "lights");
+    for (size_t i = 0; i < scene->light_count; i++) cJSON_AddItemToArray(a, write_light(&scene->lights[i]));
+  }
+  if (scene->has_environment) {
+    cJSON *o = cJSON_AddObjectToObject(root, "environment");
+    add_floats(o, "radiance", scene->environment, 3);
+  }
+  cJSON *render = write_render(&scene->render);
+  if (render) cJSON_AddItemToObject(root, "render", render);
+  free(dir_abs);
+
+  if (st == IRIS_OK) {
+    char *text = cJSON_Print(root);
+    if (!text) {
+      st = iris_error_set(err, IRIS_ERR_NOMEM, json_path, 0, NULL, "out of memory printing JSON");
+    } else {
+      size_t n = strlen(text);
+      text[n] = '\n'; /* replace the NUL: files end with a newline */
+      st = iris_file_write_atomic(json_path, text, n + 1, err);
+      free(text);
+    }
+  }
+  cJSON_Delete(root);
+  return st;
+}
+
+/* ====================================================================== */
+/* Loading                                                                 */
+/* ====================================================================== */
+
+typedef struct jctx {
+  const char *file; /* JSON path, for messages */
+  iris_error *err;
+  char element[96];
+} jctx;
+
+static iris_status jfail(jctx *c, iris_status status, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static iris_status jfail(jctx *c, iris_status status, const char *fmt, ...) {
+  char msg[400];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  return iris_error_set(c->err, status, c->file, 0, c->element[0] ? c->element : NULL, "%s", msg);
+}
+
+static void set_element(jctx *c, const char *array, size_t i) {
+  snprintf(c->element, sizeof c->element, "%s[%zu]", array, i);
+}
+
+/* Object check: must be an object; unknown keys warn; duplicate keys fail. */
+static iris_status check_keys(jctx *c, const cJSON *o, const char *const *known, size_t n) {
+  if (!cJSON_IsObject(o)) return jfail(c, IRIS_ERR_INVALID, "expected an object");
+  for (const cJSON *it = o->child; it; it = it->next) {
+    for (const cJSON *prev = o->child; prev != it; prev = prev->next)
+      if (strcmp(prev->string, it->string) == 0)
+        return jfail(c, IRIS_ERR_INVALID, "duplicate key '%s'", it->string);
+    bool found = false;
+    for (size_t k = 0; k < n && !found; k++) found = strcmp(known[k], it->string) == 0;
+    if (!found) {
+      if (c->element[0])
+        iris_warnf("%s: %s: unknown key '%s' (ignored)", c->file, c->element, it->string);
+      else
+        iris_warnf("%s: unknown key '%s' (ignored)", c->file, it->string);
+    }
+  }
+  return IRIS_OK;
+}
+
+static const cJSON *item(const cJSON *o, const char *key) { return cJSON_GetObjectItemCaseSensitive(o, key); }
+
+static iris_status require(jctx *c, const cJSON *o, const char *key) {
+  return item(o, key) ? IRIS_OK : jfail(c, IRIS_ERR_INVALID, "missing required key '%s'", key);
+}
+
+/* Numbers keep the caller's default when the key is absent. */
+static iris_status get_float(jctx *c, const cJSON *o, const char *key, float *out) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsNumber(v)) return jfail(c, IRIS_ERR_INVALID, "'%s' must be a number", key);
+  if (!isfinite(v->valuedouble) || fabs(v->valuedouble) > FLT_MAX)
+    return jfail(c, IRIS_ERR_INVALID, "'%s' is not a finite 32-bit float", key);
+  *out = (float)v->valuedouble;
+  return IRIS_OK;
+}
+
+static iris_status get_double(jctx *c, const cJSON *o, const char *key, double *out) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsNumber(v) || !isfinite(v->valuedouble))
+    return jfail(c, IRIS_ERR_INVALID, "'%s' must be a finite number", key);
+  *out = v->valuedouble;
+  return IRIS_OK;
+}
+
+static iris_status get_floats(jctx *c, const cJSON *o, const char *key, float *out, int n) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n)
+    return jfail(c, IRIS_ERR_INVALID, "'%s' must be an array of %d numbers", key, n);
+  int i = 0;
+  for (const cJSON *e = v->child; e; e = e->next, i++) {
+    if (!cJSON_IsNumber(e)) return jfail(c, IRIS_ERR_INVALID, "'%s' must be an array of %d numbers", key, n);
+    if (!isfinite(e->valuedouble) || fabs(e->valuedouble) > FLT_MAX)
+      return jfail(c, IRIS_ERR_INVALID, "'%s'[%d] is not a finite 32-bit float", key, i);
+    out[i] = (float)e->valuedouble;
+  }
+  return IRIS_OK;
+}
+
+static iris_status get_int(jctx *c, const cJSON *o, const char *key, double lo, double hi,
+                           double *out) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsNumber(v) || v->valuedouble != floor(v->valuedouble) || v->valuedouble < lo ||
+      v->valuedouble > hi)
+    return jfail(c, IRIS_ERR_INVALID, "'%s' must be an integer in [%.0f, %.0f]", key, lo, hi);
+  *out = v->valuedouble;
+  return IRIS_OK;
+}
+
+static iris_status get_i32(jctx *c, const cJSON *o, const char *key, double lo, double hi, int32_t *out) {
+  double d = *out;
+  iris_status st = get_int(c, o, key, lo, hi, &d);
+  *out = (int32_t)d;
+  return st;
+}
+
+static iris_status get_string(jctx *c, const cJSON *o, const char *key, const char **out) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsString(v)) return jfail(c, IRIS_ERR_INVALID, "'%s' must be a string", key);
+  *out = v->valuestring;
+  return IRIS_OK;
+}
+
+static iris_status get_bool(jctx *c, const cJSON *o, const char *key, bool *out) {
+  const cJSON *v = item(o, key);
+  if (!v) return IRIS_OK;
+  if (!cJSON_IsBool(v)) return jfail(c, IRIS_ERR_INVALID, "'%s' must be true or false", key);
+  *out = cJSON_IsTrue(v);
+  return IRIS_OK;
+}
+
+/* A string from a fixed list; *out keeps its default when absent. */
+static iris_status get_enum(jctx *c, const cJSON *o, const char *key, const char *const *names,
+                            int count, int *out) {
+  const char *s = NULL;
+  iris_status st = get_string(c, o, key, &s);
+  if (st != IRIS_OK || !s) return st;
+  for (int i = 0; i < count; i++)
+    if (strcmp(names[i], s) == 0) {
+      *out = i;
+      return IRIS_OK;
+    }
+  char list[160] = "";
+  for (int i = 0; i < count; i++)
+    snprintf(list + strlen(list), sizeof list - strlen(list), "%s'%s'", i ? ", " : "", names[i]);
+  return jfail(c, IRIS_ERR_INVALID, "'%s' is '%s', expected one of %s", key, s, list);
+}
+
+static iris_status get_name(jctx *c, const cJSON *o, char **out) {
+  const char *s = NULL;
+  iris_status st = get_string(c, o, "name", &s);
+  if (st != IRIS_OK || !s) return st;
+  *out = iris_strdup(s);
+  return *out ? IRIS_OK : jfail(c, IRIS_ERR_NOMEM, "out of memory");
+}
+
+/* An optional top-level array: absent means empty. */
+static iris_status get_array(jctx *c, const cJSON *root, const char *key, const cJSON **out) {
+  *out = item(root, key);
+  if (*out && !cJSON_IsArray(*out)) {
+    c->element[0] = '\0';
+    return jfail(c, IRIS_ERR_INVALID, "'%s' must be an array", key);
+  }
+  return IRIS_OK;
+}
+
+#define TRY(expr)                        \
+  do {                                   \
+    iris_status st_ = (expr);            \
+    if (st_ != IRIS_OK) return st_;      \
+  } while (0)
+
+static iris_status load_camera(jctx *c, const cJSON *o, iris_camera *cam) {
+  static const char *const keys[] = {"name", "to_world", "position", "target", "up", "yfov_deg", "aspect"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(get_name(c, o, &cam->name));
+  TRY(require(c, o, "yfov_deg"));
+  double deg = 0;
+  TRY(get_double(c, o, "yfov_deg", &deg));
+  if (!(deg > 0.0 && deg < 180.0)) return jfail(c, IRIS_ERR_INVALID, "yfov_deg %g outside (0, 180)", deg);
+  cam->yfov = deg_to_rad(deg);
+  TRY(get_float(c, o, "aspect", &cam->aspect));
+  bool matrix = item(o, "to_world") != NULL;
+  bool look = item(o, "position") || item(o, "target") || item(o, "up");
+  if (matrix && look) return jfail(c, IRIS_ERR_INVALID, "give either 'to_world' or 'position'/'target'/'up', not both");
+  if (matrix) return get_floats(c, o, "to_world", &cam->to_world.m[0][0], 16);
+  TRY(require(c, o, "position"));
+  TRY(require(c, o, "target"));
+  float eye[3], target[3], up[3] = {0, 1, 0};
+  TRY(get_floats(c, o, "position", eye, 3));
+  TRY(get_floats(c, o, "target", target, 3));
+  TRY(get_floats(c, o, "up", up, 3));
+  if (floats_equal(eye, target, 3)) return jfail(c, IRIS_ERR_INVALID, "'target' equals 'position'");
+  if (!(iris_length(iris_v3_load(up)) > 0.0f)) return jfail(c, IRIS_ERR_INVALID, "'up' is a zero vector");
+  cam->to_world = iris_mat4_look_at(iris_v3_load(eye), iris_v3_load(target), iris_v3_load(up));
+  return IRIS_OK;
+}
+
+static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
+  static const char *const keys[] = {"name", "type", "color", "color_texture", "roughness", "ior",
+                                     "metallic", "metallic_roughness_texture", "specular",
+                                     "specular_color", "transmission", "emission", "emission_texture",
+                                     "emission_two_sided", "double_sided"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(require(c, o, "type"));
+  int type = 0;
+  TRY(get_enum(c, o, "type", MATERIAL_TYPES, 4, &type));
+  *m = iris_material_default((iris_material_type)type);
+  TRY(get_name(c, o, &m->name));
+  /* Fields that do not apply to the type are read (so their types are
+   * checked) but reported as ignored, and the defaults kept. */
+  static const struct {
+    const char *key;
+    unsigned types; /* bit per iris_material_type */
+  } applies[] = {{"roughness", 0xE}, {"ior", 0xC}, {"metallic", 0x8}, {"metallic_roughness_texture", 0x8},
+                 {"specular", 0x8}, {"specular_color", 0x8}, {"transmission", 0x8}};
+  for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
+    if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
+      iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
+                 applies[k].key, MATERIAL_TYPES[type]);
+  iris_material full = *m;
+  TRY(get_floats(c, o, "color", full.color, 3));
+  TRY(get_i32(c, o, "color_texture", -1, INT32_MAX, &full.color_texture));
+  TRY(get_float(c, o, "roughness", &full.roughness));
+  TRY(get_float(c, o, "ior", &full.ior));
+  TRY(get_float(c, o, "metallic", &full.metallic));
+  TRY(get_i32(c, o, "metallic_roughness_texture", -1, INT32_MAX, &full.metallic_roughness_texture));
+  TRY(get_float(c, o, "specular", &full.specular));
+  TRY(get_floats(c, o, "specular_color", full.specular_color, 3));
+  TRY(get_float(c, o, "transmission", &full.transmission));
+  TRY(get_floats(c, o, "emission", full.emission, 3));
+  TRY(get_i32(c, o, "emission_texture", -1, INT32_MAX, &full.emission_texture));
+  TRY(get_bool(c, o, "emission_two_sided", &full.emission_two_sided));
+  TRY(get_bool(c, o, "double_sided", &full.double_sided));
+  memcpy(m->color, full.color, sizeof m->color);
+  m->color_texture = full.color_texture;
+  if (type != IRIS_MATERIAL_DIFFUSE) m->roughness = full.roughness;
+  if (type == IRIS_MATERIAL_GLASS || type == IRIS_MATERIAL_GLTF) m->ior = full.ior;
+  if (type == IRIS_MATERIAL_GLTF) {
+    m->metallic = full.metallic;
+    m->metallic_roughness_texture = full.metallic_roughness_texture;
+    m->specular = full.specular;
+    memcpy(m->specular_color, full.specular_color, sizeof m->specular_color);
+    m->transmission = full.transmission;
+  }
+  memcpy(m->emission, full.emission, sizeof m->emission);
+  m->emission_texture = full.emission_texture;
+  m->emission_two_sided = full.emission_two_sided;
+  m->double_sided = full.double_sided;
+  return IRIS_OK;
+}
+
+/* Reads the texture's first bytes to learn its type (and that it exists). */
+static iris_status load_texture_file(jctx *c, const char *dir, const char *file, iris_texture *t) {
+  char joined[PATH_MAX];
+  iris_path_join(dir, file, joined, sizeof joined);
+  t->path = realpath(joined, NULL);
+  if (!t->path) return jfail(c, IRIS_ERR_IO, "cannot find texture file '%s': %s", joined, strerror(errno));
+  FILE *fp = fopen(t->path, "rb");
+  unsigned char magic[8] = {0};
+  size_t n = fp ? fread(magic, 1, sizeof magic, fp) : 0;
+  if (fp) fclose(fp);
+  if (!fp) return jfail(c, IRIS_ERR_IO, "cannot open texture file '%s': %s", joined, strerror(errno));
+  if (n == 8 && memcmp(magic, "\x89PNG\r\n\x1a\n", 8) == 0)
+    memcpy(t->mime, "image/png", 10);
+  else if (n >= 3 && magic[0] == 0xFF && magic[1] == 0xD8 && magic[2] == 0xFF)
+    memcpy(t->mime, "image/jpeg", 11);
+  else
+    return jfail(c, IRIS_ERR_UNSUPPORTED, "texture file '%s' is not a PNG or JPEG image", joined);
+  return IRIS_OK;
+}
+
+static iris_status load_texture(jctx *c, const cJSON *o, const char *dir, iris_texture *t) {
+  static const char *const keys[] = {"name", "file", "wrap_s", "wrap_t", "filter"};
+  static const char *const filters[] = {"linear", "nearest"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(get_name(c, o, &t->name));
+  int ws = IRIS_WRAP_REPEAT, wt = IRIS_WRAP_REPEAT, filter = 0;
+  TRY(get_enum(c, o, "wrap_s", WRAP_MODES, 3, &ws));
+  TRY(get_enum(c, o, "wrap_t", WRAP_MODES, 3, &wt));
+  TRY(get_enum(c, o, "filter", filters, 2, &filter));
+  t->wrap_s = (iris_wrap)ws;
+  t->wrap_t = (iris_wrap)wt;
+  t->nearest = filter == 1;
+  TRY(require(c, o, "file"));
+  const char *file = NULL;
+  TRY(get_string(c, o, "file", &file));
+  if (!file[0]) return jfail(c, IRIS_ERR_INVALID, "'file' is empty");
+  return load_texture_file(c, dir, file, t);
+}
+
+/* JSON side of a mesh; the file is read afterwards by load_mesh_file. */
+typedef struct mesh_desc {
+  const char *file;
+  double vertices, triangles; /* -1 when absent */
+  int attributes;             /* IRIS_MESH_HAS_* bits, -1 when absent */
+} mesh_desc;
+
+static iris_status load_mesh_desc(jctx *c, const cJSON *o, iris_mesh *m, mesh_desc *d) {
+  static const char *const keys[] = {"name", "file", "material", "vertices", "triangles", "attributes"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(get_name(c, o, &m->name));
+  m->material = -1;
+  TRY(get_i32(c, o, "material", -1, INT32_MAX, &m->material));
+  TRY(require(c, o, "file"));
+  d->file = NULL;
+  TRY(get_string(c, o, "file", &d->file));
+  if (!d->file[0]) return jfail(c, IRIS_ERR_INVALID, "'file' is empty");
+  d->vertices = d->triangles = -1;
+  TRY(get_int(c, o, "vertices", 1, UINT32_MAX, &d->vertices));
+  TRY(get_int(c, o, "triangles", 1, UINT32_MAX, &d->triangles));
+  d->attributes = -1;
+  const cJSON *a = item(o, "attributes");
+  if (a) {
+    if (!cJSON_IsArray(a)) return jfail(c, IRIS_ERR_INVALID, "'attributes' must be an array of strings");
+    d->attributes = 0;
+    for (const cJSON *e = a->child; e; e = e->next) {
+      int k = 0;
+      while (k < 3 && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
+      if (k == 3)
+        return jfail(c, IRIS_ERR_INVALID,
+                     "'attributes' entries must be \"normals\", \"uvs\" or \"colors\"");
+      if (d->attributes & (1 << k)) return jfail(c, IRIS_ERR_INVALID, "'%s' listed twice in 'attributes'", ATTRIBUTE_NAMES[k]);
+      d->attributes |= 1 << k;
+    }
+  }
+  return IRIS_OK;
+}
+
+static iris_status load_mesh_file(jctx *c, const char *dir, const mesh_desc *d, iris_mesh *m,
+                                  iris_file_map *map) {
+  char path[PATH_MAX];
+  iris_path_join(dir, d->file, path, sizeof path);
+  TRY(iris_file_map_open(path, map, c->err));
+  iris_mesh loaded;
+  TRY(iris_mesh_read_map(map, path, &loaded, c->err));
+  if (d->vertices >= 0 && (uint32_t)d->vertices != loaded.vertex_count)
+    return jfail(c, IRIS_ERR_INVALID, "'vertices' is %.0f but %s has %u", d->vertices, d->file,
+                 (unsigned)loaded.vertex_count);
+  if (d->triangles >= 0 && (uint32_t)d->triangles != loaded.triangle_count)
+    return jfail(c, IRIS_ERR_INVALID, "'triangles' is %.0f but %s has %u", d->triangles, d->file,
+                 (unsigned)loaded.triangle_count);
+  if (d->attributes >= 0 && (uint32_t)d->attributes != iris_mesh_file_flags(&loaded))
+    return jfail(c, IRIS_ERR_INVALID, "'attributes' do not match the attributes stored in %s", d->file);
+  loaded.name = m->name;
+  loaded.material = m->material;
+  *m = loaded;
+  return IRIS_OK;
+}
+
+static iris_status load_instance(jctx *c, const cJSON *o, iris_instance *inst) {
+  static const char *const keys[] = {"mesh", "transform"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(require(c, o, "mesh"));
+  double mesh = 0;
+  TRY(get_int(c, o, "mesh", 0, UINT32_MAX, &mesh));
+  inst->mesh = (uint32_t)mesh;
+  inst->transform = iris_mat4_identity();
+  return get_floats(c, o, "transform", &inst->transform.m[0][0], 16);
+}
+
+static iris_status load_light(jctx *c, const cJSON *o, iris_light *l) {
+  static const char *const keys[] = {"name", "type", "color", "intensity", "position", "direction",
+                                     "range", "inner_cone_deg", "outer_cone_deg"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  TRY(get_name(c, o, &l->name));
+  TRY(require(c, o, "type"));
+  int type = 0;
+  TRY(get_enum(c, o, "type", LIGHT_TYPES, 3, &type));
+  l->type = (iris_light_type)type;
+  l->color[0] = l->color[1] = l->color[2] = 1.0f;
+  l->intensity = 1.0f;
+  l->outer_cone = 0.25f * IRIS_PI;
+  TRY(get_floats(c, o, "color", l->color, 3));
+  TRY(get_float(c, o, "intensity", &l->intensity));
+  if (l->type != IRIS_LIGHT_DIRECTIONAL) TRY(require(c, o, "position"));
+  if (l->type != IRIS_LIGHT_POINT) TRY(require(c, o, "direction"));
+  TRY(get_floats(c, o, "position", l->position, 3));
+  TRY(get_floats(c, o, "direction", l->direction, 3));
+  TRY(get_float(c, o, "range", &l->range));
+  double inner = -1, outer = -1;
+  TRY(get_double(c, o, "inner_cone_deg", &inner));
+  TRY(get_double(c, o, "outer_cone_deg", &outer));
+  if (inner != -1) l->inner_cone = deg_to_rad(inner);
+  if (outer != -1) l->outer_cone = deg_to_rad(outer);
+  return IRIS_OK;
+}
+
+static iris_status load_render(jctx *c, const cJSON *o, iris_render_settings *r) {
+  static const char *const keys[] = {"width", "height", "spp", "max_depth", "method", "seed"};
+  TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
+  double width = 0, height = 0, spp = 0, max_depth = -1;
+  TRY(get_int(c, o, "width", 0, 65536, &width));
+  TRY(get_int(c, o, "height", 0, 65536, &height));
+  TRY(get_int(c, o, "spp", 0, INT_MAX, &spp));
+  TRY(get_int(c, o, "max_depth", -1, INT_MAX, &max_depth));
+  r->width = (int)width;
+  r->height = (int)height;
+  r->spp = (int)spp;
+  r->max_depth = (int)max_depth;
+  const char *method = NULL;
+  TRY(get_string(c, o, "method", &method));
+  if (method) {
+    if (strlen(method) >= sizeof r->method)
+      return jfail(c, IRIS_ERR_INVALID, "'method' is longer than %zu characters", sizeof r->method - 1);
+    strcpy(r->method, method);
+  }
+  const cJSON *seed = item(o, "seed");
+  if (seed) {
+    r->has_seed = true;
+    if (cJSON_IsString(seed)) {
+      const char *s = seed->valuestring;
+      char *end = NULL;
+      errno = 0;
+      unsigned long long u = strtoull(s, &end, 10);
+      if (!s[0] || s[0] == '-' || s[0] == '+' || *end || errno)
+        return jfail(c, IRIS_ERR_INVALID, "'seed' must be a non-negative 64-bit integer");
+      r->seed = u;
+    } else {
+      double d = 0;
+      TRY(get_int(c, o, "seed", 0, 9007199254740992.0, &d));
+      r->seed = (uint64_t)d;
+    }
+  }
+  return IRIS_OK;
+}
+
+/* 1-based line of byte `offset` in text. */
+static long line_of(const char *text, size_t offset) {
+  long line = 1;
+  for (size_t i = 0; i < offset; i++)
+    if (text[i] == '\n') line++;
+  return line;
+}
+
+/* Reserves n zeroed elements for an array the loader fills in place. */
+static void *alloc_array(jctx *c, size_t n, size_t size, iris_status *st) {
+  if (n == 0) return NULL;
+  void *p = calloc(n, size);
+  if (!p) *st = jfail(c, IRIS_ERR_NOMEM, "out of memory");
+  return p;
+}
+
+static iris_status parse_scene(jctx *c, const cJSON *root, const char *dir, iris_scene *s) {
+  static const char *const keys[] = {"format", "version", "units", "cameras", "textures", "materials",
+                                     "meshes", "instances", "lights", "environment", "render"};
+  c->element[0] = '\0';
+  if (!cJSON_IsObject(root)) return jfail(c, IRIS_ERR_INVALID, "the top level must be a JSON object");
+  TRY(check_keys(c, root, keys, sizeof keys / sizeof *keys));
+  const char *format = NULL;
+  TRY(require(c, root, "format"));
+  TRY(get_string(c, root, "format", &format));
+  if (strcmp(format, SCENE_FORMAT_NAME) != 0)
+    return jfail(c, IRIS_ERR_PARSE, "'format' is '%s', expected '%s'", format, SCENE_FORMAT_NAME);
+  TRY(require(c, root, "version"));
+  double version = 0;
+  TRY(get_int(c, root, "version", 1, INT_MAX, &version));
+  if (version != IRIS_SCENE_FORMAT_VERSION)
+    return jfail(c, IRIS_ERR_UNSUPPORTED, "version %.0f is not supported (this iris reads version %d)",
+                 version, IRIS_SCENE_FORMAT_VERSION);
+  const char *units = NULL;
+  TRY(get_string(c, root, "units", &units));
+  if (units) {
+    if (!units[0] || strlen(units) >= sizeof s->units)
+      return jfail(c, IRIS_ERR_INVALID, "'units' must be 1 to %zu characters", sizeof s->units - 1);
+    strcpy(s->units, units);
+  }
+
+  const cJSON *cams, *texs, *mats, *meshes, *insts, *lights;
+  TRY(get_array(c, root, "cameras", &cams));
+  TRY(get_array(c, root, "textures", &texs));
+  TRY(get_array(c, root, "materials", &mats));
+  TRY(get_array(c, root, "meshes", &meshes));
+  TRY(get_array(c, root, "instances", &insts));
+  TRY(get_array(c, root, "lights", &lights));
+  iris_status st = IRIS_OK;
+  size_t n;
+
+  /* Arrays are sized up front and counts raised element by element, so a
+   * failure leaves a scene that iris_scene_destroy frees correctly. */
+  n = (size_t)cJSON_GetArraySize(cams);
+  if (!(s->cameras = alloc_array(c, n, sizeof *s->cameras, &st)) && n) return st;
+  for (const cJSON *e = cams ? cams->child : NULL; e; e = e->next) {
+    set_element(c, "cameras", s->camera_count);
+    TRY(load_camera(c, e, &s->cameras[s->camera_count++]));
+  }
+  n = (size_t)cJSON_GetArraySize(texs);
+  if (!(s->textures = alloc_array(c, n, sizeof *s->textures, &st)) && n) return st;
+  for (const cJSON *e = texs ? texs->child : NULL; e; e = e->next) {
+    set_element(c, "textures", s->texture_count);
+    TRY(load_texture(c, e, dir, &s->textures[s->texture_count++]));
+  }
+  n = (size_t)cJSON_GetArraySize(mats);
+  if (!(s->materials = alloc_array(c, n, sizeof *s->materials, &st)) && n) return st;
+  for (const cJSON *e = mats ? mats->child : NULL; e; e = e->next) {
+    set_element(c, "materials", s->material_count);
+    TRY(load_material(c, e, &s->materials[s->material_count++]));
+  }
+  n = (size_t)cJSON_GetArraySize(insts);
+  if (!(s->instances = alloc_array(c, n, sizeof *s->instances, &st)) && n) return st;
+  for (const cJSON *e = insts ? insts->child : NULL; e; e = e->next) {
+    set_element(c, "instances", s->instance_count);
+    TRY(load_instance(c, e, &s->instances[s->instance_count++]));
+  }
+  n = (size_t)cJSON_GetArraySize(lights);
+  if (!(s->lights = alloc_array(c, n, sizeof *s->lights, &st)) && n) return st;
+  for (const cJSON *e = lights ? lights->child : NULL; e; e = e->next) {
+    set_element(c, "lights", s->light_count);
+    TRY(load_light(c, e, &s->lights[s->light_count++]));
+  }
+  const cJSON *env = item(root, "environment");
+  if (env) {
+    static const char *const env_keys[] = {"radiance"};
+    snprintf(c->element, sizeof c->element, "environment");
+    TRY(check_keys(c, env, env_keys, 1));
+    TRY(require(c, env, "radiance"));
+    TRY(get_floats(c, env, "radiance", s->environment, 3));
+    s->has_environment = true;
+  }
+  const cJSON *render = item(root, "render");
+  if (render) {
+    snprintf(c->element, sizeof c->element, "render");
+    TRY(load_render(c, render, &s->render));
+  }
+
+  /* Meshes last: their JSON is checked completely before any file is mapped. */
+  n = (size_t)cJSON_GetArraySize(meshes);
+  mesh_desc *descs = alloc_array(c, n, sizeof *descs, &st);
+  if (n && !descs) return st;
+  if (n && !(s->meshes = alloc_array(c, n, sizeof *s->meshes, &st))) {
+    free(descs);
+    return st;
+  }
+  if (n && !(s->maps = alloc_array(c, n, sizeof(iris_file_map), &st))) {
+    free(descs);
+    return st;
+  }
+  size_t i = 0;
+  for (const cJSON *e = meshes ? meshes->child : NULL; e && st == IRIS_OK; e = e->next, i++) {
+    set_element(c, "meshes", i);
+    s->meshes[i].owned = false;
+    s->mesh_count = i + 1;
+    st = load_mesh_desc(c, e, &s->meshes[i], &descs[i]);
+  }
+  for (i = 0; i < s->mesh_count && st == IRIS_OK; i++) {
+    set_element(c, "meshes", i);
+    iris_file_map *maps = s->maps;
+    s->map_count = i + 1; /* before mapping, so that destroy unmaps it on failure */
+    st = load_mesh_file(c, dir, &descs[i], &s->meshes[i], &maps[i]);
+  }
+  free(descs);
+  return st;
+}
+
+iris_status iris_scene_load(const char *json_path, iris_scene **out, iris_error *err) {
+  *out = NULL;
+  char *text = NULL;
+  size_t size = 0;
+  iris_status st = iris_file_read(json_path, MAX_JSON_BYTES, &text, &size, err);
+  if (st != IRIS_OK) return st;
+  if (strlen(text) != size) {
+    st = iris_error_set(err, IRIS_ERR_PARSE, json_path, line_of(text, strlen(text)), NULL,
+                        "the file contains a NUL byte (not a JSON text file)");
+    free(text);
+    return st;
+  }
+  jctx c = {json_path, err, ""};
+  const char *end = NULL;
+  /* size + 1: cJSON wants to see the terminating NUL to reject trailing garbage. */
+  cJSON *root = cJSON_ParseWithLengthOpts(text, size + 1, &end, true);
+  if (!root) {
+    size_t offset = end && end >= text && end <= text + size ? (size_t)(end - text) : 0;
+    char near[24] = "";
+    for (size_t k = 0; k + 1 < sizeof near && offset + k < size && text[offset + k] != '\n'; k++)
+      near[k] = (char)(text[offset + k] >= 32 && text[offset + k] < 127 ? text[offset + k] : '?');
+    st = iris_error_set(err, IRIS_ERR_PARSE, json_path, line_of(text, offset), NULL,
+                        near[0] ? "JSON syntax error near '%s'" : "JSON syntax error%s",
+                        near[0] ? near : " (unexpected end of file)");
+    free(text);
+    return st;
+  }
+  iris_scene *s = iris_scene_create();
+  if (!s) {
+    cJSON_Delete(root);
+    free(text);
+    return iris_error_set(err, IRIS_ERR_NOMEM, json_path, 0, NULL, "out of memory");
+  }
+  char dir[PATH_MAX];
+  iris_path_dir(json_path, dir, sizeof dir);
+  st = parse_scene(&c, root, dir, s);
+  cJSON_Delete(root);
+  free(text);
+  if (st == IRIS_OK && !(s->source_path = iris_strdup(json_path)))
+    st = iris_error_set(err, IRIS_ERR_NOMEM, json_path, 0, NULL, "out of memory");
+  if (st == IRIS_OK) st = iris_scene_validate(s, json_path, err);
+  if (st != IRIS_OK) {
+    iris_scene_destroy(s);
+    return st;
+  }
+  *out = s;
+  return IRIS_OK;
+}
