@@ -2,8 +2,10 @@
  * each BSDF (docs/materials.md gives every formula and its Cycles 3.4 node).
  * All directions are in the local shading frame (z = shading normal) and point
  * away from the surface: wo towards the viewer, wi towards the light.
- * For materials without transmission the caller orients the frame so that
- * wo.z > 0 (two-sided shading as in Cycles); glass uses wo.z < 0 for "inside". */
+ * For BSDFs without a transmission lobe (iris_bsdf_lobes has no
+ * IRIS_LOBE_TRANSMISSION) the caller orients the frame so that wo.z > 0
+ * (two-sided shading as in Cycles); glass and transmissive gltf keep the
+ * geometric side: wo.z < 0 means wo is inside and the IOR is inverted. */
 #ifndef IRIS_RENDERER_BSDF_H
 #define IRIS_RENDERER_BSDF_H
 
@@ -24,8 +26,11 @@ typedef enum iris_bsdf_type {
   IRIS_BSDF_GLTF
 } iris_bsdf_type;
 
-/* Roughness below this is treated as perfectly smooth (a delta lobe). */
-#define IRIS_BSDF_MIN_ROUGHNESS 1e-3f
+/* Roughness at or below this is treated as perfectly smooth (a delta lobe).
+ * Cycles 3.4 makes a GGX closure singular when alpha^2 <= 1e-7, i.e.
+ * roughness^4 <= 1e-7; bsdf.c applies exactly that test and this is its
+ * roughness (1e-7^(1/4)). */
+#define IRIS_BSDF_MIN_ROUGHNESS 0.0177827941f
 
 typedef struct iris_bsdf {
   iris_bsdf_type type;
@@ -47,12 +52,13 @@ enum {
   IRIS_LOBE_DELTA = 1u << 4
 };
 
-typedef struct iris_bsdf_sample {
+/* A struct tag only (no typedef): the name also belongs to the function below. */
+struct iris_bsdf_sample {
   iris_vec3 wi;   /* sampled direction (local) */
   iris_vec3 f;    /* BSDF value; for delta lobes it includes 1/|cos wi| */
   float pdf;      /* solid-angle pdf; for delta lobes the discrete lobe probability */
   uint32_t lobe;  /* IRIS_LOBE_* of the sampled lobe */
-} iris_bsdf_sample;
+};
 
 /* Builds the BSDF of a material at a point (texture value `tex_color` already
  * sRGB-decoded and multiplied in by the caller; pass the material's colour when
@@ -67,7 +73,7 @@ float iris_bsdf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi);
 /* Samples wi with three uniform numbers (u_lobe picks the lobe). Returns false
  * when no direction could be produced (the path ends). */
 bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
-                      iris_bsdf_sample *s);
+                      struct iris_bsdf_sample *s);
 
 /* Union of IRIS_LOBE_* flags the BSDF can produce. */
 uint32_t iris_bsdf_lobes(const iris_bsdf *b);

@@ -1,0 +1,501 @@
+/* The four iris materials (see bsdf.h; every formula and its Cycles 3.4
+ * counterpart is in docs/materials.md). Each type has eval / pdf / sample
+ * side by side; the public functions dispatch on the type. */
+#include "renderer/bsdf.h"
+
+#include "renderer/microfacet.h"
+#include "renderer/sampling.h"
+
+/* Cycles 3.4 treats a microfacet closure as singular when alpha_x * alpha_y
+ * <= 1e-7 (bsdf_microfacet.h); iris uses the same test so that the delta/rough
+ * switch happens at the same roughness (about 0.0178). */
+#define IRIS_BSDF_SINGULAR_ALPHA2 1e-7f
+/* Cosines below this count as grazing: f, pdf and samples are zero there, so
+ * that no 1/cos can overflow. */
+#define IRIS_BSDF_MIN_COS 1e-6f
+
+static const iris_vec3 zero3 = {0.0f, 0.0f, 0.0f};
+
+static float alpha_of(float roughness) {
+  float r = iris_clampf(isfinite(roughness) ? roughness : 1.0f, 0.0f, 1.0f);
+  return r * r;
+}
+
+static bool alpha_is_singular(float alpha) { return alpha * alpha <= IRIS_BSDF_SINGULAR_ALPHA2; }
+
+static iris_vec3 sanitize3(iris_vec3 v) {
+  if (!iris_isfinite3(v)) return zero3;
+  return iris_v3(fmaxf(v.x, 0.0f), fmaxf(v.y, 0.0f), fmaxf(v.z, 0.0f));
+}
+
+static float sanitize1(float v) { return (isfinite(v) && v > 0.0f) ? v : 0.0f; }
+
+static iris_vec3 flip_z(iris_vec3 v) { return iris_v3(v.x, v.y, -v.z); }
+
+/* ---- shared GGX lobes (wo.z > 0 in the frame they are given) ------------ */
+
+/* Reflection half vector and the GGX reflection term without colour or
+ * Fresnel: D G / (4 cos_o cos_i). `height_correlated` picks the Smith G. */
+static float ggx_reflect_f(float alpha, iris_vec3 wo, iris_vec3 wi, bool height_correlated) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 m = iris_normalize(iris_add(wo, wi));
+  float d = iris_ggx_d(alpha, m);
+  float g = height_correlated
+                ? 1.0f / (1.0f + iris_ggx_lambda(alpha, wo) + iris_ggx_lambda(alpha, wi))
+                : iris_ggx_g1(alpha, wo) * iris_ggx_g1(alpha, wi);
+  return d * g / (4.0f * wo.z * wi.z);
+}
+
+/* Density of reflecting wo about a visible normal: D_wo(m) / (4 wo.m). */
+static float ggx_reflect_pdf(float alpha, iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 m = iris_normalize(iris_add(wo, wi));
+  return iris_ggx_g1(alpha, wo) * iris_ggx_d(alpha, m) / (4.0f * wo.z);
+}
+
+/* Generalised half vector of a refraction pair (Walter 2007 eq. 16), turned
+ * to the +z side; false when the pair cannot come from one microfacet. */
+static bool refract_half(iris_vec3 wo, iris_vec3 wi, float eta, iris_vec3 *m, float *denom) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z > -IRIS_BSDF_MIN_COS) return false;
+  iris_vec3 ht = iris_neg(iris_add(iris_scale(wi, eta), wo));
+  float len2 = iris_dot(ht, ht);
+  if (!(len2 > 1e-12f)) return false;
+  iris_vec3 h = iris_scale(ht, 1.0f / sqrtf(len2));
+  if (h.z < 0.0f) h = iris_neg(h);
+  float wo_m = iris_dot(wo, h), wi_m = iris_dot(wi, h);
+  if (wo_m <= 0.0f || wi_m >= 0.0f) return false;
+  *m = h;
+  *denom = eta * wi_m + wo_m;
+  *denom *= *denom;
+  return *denom > 0.0f;
+}
+
+/* Walter 2007 eq. 21 without Fresnel: D G |wo.m| |wi.m| eta^2 / (cos_o |cos_i| (eta wi.m + wo.m)^2).
+ * No 1/eta^2 radiance scaling: Cycles 3.4 does not apply it either. */
+static float ggx_refract_f(float alpha, float eta, iris_vec3 wo, iris_vec3 wi,
+                           bool height_correlated) {
+  iris_vec3 m;
+  float denom;
+  if (!refract_half(wo, wi, eta, &m, &denom)) return 0.0f;
+  float d = iris_ggx_d(alpha, m);
+  float g = height_correlated
+                ? 1.0f / (1.0f + iris_ggx_lambda(alpha, wo) + iris_ggx_lambda(alpha, wi))
+                : iris_ggx_g1(alpha, wo) * iris_ggx_g1(alpha, wi);
+  return d * g * fabsf(iris_dot(wo, m) * iris_dot(wi, m)) * eta * eta /
+         (wo.z * fabsf(wi.z) * denom);
+}
+
+/* Density of refracting wo through a visible normal: D_wo(m) eta^2 |wi.m| / (eta wi.m + wo.m)^2. */
+static float ggx_refract_pdf(float alpha, float eta, iris_vec3 wo, iris_vec3 wi) {
+  iris_vec3 m;
+  float denom;
+  if (!refract_half(wo, wi, eta, &m, &denom)) return 0.0f;
+  return iris_ggx_vndf_pdf(alpha, wo, m) * eta * eta * fabsf(iris_dot(wi, m)) / denom;
+}
+
+/* ---- diffuse: Lambert ---------------------------------------------------- */
+
+static iris_vec3 diffuse_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return zero3;
+  return iris_scale(b->color, IRIS_INV_PI);
+}
+
+static float diffuse_pdf(iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z <= 0.0f) return 0.0f;
+  return iris_sample_cosine_hemisphere_pdf(wi.z);
+}
+
+static bool diffuse_sample(const iris_bsdf *b, iris_vec3 wo, float u0, float u1,
+                           struct iris_bsdf_sample *s) {
+  if (wo.z <= 0.0f) return false;
+  s->wi = iris_sample_cosine_hemisphere(u0, u1);
+  s->f = diffuse_eval(b, wo, s->wi);
+  s->pdf = diffuse_pdf(wo, s->wi);
+  s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
+  return s->pdf > 0.0f;
+}
+
+/* ---- glossy: GGX reflection, tint, no Fresnel (Cycles Glossy BSDF) ------- */
+
+static iris_vec3 glossy_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  float alpha = alpha_of(b->roughness);
+  if (alpha_is_singular(alpha)) return zero3;
+  return iris_scale(b->color, ggx_reflect_f(alpha, wo, wi, false));
+}
+
+static float glossy_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  float alpha = alpha_of(b->roughness);
+  if (alpha_is_singular(alpha)) return 0.0f;
+  return ggx_reflect_pdf(alpha, wo, wi);
+}
+
+static bool glossy_sample(const iris_bsdf *b, iris_vec3 wo, float u0, float u1,
+                          struct iris_bsdf_sample *s) {
+  if (wo.z < IRIS_BSDF_MIN_COS) return false;
+  float alpha = alpha_of(b->roughness);
+  if (alpha_is_singular(alpha)) {
+    s->wi = iris_v3(-wo.x, -wo.y, wo.z);
+    s->f = iris_scale(b->color, 1.0f / wo.z);
+    s->pdf = 1.0f;
+    s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DELTA;
+    return true;
+  }
+  iris_vec3 m = iris_ggx_sample_vndf(alpha, wo, u0, u1);
+  s->wi = iris_reflect(wo, m);
+  s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
+  s->f = glossy_eval(b, wo, s->wi);
+  s->pdf = glossy_pdf(b, wo, s->wi);
+  return s->pdf > 0.0f;
+}
+
+/* ---- glass: dielectric, Fresnel from the shading normal (Cycles Glass BSDF) */
+
+typedef struct glass_setup {
+  bool inside;  /* wo.z < 0: directions were mirrored to the +z side */
+  float eta;    /* n on the far side / n on wo's side */
+  float alpha;
+  bool smooth;
+  float fr;     /* reflection weight: exact Fresnel at the shading normal */
+} glass_setup;
+
+static glass_setup glass_begin(const iris_bsdf *b, iris_vec3 *wo) {
+  glass_setup g;
+  float ior = (isfinite(b->ior) && b->ior > 1e-5f) ? b->ior : 1e-5f;
+  g.inside = wo->z < 0.0f;
+  g.eta = g.inside ? 1.0f / ior : ior;
+  if (g.inside) *wo = flip_z(*wo);
+  g.alpha = alpha_of(b->roughness);
+  /* An index-matched interface only passes light straight through. */
+  g.smooth = alpha_is_singular(g.alpha) || fabsf(g.eta - 1.0f) < 1e-4f;
+  g.fr = iris_fresnel_dielectric(wo->z, g.eta);
+  return g;
+}
+
+static iris_vec3 glass_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  glass_setup g = glass_begin(b, &wo);
+  if (g.smooth) return zero3;
+  if (g.inside) wi = flip_z(wi);
+  if (wi.z > 0.0f) return iris_scale(b->color, g.fr * ggx_reflect_f(g.alpha, wo, wi, false));
+  return iris_scale(b->color, (1.0f - g.fr) * ggx_refract_f(g.alpha, g.eta, wo, wi, false));
+}
+
+static float glass_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  glass_setup g = glass_begin(b, &wo);
+  if (g.smooth) return 0.0f;
+  if (g.inside) wi = flip_z(wi);
+  if (wi.z > 0.0f) return g.fr * ggx_reflect_pdf(g.alpha, wo, wi);
+  return (1.0f - g.fr) * ggx_refract_pdf(g.alpha, g.eta, wo, wi);
+}
+
+static bool glass_sample(const iris_bsdf *b, iris_vec3 wo_in, float u_lobe, float u0, float u1,
+                         struct iris_bsdf_sample *s) {
+  iris_vec3 wo = wo_in;
+  glass_setup g = glass_begin(b, &wo);
+  if (wo.z < IRIS_BSDF_MIN_COS) return false;
+  bool reflect = u_lobe < g.fr;
+  if (g.smooth) {
+    /* Delta lobes: f carries 1/|cos wi|, pdf is the lobe probability, so
+     * f |cos| / pdf = colour, as in Cycles' singular closures. */
+    if (reflect) {
+      s->wi = iris_v3(-wo.x, -wo.y, wo.z);
+      s->pdf = g.fr;
+      s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DELTA;
+    } else {
+      if (!iris_refract(wo, iris_v3(0.0f, 0.0f, 1.0f), g.eta, &s->wi)) return false;
+      s->pdf = 1.0f - g.fr;
+      s->lobe = IRIS_LOBE_TRANSMISSION | IRIS_LOBE_DELTA;
+    }
+    if (fabsf(s->wi.z) < IRIS_BSDF_MIN_COS || !(s->pdf > 0.0f)) return false;
+    s->f = iris_scale(b->color, s->pdf / fabsf(s->wi.z));
+  } else {
+    iris_vec3 m = iris_ggx_sample_vndf(g.alpha, wo, u0, u1);
+    if (reflect) {
+      s->wi = iris_reflect(wo, m);
+      if (s->wi.z < IRIS_BSDF_MIN_COS) return false;
+      s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
+    } else {
+      /* Microfacet total internal reflection ends the path, as in Cycles. */
+      if (!iris_refract(wo, m, g.eta, &s->wi) || s->wi.z > -IRIS_BSDF_MIN_COS) return false;
+      s->lobe = IRIS_LOBE_TRANSMISSION | IRIS_LOBE_GLOSSY;
+    }
+    if (g.inside) s->wi = flip_z(s->wi);
+    s->f = sanitize3(glass_eval(b, wo_in, s->wi));
+    s->pdf = sanitize1(glass_pdf(b, wo_in, s->wi));
+    return s->pdf > 0.0f;
+  }
+  if (g.inside) s->wi = flip_z(s->wi);
+  return true;
+}
+
+/* ---- gltf: glTF 2.0 Appendix B + KHR_materials_specular / _transmission -- */
+
+typedef struct gltf_setup {
+  bool inside;
+  float eta;
+  float alpha;
+  bool smooth;
+  iris_vec3 f0;       /* min(((ior-1)/(ior+1))^2 specularColor, 1) */
+  float weight;       /* specularFactor */
+  float metallic;
+  float transmission;
+  float p_spec, p_diffuse, p_trans; /* lobe selection probabilities at wo */
+} gltf_setup;
+
+static iris_vec3 schlick3(iris_vec3 f0, float c) {
+  return iris_v3(iris_fresnel_schlick(f0.x, c), iris_fresnel_schlick(f0.y, c),
+                 iris_fresnel_schlick(f0.z, c));
+}
+
+/* Returns false when wo cannot be shaded (below the surface of an opaque material). */
+static bool gltf_begin(const iris_bsdf *b, iris_vec3 *wo, gltf_setup *g) {
+  g->metallic = iris_clampf(b->metallic, 0.0f, 1.0f);
+  g->transmission = iris_clampf(b->transmission, 0.0f, 1.0f) * (1.0f - g->metallic);
+  g->inside = wo->z < 0.0f;
+  if (g->inside) {
+    if (!(g->transmission > 0.0f)) return false;
+    *wo = flip_z(*wo);
+  }
+  if (wo->z < IRIS_BSDF_MIN_COS) return false;
+  float ior = (isfinite(b->ior) && b->ior > 1e-5f) ? b->ior : 1.5f;
+  g->eta = g->inside ? 1.0f / ior : ior;
+  g->alpha = alpha_of(b->roughness);
+  g->smooth = alpha_is_singular(g->alpha);
+  float f0 = iris_sqr((ior - 1.0f) / (ior + 1.0f));
+  iris_vec3 sc = sanitize3(b->specular_color);
+  g->f0 = iris_v3(fminf(f0 * sc.x, 1.0f), fminf(f0 * sc.y, 1.0f), fminf(f0 * sc.z, 1.0f));
+  g->weight = sanitize1(b->specular);
+  /* Lobe choice from the lobe weights at the macro normal (an albedo estimate). */
+  float c = wo->z;
+  float fr_max = iris_max3(schlick3(g->f0, c));
+  float dielectric_base = fmaxf(0.0f, 1.0f - g->weight * fr_max) * iris_avg3(sanitize3(b->color));
+  float metal = iris_avg3(schlick3(sanitize3(b->color), c));
+  float ps = (1.0f - g->metallic) * g->weight * fr_max + g->metallic * metal;
+  float pd = (1.0f - g->metallic) * (1.0f - iris_clampf(b->transmission, 0.0f, 1.0f)) *
+             dielectric_base;
+  float pt = g->transmission * dielectric_base;
+  float sum = ps + pd + pt;
+  if (!(sum > 0.0f) || !isfinite(sum)) {
+    g->p_spec = g->p_diffuse = g->p_trans = 0.0f;
+  } else {
+    g->p_spec = ps / sum;
+    g->p_diffuse = pd / sum;
+    g->p_trans = pt / sum;
+  }
+  return true;
+}
+
+/* Dielectric specular tint w * F_r(c) and metal tint F_m(c) combined by metallic. */
+static iris_vec3 gltf_spec_tint(const iris_bsdf *b, const gltf_setup *g, float c) {
+  iris_vec3 diel = iris_scale(schlick3(g->f0, c), g->weight * (1.0f - g->metallic));
+  iris_vec3 metal = iris_scale(schlick3(sanitize3(b->color), c), g->metallic);
+  return iris_add(diel, metal);
+}
+
+/* (1 - w max(F_r(c))): what the dielectric layer leaves for diffuse/transmission. */
+static float gltf_base_weight(const gltf_setup *g, float c) {
+  return fmaxf(0.0f, 1.0f - g->weight * iris_max3(schlick3(g->f0, c)));
+}
+
+static iris_vec3 gltf_eval_local(const iris_bsdf *b, const gltf_setup *g, iris_vec3 wo,
+                                 iris_vec3 wi) {
+  iris_vec3 base = sanitize3(b->color);
+  if (wi.z > 0.0f) {
+    if (wi.z < IRIS_BSDF_MIN_COS) return zero3;
+    iris_vec3 m = iris_normalize(iris_add(wo, wi));
+    float c = iris_dot(wo, m);
+    float opaque = (1.0f - g->metallic) * (1.0f - iris_clampf(b->transmission, 0.0f, 1.0f));
+    iris_vec3 f = iris_scale(base, opaque * gltf_base_weight(g, c) * IRIS_INV_PI);
+    if (!g->smooth) {
+      float spec = ggx_reflect_f(g->alpha, wo, wi, true);
+      f = iris_add(f, iris_scale(gltf_spec_tint(b, g, c), spec));
+    }
+    return f;
+  }
+  if (g->smooth || !(g->transmission > 0.0f)) return zero3;
+  iris_vec3 m;
+  float denom;
+  if (!refract_half(wo, wi, g->eta, &m, &denom)) return zero3;
+  float btdf = ggx_refract_f(g->alpha, g->eta, wo, wi, true);
+  return iris_scale(base, g->transmission * gltf_base_weight(g, iris_dot(wo, m)) * btdf);
+}
+
+static float gltf_pdf_local(const gltf_setup *g, iris_vec3 wo, iris_vec3 wi) {
+  if (wi.z > 0.0f) {
+    float p = g->p_diffuse * iris_sample_cosine_hemisphere_pdf(wi.z);
+    if (!g->smooth) p += g->p_spec * ggx_reflect_pdf(g->alpha, wo, wi);
+    return p;
+  }
+  if (g->smooth) return 0.0f;
+  return g->p_trans * ggx_refract_pdf(g->alpha, g->eta, wo, wi);
+}
+
+static iris_vec3 gltf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  gltf_setup g;
+  if (!gltf_begin(b, &wo, &g)) return zero3;
+  if (g.inside) wi = flip_z(wi);
+  return gltf_eval_local(b, &g, wo, wi);
+}
+
+static float gltf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  gltf_setup g;
+  if (!gltf_begin(b, &wo, &g)) return 0.0f;
+  if (g.inside) wi = flip_z(wi);
+  return gltf_pdf_local(&g, wo, wi);
+}
+
+static bool gltf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
+                        struct iris_bsdf_sample *s) {
+  gltf_setup g;
+  if (!gltf_begin(b, &wo, &g)) return false;
+  iris_vec3 n = iris_v3(0.0f, 0.0f, 1.0f);
+  if (u_lobe < g.p_spec) {
+    if (g.smooth) {
+      s->wi = iris_v3(-wo.x, -wo.y, wo.z);
+      s->pdf = g.p_spec;
+      s->f = iris_scale(gltf_spec_tint(b, &g, wo.z), 1.0f / wo.z);
+      s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DELTA;
+      if (g.inside) s->wi = flip_z(s->wi);
+      return s->pdf > 0.0f;
+    }
+    s->wi = iris_reflect(wo, iris_ggx_sample_vndf(g.alpha, wo, u0, u1));
+    if (s->wi.z < IRIS_BSDF_MIN_COS) return false;
+    s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
+  } else if (u_lobe < g.p_spec + g.p_diffuse) {
+    s->wi = iris_sample_cosine_hemisphere(u0, u1);
+    s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
+  } else {
+    if (!(g.p_trans > 0.0f)) return false;
+    if (g.smooth) {
+      if (!iris_refract(wo, n, g.eta, &s->wi) || s->wi.z > -IRIS_BSDF_MIN_COS) return false;
+      s->pdf = g.p_trans;
+      float w = g.transmission * gltf_base_weight(&g, wo.z) / fabsf(s->wi.z);
+      s->f = iris_scale(sanitize3(b->color), w);
+      s->lobe = IRIS_LOBE_TRANSMISSION | IRIS_LOBE_DELTA;
+      if (g.inside) s->wi = flip_z(s->wi);
+      return true;
+    }
+    if (!iris_refract(wo, iris_ggx_sample_vndf(g.alpha, wo, u0, u1), g.eta, &s->wi) ||
+        s->wi.z > -IRIS_BSDF_MIN_COS)
+      return false;
+    s->lobe = IRIS_LOBE_TRANSMISSION | IRIS_LOBE_GLOSSY;
+  }
+  s->f = sanitize3(gltf_eval_local(b, &g, wo, s->wi));
+  s->pdf = sanitize1(gltf_pdf_local(&g, wo, s->wi));
+  if (g.inside) s->wi = flip_z(s->wi);
+  return s->pdf > 0.0f;
+}
+
+/* ---- public dispatch ----------------------------------------------------- */
+
+static iris_vec3 color_from(const float *c) {
+  return sanitize3(iris_v3(c[0], c[1], c[2]));
+}
+
+iris_bsdf iris_bsdf_from_material(const iris_material *mat, iris_vec3 color, float roughness,
+                                  float metallic) {
+  iris_bsdf b;
+  switch (mat->type) {
+    case IRIS_MATERIAL_GLOSSY: b.type = IRIS_BSDF_GLOSSY; break;
+    case IRIS_MATERIAL_GLASS: b.type = IRIS_BSDF_GLASS; break;
+    case IRIS_MATERIAL_GLTF: b.type = IRIS_BSDF_GLTF; break;
+    case IRIS_MATERIAL_DIFFUSE:
+    default: b.type = IRIS_BSDF_DIFFUSE; break;
+  }
+  b.color = sanitize3(color);
+  b.roughness = iris_clampf(isfinite(roughness) ? roughness : 1.0f, 0.0f, 1.0f);
+  /* Cycles clamps the Glass IOR to >= 1e-5; an unset (0) IOR gets the node
+   * default (Glass 1.45) or the glTF default (1.5). */
+  float default_ior = mat->type == IRIS_MATERIAL_GLASS ? 1.45f : 1.5f;
+  b.ior = (isfinite(mat->ior) && mat->ior > 0.0f) ? fmaxf(mat->ior, 1e-5f) : default_ior;
+  b.metallic = iris_clampf(isfinite(metallic) ? metallic : 0.0f, 0.0f, 1.0f);
+  b.specular = sanitize1(mat->specular);
+  b.specular_color = color_from(mat->specular_color);
+  b.transmission = iris_clampf(isfinite(mat->transmission) ? mat->transmission : 0.0f, 0.0f, 1.0f);
+  return b;
+}
+
+iris_vec3 iris_bsdf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  iris_vec3 f;
+  switch (b->type) {
+    case IRIS_BSDF_DIFFUSE: f = diffuse_eval(b, wo, wi); break;
+    case IRIS_BSDF_GLOSSY: f = glossy_eval(b, wo, wi); break;
+    case IRIS_BSDF_GLASS: f = glass_eval(b, wo, wi); break;
+    case IRIS_BSDF_GLTF: f = gltf_eval(b, wo, wi); break;
+    default: f = zero3; break;
+  }
+  return sanitize3(f);
+}
+
+float iris_bsdf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  float p;
+  switch (b->type) {
+    case IRIS_BSDF_DIFFUSE: p = diffuse_pdf(wo, wi); break;
+    case IRIS_BSDF_GLOSSY: p = glossy_pdf(b, wo, wi); break;
+    case IRIS_BSDF_GLASS: p = glass_pdf(b, wo, wi); break;
+    case IRIS_BSDF_GLTF: p = gltf_pdf(b, wo, wi); break;
+    default: p = 0.0f; break;
+  }
+  return sanitize1(p);
+}
+
+bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
+                      struct iris_bsdf_sample *s) {
+  bool ok;
+  s->wi = zero3;
+  s->f = zero3;
+  s->pdf = 0.0f;
+  s->lobe = 0;
+  switch (b->type) {
+    case IRIS_BSDF_DIFFUSE: ok = diffuse_sample(b, wo, u0, u1, s); break;
+    case IRIS_BSDF_GLOSSY: ok = glossy_sample(b, wo, u0, u1, s); break;
+    case IRIS_BSDF_GLASS: ok = glass_sample(b, wo, u_lobe, u0, u1, s); break;
+    case IRIS_BSDF_GLTF: ok = gltf_sample(b, wo, u_lobe, u0, u1, s); break;
+    default: ok = false; break;
+  }
+  s->f = sanitize3(s->f);
+  s->pdf = sanitize1(s->pdf);
+  if (!ok || !(s->pdf > 0.0f) || !iris_isfinite3(s->wi)) {
+    s->f = zero3;
+    s->pdf = 0.0f;
+    return false;
+  }
+  return true;
+}
+
+uint32_t iris_bsdf_lobes(const iris_bsdf *b) {
+  bool smooth = alpha_is_singular(alpha_of(b->roughness));
+  uint32_t spec = smooth ? IRIS_LOBE_DELTA : IRIS_LOBE_GLOSSY;
+  switch (b->type) {
+    case IRIS_BSDF_DIFFUSE: return IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
+    case IRIS_BSDF_GLOSSY: return IRIS_LOBE_REFLECTION | spec;
+    case IRIS_BSDF_GLASS:
+      if (fabsf(b->ior - 1.0f) < 1e-4f) spec = IRIS_LOBE_DELTA;
+      return IRIS_LOBE_REFLECTION | IRIS_LOBE_TRANSMISSION | spec;
+    case IRIS_BSDF_GLTF: {
+      float metallic = iris_clampf(b->metallic, 0.0f, 1.0f);
+      float transmission = iris_clampf(b->transmission, 0.0f, 1.0f);
+      uint32_t l = 0;
+      if (metallic < 1.0f && transmission < 1.0f) l |= IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
+      if (metallic > 0.0f || b->specular > 0.0f) l |= IRIS_LOBE_REFLECTION | spec;
+      if (metallic < 1.0f && transmission > 0.0f) l |= IRIS_LOBE_TRANSMISSION | spec;
+      return l;
+    }
+    default: return 0;
+  }
+}
+
+bool iris_bsdf_is_delta(const iris_bsdf *b) {
+  uint32_t l = iris_bsdf_lobes(b);
+  return (l & IRIS_LOBE_DELTA) && !(l & (IRIS_LOBE_DIFFUSE | IRIS_LOBE_GLOSSY));
+}
+
+float iris_bsdf_guiding_roughness(const iris_bsdf *b) {
+  uint32_t l = iris_bsdf_lobes(b);
+  if (iris_bsdf_is_delta(b)) return 0.0f;
+  if (!(l & (IRIS_LOBE_GLOSSY | IRIS_LOBE_DELTA))) return INFINITY;
+  if (l & IRIS_LOBE_GLOSSY) return iris_clampf(b->roughness, 0.0f, 1.0f);
+  /* gltf with a smooth coat over a diffuse base: the diffuse share of the
+   * material decides how much irradiance sampling may be used. */
+  return (1.0f - iris_clampf(b->metallic, 0.0f, 1.0f)) *
+         (1.0f - iris_clampf(b->transmission, 0.0f, 1.0f));
+}

@@ -1,1 +1,0 @@
-/* placeholder */ typedef int iris_placeholder_unit_;

@@ -1,0 +1,139 @@
+/* Sample warps and their densities (see sampling.h; formulas in docs/materials.md). */
+#include "renderer/sampling.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void iris_sample_concentric_disk(float u0, float u1, float *x, float *y) {
+  /* Shirley & Chiu 1997: squares to rings, so strata stay compact. */
+  float a = 2.0f * u0 - 1.0f;
+  float b = 2.0f * u1 - 1.0f;
+  if (a == 0.0f && b == 0.0f) {
+    *x = 0.0f;
+    *y = 0.0f;
+    return;
+  }
+  float r, phi;
+  if (fabsf(a) > fabsf(b)) {
+    r = a;
+    phi = (IRIS_PI / 4.0f) * (b / a);
+  } else {
+    r = b;
+    phi = (IRIS_PI / 2.0f) - (IRIS_PI / 4.0f) * (a / b);
+  }
+  *x = r * cosf(phi);
+  *y = r * sinf(phi);
+}
+
+iris_vec3 iris_sample_cosine_hemisphere(float u0, float u1) {
+  float x, y;
+  iris_sample_concentric_disk(u0, u1, &x, &y);
+  /* z > 0 strictly so that callers never get a direction in the surface plane. */
+  float z = iris_safe_sqrt(1.0f - x * x - y * y);
+  return iris_v3(x, y, fmaxf(z, 1e-7f));
+}
+
+iris_vec3 iris_sample_uniform_hemisphere(float u0, float u1) {
+  float z = u0;
+  float r = iris_safe_sqrt(1.0f - z * z);
+  float phi = 2.0f * IRIS_PI * u1;
+  return iris_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+iris_vec3 iris_sample_uniform_sphere(float u0, float u1) {
+  float z = 1.0f - 2.0f * u0;
+  float r = iris_safe_sqrt(1.0f - z * z);
+  float phi = 2.0f * IRIS_PI * u1;
+  return iris_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+iris_vec3 iris_sample_uniform_cone(float u0, float u1, float cos_max) {
+  float z = 1.0f - u0 * (1.0f - cos_max);
+  float r = iris_safe_sqrt(1.0f - z * z);
+  float phi = 2.0f * IRIS_PI * u1;
+  return iris_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+float iris_sample_uniform_cone_pdf(float cos_theta, float cos_max) {
+  if (cos_theta < cos_max || cos_max >= 1.0f) return 0.0f;
+  return 1.0f / (2.0f * IRIS_PI * (1.0f - cos_max));
+}
+
+void iris_sample_uniform_triangle(float u0, float u1, float *b0, float *b1) {
+  /* Heitz 2019, "A Low-Distortion Map Between Triangle and Square". */
+  if (u0 < u1) {
+    *b0 = u0 * 0.5f;
+    *b1 = u1 - *b0;
+  } else {
+    *b1 = u1 * 0.5f;
+    *b0 = u0 - *b1;
+  }
+}
+
+iris_status iris_distrib1d_create(iris_distrib1d *d, const float *weights, size_t count,
+                                  iris_error *err) {
+  memset(d, 0, sizeof(*d));
+  if (count == 0 || count > ((size_t)1 << 32)) {
+    return iris_error_set(err, IRIS_ERR_INVALID, NULL, 0, NULL,
+                          "discrete distribution needs 1 to 2^32 entries, got %zu", count);
+  }
+  d->cdf = malloc((count + 1) * sizeof(float));
+  d->func = malloc(count * sizeof(float));
+  if (!d->cdf || !d->func) {
+    iris_distrib1d_destroy(d);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL,
+                          "out of memory for a distribution of %zu entries", count);
+  }
+  d->count = count;
+  double sum = 0.0;
+  for (size_t i = 0; i < count; ++i) {
+    float w = weights[i];
+    d->func[i] = (isfinite(w) && w > 0.0f) ? w : 0.0f;
+    sum += d->func[i];
+  }
+  d->total = sum;
+  /* Accumulate in double so that long tables keep their small entries. */
+  double acc = 0.0;
+  d->cdf[0] = 0.0f;
+  for (size_t i = 0; i < count; ++i) {
+    acc += sum > 0.0 ? (double)d->func[i] / sum : 1.0 / (double)count;
+    d->cdf[i + 1] = (float)acc;
+  }
+  /* cdf ends at exactly 1 right after the last live entry, so rounding can
+   * never hand a sample to a zero-weight tail. */
+  size_t last = count;
+  while (last > 1 && sum > 0.0 && d->func[last - 1] == 0.0f) --last;
+  for (size_t i = last; i <= count; ++i) d->cdf[i] = 1.0f;
+  return IRIS_OK;
+}
+
+void iris_distrib1d_destroy(iris_distrib1d *d) {
+  if (!d) return;
+  free(d->cdf);
+  free(d->func);
+  memset(d, 0, sizeof(*d));
+}
+
+float iris_distrib1d_pmf(const iris_distrib1d *d, size_t index) {
+  if (index >= d->count) return 0.0f;
+  if (d->total <= 0.0) return 1.0f / (float)d->count;
+  return (float)((double)d->func[index] / d->total);
+}
+
+size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float *u_remapped) {
+  /* Largest i with cdf[i] <= u, skipping zero-probability entries. */
+  size_t lo = 0, hi = d->count; /* invariant: cdf[lo] <= u < cdf[hi] (cdf[count] = 1 > u) */
+  while (hi - lo > 1) {
+    size_t mid = lo + (hi - lo) / 2;
+    if (d->cdf[mid] <= u) lo = mid;
+    else hi = mid;
+  }
+  float p = iris_distrib1d_pmf(d, lo);
+  if (pmf) *pmf = p;
+  if (u_remapped) {
+    float width = d->cdf[lo + 1] - d->cdf[lo];
+    float r = width > 0.0f ? (u - d->cdf[lo]) / width : 0.0f;
+    *u_remapped = iris_clampf(r, 0.0f, 0x1.fffffep-1f);
+  }
+  return lo;
+}
