@@ -1,0 +1,1428 @@
+/* glTF 2.0 import, C side: validates the document the tinygltf shim filled
+ * (every index, byte range and number) and turns it into an iris_scene.
+ * Mapping decisions are documented in docs/import-gltf.md. */
+#include "importers/gltf_convert.h"
+
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
+
+/* glTF constants (the numeric codes of the spec; tinygltf uses the same). */
+enum {
+  CT_BYTE = 5120, CT_UBYTE = 5121, CT_SHORT = 5122, CT_USHORT = 5123, CT_UINT = 5125, CT_FLOAT = 5126,
+  TYPE_VEC2 = 2, TYPE_VEC3 = 3, TYPE_VEC4 = 4, TYPE_MAT2 = 34, TYPE_MAT3 = 35, TYPE_MAT4 = 36,
+  TYPE_SCALAR = 65,
+  MODE_TRIANGLES = 4, MODE_STRIP = 5, MODE_FAN = 6,
+  WRAP_REPEAT = 10497, WRAP_CLAMP = 33071, WRAP_MIRROR = 33648,
+  FILTER_NEAREST = 9728, FILTER_LINEAR = 9729
+};
+
+/* Accessors without a bufferView are zero-filled from nothing but their
+ * declared count; cap them so a tiny file cannot demand gigabytes. */
+#define ZERO_ACCESSOR_MAX_COUNT ((size_t)1 << 24)
+/* tinygltf recurses over extras/extensions: refuse deeper JSON. */
+#define JSON_MAX_DEPTH 64
+
+/* Extensions whose content iris maps (anything else used produces one warning). */
+static const char *const supported_extensions[] = {
+    "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
+    "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+
+/* ---- small helpers ------------------------------------------------------ */
+
+typedef struct dmat4 {
+  double m[4][4]; /* row-major, column vectors (as iris_mat4) */
+} dmat4;
+
+static dmat4 dmat4_identity(void) {
+  dmat4 r;
+  memset(&r, 0, sizeof r);
+  for (int i = 0; i < 4; i++) r.m[i][i] = 1.0;
+  return r;
+}
+
+static dmat4 dmat4_mul(const dmat4 *a, const dmat4 *b) {
+  dmat4 r;
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) {
+      double s = 0.0;
+      for (int k = 0; k < 4; k++) s += a->m[i][k] * b->m[k][j];
+      r.m[i][j] = s;
+    }
+  return r;
+}
+
+static iris_mat4 dmat4_to_float(const dmat4 *a) {
+  iris_mat4 r;
+  for (int i = 0; i < 4; i++)
+    for (int j = 0; j < 4; j++) r.m[i][j] = (float)a->m[i][j];
+  return r;
+}
+
+static bool all_finite(const double *v, size_t n) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i])) return false;
+  return true;
+}
+
+static size_t component_size(int ct) {
+  switch (ct) {
+    case CT_BYTE: case CT_UBYTE: return 1;
+    case CT_SHORT: case CT_USHORT: return 2;
+    case CT_UINT: case CT_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+static int type_components(int type) {
+  switch (type) {
+    case TYPE_SCALAR: return 1;
+    case TYPE_VEC2: return 2;
+    case TYPE_VEC3: return 3;
+    case TYPE_VEC4: case TYPE_MAT2: return 4;
+    case TYPE_MAT3: return 9;
+    case TYPE_MAT4: return 16;
+    default: return 0;
+  }
+}
+
+static const char *type_name(int type) {
+  switch (type) {
+    case TYPE_SCALAR: return "SCALAR";
+    case TYPE_VEC2: return "VEC2";
+    case TYPE_VEC3: return "VEC3";
+    case TYPE_VEC4: return "VEC4";
+    case TYPE_MAT2: return "MAT2";
+    case TYPE_MAT3: return "MAT3";
+    case TYPE_MAT4: return "MAT4";
+    default: return "unknown";
+  }
+}
+
+/* Element size including the column padding matrices of small components get. */
+static size_t element_size(int ct, int type) {
+  size_t cs = component_size(ct);
+  if (type == TYPE_MAT2 && cs == 1) return 8;
+  if (type == TYPE_MAT3 && cs == 1) return 12;
+  if (type == TYPE_MAT3 && cs == 2) return 24;
+  return cs * (size_t)type_components(type);
+}
+
+static uint32_t load_u32(const uint8_t *p, int ct) {
+  switch (ct) {
+    case CT_UBYTE: return p[0];
+    case CT_USHORT: return (uint32_t)p[0] | (uint32_t)p[1] << 8;
+    default: return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+  }
+}
+
+/* One component as float; normalized integers per glTF 2.0 section 3.11. */
+static float load_component(const uint8_t *p, int ct, bool normalized) {
+  switch (ct) {
+    case CT_FLOAT: {
+      uint32_t u = load_u32(p, CT_UINT);
+      float f;
+      memcpy(&f, &u, sizeof f);
+      return f;
+    }
+    case CT_UBYTE: return normalized ? (float)p[0] / 255.0f : (float)p[0];
+    case CT_BYTE: {
+      float v = (float)(int8_t)p[0];
+      return normalized ? fmaxf(v / 127.0f, -1.0f) : v;
+    }
+    case CT_USHORT: {
+      float v = (float)load_u32(p, CT_USHORT);
+      return normalized ? v / 65535.0f : v;
+    }
+    case CT_SHORT: {
+      float v = (float)(int16_t)load_u32(p, CT_USHORT);
+      return normalized ? fmaxf(v / 32767.0f, -1.0f) : v;
+    }
+    case CT_UINT: return (float)load_u32(p, CT_UINT);
+    default: return 0.0f;
+  }
+}
+
+/* ---- conversion context ------------------------------------------------- */
+
+typedef struct converted_prim {
+  iris_mesh mesh;     /* arrays owned here until handed to the scene */
+  bool valid;         /* false: skipped (points/lines, no POSITION) */
+  int gltf_material;  /* -1: glTF default material */
+  int32_t scene_mesh; /* index in the scene once instanced, else -1 */
+} converted_prim;
+
+typedef struct ctx {
+  const iris_gltf_doc *doc;
+  const iris_import_options *opts;
+  const char *file;
+  iris_error *err;
+  iris_scene *scene;
+
+  converted_prim **prims; /* [mesh][primitive] */
+  iris_material *materials; /* validated, textures still glTF indices */
+  int32_t *material_map;    /* glTF material -> scene index, -1 not yet */
+  int32_t default_material;
+  int32_t *texture_map;     /* glTF texture -> scene index, -1 not yet, -2 dropped */
+
+  int *parent;
+  dmat4 *world;
+
+  /* Present-but-ignored features, reported once each at the end. */
+  char ignored_attributes[256];
+  size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
+  bool warned_texcoord, warned_alpha, warned_normal_occlusion, warned_spec_tex, warned_trans_tex;
+  bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
+  size_t zero_normals;
+} ctx;
+
+static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...) {
+  char msg[512];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  return iris_error_set(c->err, st, c->file, 0, element, "%s", msg);
+}
+
+#define ELEMENT(buf, ...) snprintf(buf, sizeof buf, __VA_ARGS__)
+
+/* ---- container pre-checks ----------------------------------------------- */
+
+static iris_status check_json_depth(const uint8_t *p, size_t n, const char *file, iris_error *err) {
+  int depth = 0;
+  bool in_string = false;
+  for (size_t i = 0; i < n; i++) {
+    uint8_t ch = p[i];
+    if (in_string) {
+      if (ch == '\\') i++;
+      else if (ch == '"') in_string = false;
+    } else if (ch == '"') {
+      in_string = true;
+    } else if (ch == '[' || ch == '{') {
+      if (++depth > JSON_MAX_DEPTH)
+        return iris_error_set(err, IRIS_ERR_PARSE, file, 0, NULL,
+                              "JSON nested deeper than %d levels", JSON_MAX_DEPTH);
+    } else if (ch == ']' || ch == '}') {
+      depth--;
+    }
+  }
+  return IRIS_OK;
+}
+
+iris_status iris_gltf_check_container(const uint8_t *data, size_t size, const char *file,
+                                      bool *is_glb, iris_error *err) {
+  *is_glb = size >= 4 && memcmp(data, "glTF", 4) == 0;
+  if (size > UINT32_MAX)
+    return iris_error_set(err, IRIS_ERR_NOMEM, file, 0, NULL, "file larger than 4 GiB");
+  if (size == 0) return iris_error_set(err, IRIS_ERR_PARSE, file, 0, NULL, "empty file");
+  char ext[16] = "";
+  if (file) iris_path_ext(file, ext, sizeof ext);
+  if (!*is_glb && strcmp(ext, "glb") == 0)
+    return iris_error_set(err, IRIS_ERR_PARSE, file, 0, "GLB header", "invalid magic (not 'glTF')");
+  if (!*is_glb) return check_json_depth(data, size, file, err);
+
+  /* GLB: 12-byte header, then chunks (glTF 2.0 section 4.4). */
+  if (size < 12)
+    return iris_error_set(err, IRIS_ERR_PARSE, file, 0, "GLB header", "truncated (%zu bytes)", size);
+  uint32_t version = load_u32(data + 4, CT_UINT), length = load_u32(data + 8, CT_UINT);
+  if (version != 2)
+    return iris_error_set(err, IRIS_ERR_UNSUPPORTED, file, 0, "GLB header",
+                          "container version %u (only 2 is supported)", version);
+  if (length != size)
+    return iris_error_set(err, IRIS_ERR_PARSE, file, 0, "GLB header",
+                          "declared length %u but the file has %zu bytes", length, size);
+  size_t pos = 12;
+  int chunk = 0;
+  const uint8_t *json = NULL;
+  size_t json_size = 0;
+  while (pos < size) {
+    char el[32];
+    snprintf(el, sizeof el, "GLB chunk %d", chunk);
+    if (size - pos < 8)
+      return iris_error_set(err, IRIS_ERR_PARSE, file, 0, el, "truncated chunk header");
+    uint32_t clen = load_u32(data + pos, CT_UINT), ctype = load_u32(data + pos + 4, CT_UINT);
+    if (clen > size - pos - 8)
+      return iris_error_set(err, IRIS_ERR_PARSE, file, 0, el,
+                            "chunk length %u exceeds the remaining %zu bytes", clen, size - pos - 8);
+    if (clen % 4 != 0)
+      return iris_error_set(err, IRIS_ERR_PARSE, file, 0, el,
+                            "chunk length %u is not a multiple of 4", clen);
+    if (chunk == 0) {
+      if (ctype != 0x4E4F534Au)
+        return iris_error_set(err, IRIS_ERR_PARSE, file, 0, el, "first chunk is not JSON");
+      if (clen == 0) return iris_error_set(err, IRIS_ERR_PARSE, file, 0, el, "empty JSON chunk");
+      json = data + pos + 8;
+      json_size = clen;
+    } else if (chunk == 1 && ctype != 0x004E4942u) {
+      /* Unknown chunk types must be ignored; tinygltf only looks at chunk 1. */
+      return iris_error_set(err, IRIS_ERR_UNSUPPORTED, file, 0, el,
+                            "second chunk is not BIN (type 0x%08x)", ctype);
+    }
+    pos += 8 + (size_t)clen;
+    chunk++;
+  }
+  if (!json) return iris_error_set(err, IRIS_ERR_PARSE, file, 0, "GLB", "no JSON chunk");
+  return check_json_depth(json, json_size, file, err);
+}
+
+static bool is_supported_extension(const char *name) {
+  for (size_t i = 0; i < sizeof supported_extensions / sizeof *supported_extensions; i++)
+    if (strcmp(name, supported_extensions[i]) == 0) return true;
+  return false;
+}
+
+iris_status iris_gltf_check_required(const char *const *names, size_t count, const char *file,
+                                     iris_error *err) {
+  for (size_t i = 0; i < count; i++)
+    if (!is_supported_extension(names[i]))
+      return iris_error_set(err, IRIS_ERR_UNSUPPORTED, file, 0, "extensionsRequired",
+                            "extension %s is not supported by iris", names[i]);
+  return IRIS_OK;
+}
+
+/* ---- buffers, views, accessors ------------------------------------------ */
+
+static iris_status validate_views(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  for (size_t i = 0; i < d->view_count; i++) {
+    const iris_gltf_view *v = &d->views[i];
+    ELEMENT(el, "bufferView %zu", i);
+    if (v->buffer < 0 || (size_t)v->buffer >= d->buffer_count)
+      return fail(c, IRIS_ERR_INVALID, el, "buffer %d does not exist (%zu buffers)", v->buffer,
+                  d->buffer_count);
+    size_t bsize = d->buffers[v->buffer].size;
+    if (v->length < 1) return fail(c, IRIS_ERR_INVALID, el, "byteLength must be at least 1");
+    if (v->offset > bsize || v->length > bsize - v->offset)
+      return fail(c, IRIS_ERR_INVALID, el,
+                  "byteOffset %zu + byteLength %zu exceeds buffer %d's %zu bytes", v->offset,
+                  v->length, v->buffer, bsize);
+    if (v->stride != 0 && (v->stride < 4 || v->stride > 252 || v->stride % 4 != 0))
+      return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is not a multiple of 4 in [4, 252]",
+                  v->stride);
+  }
+  return IRIS_OK;
+}
+
+/* Checks that `count` elements of `elem` bytes at `offset` with `stride` fit in view `vi`. */
+static bool range_fits(const iris_gltf_view *v, size_t offset, size_t elem, size_t stride,
+                       size_t count) {
+  if (count == 0) return true;
+  if (offset > v->length || elem > v->length - offset) return false;
+  size_t room = v->length - offset - elem;
+  return stride == 0 ? true : (count - 1) <= room / stride;
+}
+
+static iris_status validate_accessors(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  for (size_t i = 0; i < d->accessor_count; i++) {
+    const iris_gltf_accessor *a = &d->accessors[i];
+    ELEMENT(el, "accessor %zu", i);
+    if (component_size(a->component_type) == 0)
+      return fail(c, IRIS_ERR_INVALID, el, "invalid componentType %d", a->component_type);
+    if (type_components(a->type) == 0) return fail(c, IRIS_ERR_INVALID, el, "invalid type");
+    if (a->count < 1) return fail(c, IRIS_ERR_INVALID, el, "count must be at least 1");
+    if (a->normalized && (a->component_type == CT_FLOAT || a->component_type == CT_UINT))
+      return fail(c, IRIS_ERR_INVALID, el, "normalized is only allowed for 8- and 16-bit integers");
+    size_t elem = element_size(a->component_type, a->type);
+    if (a->view >= 0) {
+      if ((size_t)a->view >= d->view_count)
+        return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist (%zu views)", a->view,
+                    d->view_count);
+      const iris_gltf_view *v = &d->views[a->view];
+      if (v->stride != 0 && v->stride < elem)
+        return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is smaller than the %zu-byte element",
+                    v->stride, elem);
+      size_t stride = v->stride ? v->stride : elem;
+      if (!range_fits(v, a->offset, elem, stride, a->count))
+        return fail(c, IRIS_ERR_INVALID, el,
+                    "byteOffset %zu + %zu elements of %zu bytes (stride %zu) exceed bufferView "
+                    "%d's %zu bytes",
+                    a->offset, a->count, elem, stride, a->view, v->length);
+    } else if (a->view != -1) {
+      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", a->view);
+    } else if (a->count > ZERO_ACCESSOR_MAX_COUNT) {
+      return fail(c, IRIS_ERR_NOMEM, el, "count %zu without a bufferView exceeds the limit %zu",
+                  a->count, ZERO_ACCESSOR_MAX_COUNT);
+    }
+    if (!a->sparse) continue;
+    if (a->sparse_count < 1 || (unsigned long long)a->sparse_count > a->count)
+      return fail(c, IRIS_ERR_INVALID, el, "sparse count %lld not in [1, %zu]", a->sparse_count,
+                  a->count);
+    size_t n = (size_t)a->sparse_count;
+    size_t isize = component_size(a->sparse_index_type);
+    if (a->sparse_index_type != CT_UBYTE && a->sparse_index_type != CT_USHORT &&
+        a->sparse_index_type != CT_UINT)
+      return fail(c, IRIS_ERR_INVALID, el, "sparse indices componentType %d is not unsigned",
+                  a->sparse_index_type);
+    int views[2] = {a->sparse_index_view, a->sparse_value_view};
+    long long offsets[2] = {a->sparse_index_offset, a->sparse_value_offset};
+    size_t sizes[2] = {isize, elem};
+    for (int k = 0; k < 2; k++) {
+      if (views[k] < 0 || (size_t)views[k] >= d->view_count)
+        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d does not exist",
+                    k ? "values" : "indices", views[k]);
+      const iris_gltf_view *v = &d->views[views[k]];
+      if (v->stride != 0)
+        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d must not have byteStride",
+                    k ? "values" : "indices", views[k]);
+      if (offsets[k] < 0 || !range_fits(v, (size_t)offsets[k], sizes[k], sizes[k], n))
+        return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
+                    k ? "values" : "indices", views[k]);
+    }
+    const iris_gltf_view *iv = &d->views[a->sparse_index_view];
+    const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
+    for (size_t k = 0; k < n; k++) {
+      uint32_t idx = load_u32(ip + k * isize, a->sparse_index_type);
+      if (idx >= a->count)
+        return fail(c, IRIS_ERR_INVALID, el, "sparse index %u >= count %zu", idx, a->count);
+    }
+  }
+  return IRIS_OK;
+}
+
+/* Pointer to element `i` of accessor `a`'s dense data (NULL when zero-filled). */
+static const uint8_t *element_ptr(const iris_gltf_doc *d, const iris_gltf_accessor *a, size_t i) {
+  if (a->view < 0) return NULL;
+  const iris_gltf_view *v = &d->views[a->view];
+  size_t elem = element_size(a->component_type, a->type);
+  size_t stride = v->stride ? v->stride : elem;
+  return d->buffers[v->buffer].data + v->offset + a->offset + i * stride;
+}
+
+/* Reads a (validated) accessor into count * ncomp floats, applying sparse substitution. */
+static void read_floats(const iris_gltf_doc *d, const iris_gltf_accessor *a, int ncomp, float *out) {
+  size_t cs = component_size(a->component_type);
+  for (size_t i = 0; i < a->count; i++) {
+    const uint8_t *p = element_ptr(d, a, i);
+    for (int k = 0; k < ncomp; k++)
+      out[i * (size_t)ncomp + (size_t)k] = p ? load_component(p + (size_t)k * cs, a->component_type, a->normalized) : 0.0f;
+  }
+  if (!a->sparse) return;
+  const iris_gltf_view *iv = &d->views[a->sparse_index_view], *vv = &d->views[a->sparse_value_view];
+  const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
+  const uint8_t *vp = d->buffers[vv->buffer].data + vv->offset + (size_t)a->sparse_value_offset;
+  size_t isize = component_size(a->sparse_index_type), elem = element_size(a->component_type, a->type);
+  for (size_t k = 0; k < (size_t)a->sparse_count; k++) {
+    uint32_t idx = load_u32(ip + k * isize, a->sparse_index_type);
+    for (int j = 0; j < ncomp; j++)
+      out[(size_t)idx * (size_t)ncomp + (size_t)j] =
+          load_component(vp + k * elem + (size_t)j * cs, a->component_type, a->normalized);
+  }
+}
+
+static void read_indices(const iris_gltf_doc *d, const iris_gltf_accessor *a, uint32_t *out) {
+  for (size_t i = 0; i < a->count; i++) {
+    const uint8_t *p = element_ptr(d, a, i);
+    out[i] = p ? load_u32(p, a->component_type) : 0;
+  }
+  if (!a->sparse) return;
+  const iris_gltf_view *iv = &d->views[a->sparse_index_view], *vv = &d->views[a->sparse_value_view];
+  const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
+  const uint8_t *vp = d->buffers[vv->buffer].data + vv->offset + (size_t)a->sparse_value_offset;
+  size_t isize = component_size(a->sparse_index_type), vsize = component_size(a->component_type);
+  for (size_t k = 0; k < (size_t)a->sparse_count; k++)
+    out[load_u32(ip + k * isize, a->sparse_index_type)] = load_u32(vp + k * vsize, a->component_type);
+}
+
+/* ---- meshes -------------------------------------------------------------- */
+
+static void note_ignored_attribute(ctx *c, const char *name) {
+  /* Keep one entry per name; group numbered sets (TEXCOORD_1, JOINTS_0) as-is. */
+  const char *p = c->ignored_attributes;
+  size_t n = strlen(name);
+  while ((p = strstr(p, name)) != NULL) {
+    if ((p == c->ignored_attributes || p[-1] == ' ') && (p[n] == ',' || p[n] == '\0')) return;
+    p += n;
+  }
+  size_t used = strlen(c->ignored_attributes);
+  if (used + n + 3 >= sizeof c->ignored_attributes) return;
+  snprintf(c->ignored_attributes + used, sizeof c->ignored_attributes - used, "%s%s",
+           used ? ", " : "", name);
+}
+
+static void free_mesh_arrays(iris_mesh *m) {
+  free(m->name);
+  free(m->positions);
+  free(m->normals);
+  free(m->uvs);
+  free(m->colors);
+  free(m->indices);
+  memset(m, 0, sizeof *m);
+}
+
+/* Looks up an attribute accessor; checks its type and vertex count. */
+static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, const char *name,
+                                      const char *el, int want_type, int alt_type, size_t want_count,
+                                      const iris_gltf_accessor **out) {
+  *out = NULL;
+  for (size_t i = 0; i < p->attribute_count; i++) {
+    if (strcmp(p->attributes[i].name, name) != 0) continue;
+    const iris_gltf_accessor *a = &c->doc->accessors[p->attributes[i].accessor];
+    if (a->type != want_type && a->type != alt_type)
+      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has type %s", name,
+                  p->attributes[i].accessor, type_name(a->type));
+    if (want_count && a->count != want_count)
+      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has %zu elements but POSITION has %zu",
+                  name, p->attributes[i].accessor, a->count, want_count);
+    *out = a;
+    return IRIS_OK;
+  }
+  return IRIS_OK;
+}
+
+static iris_status check_finite_array(ctx *c, const float *v, size_t n, const char *el,
+                                      const char *what) {
+  for (size_t i = 0; i < n; i++)
+    if (!isfinite(v[i]))
+      return fail(c, IRIS_ERR_INVALID, el, "non-finite %s value %g at element %zu", what, (double)v[i],
+                  i);
+  return IRIS_OK;
+}
+
+static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_prim *out) {
+  const iris_gltf_doc *d = c->doc;
+  const iris_gltf_mesh *gm = &d->meshes[mi];
+  const iris_gltf_primitive *p = &gm->primitives[pi];
+  char el[96];
+  ELEMENT(el, "mesh %zu primitive %zu", mi, pi);
+  memset(out, 0, sizeof *out);
+  out->scene_mesh = -1;
+  out->gltf_material = p->material;
+
+  for (size_t i = 0; i < p->attribute_count; i++) {
+    int ai = p->attributes[i].accessor;
+    if (ai < 0 || (size_t)ai >= d->accessor_count)
+      return fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
+                  p->attributes[i].name, ai);
+    const char *n = p->attributes[i].name;
+    if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0"))
+      note_ignored_attribute(c, n);
+  }
+  if (p->indices != -1 && (p->indices < 0 || (size_t)p->indices >= d->accessor_count))
+    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d does not exist (%zu accessors)",
+                p->indices, d->accessor_count);
+  if (p->material != -1 && (p->material < 0 || (size_t)p->material >= d->material_count))
+    return fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
+                d->material_count);
+  int mode = p->mode < 0 ? MODE_TRIANGLES : p->mode;
+  if (mode > MODE_FAN) return fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
+  if (p->target_count) c->warned_morph = true;
+  if (mode < MODE_TRIANGLES) {
+    c->skipped_points_lines++;
+    return IRIS_OK;
+  }
+  const iris_gltf_accessor *pos, *nrm, *uv, *col;
+  iris_status st = attribute_accessor(c, p, "POSITION", el, TYPE_VEC3, TYPE_VEC3, 0, &pos);
+  if (st) return st;
+  if (!pos) {
+    c->skipped_no_position++;
+    return IRIS_OK;
+  }
+  if (pos->count > UINT32_MAX) return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 vertices");
+  size_t nv = pos->count;
+  if ((st = attribute_accessor(c, p, "NORMAL", el, TYPE_VEC3, TYPE_VEC3, nv, &nrm)) ||
+      (st = attribute_accessor(c, p, "TEXCOORD_0", el, TYPE_VEC2, TYPE_VEC2, nv, &uv)) ||
+      (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)))
+    return st;
+  const iris_gltf_accessor *ia = p->indices >= 0 ? &d->accessors[p->indices] : NULL;
+  if (ia && (ia->type != TYPE_SCALAR || ia->normalized ||
+             (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT &&
+              ia->component_type != CT_UINT)))
+    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d must be unsigned integer SCALAR",
+                p->indices);
+  size_t ni = ia ? ia->count : nv;
+  if (mode == MODE_TRIANGLES && ni % 3 != 0)
+    return fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
+
+  iris_mesh *m = &out->mesh;
+  m->owned = true;
+  m->material = -1;
+  m->vertex_count = (uint32_t)nv;
+  m->positions = malloc(nv * 3 * sizeof(float));
+  if (!m->positions) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  read_floats(d, pos, 3, m->positions);
+  char ael[128];
+  ELEMENT(ael, "accessor %d", (int)(pos - d->accessors));
+  if ((st = check_finite_array(c, m->positions, nv * 3, ael, "POSITION"))) return st;
+
+  if (nrm) {
+    m->normals = malloc(nv * 3 * sizeof(float));
+    if (!m->normals) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    read_floats(d, nrm, 3, m->normals);
+    if ((st = check_finite_array(c, m->normals, nv * 3, el, "NORMAL"))) return st;
+    bool zero = false;
+    for (size_t i = 0; i < nv; i++) {
+      float *n = m->normals + 3 * i;
+      float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (!(len > 0.0f) || !isfinite(1.0f / len)) {
+        zero = true;
+        break;
+      }
+      n[0] /= len, n[1] /= len, n[2] /= len;
+    }
+    if (zero) { /* unusable: drop them so they get recomputed */
+      free(m->normals);
+      m->normals = NULL;
+      c->zero_normals++;
+    }
+  }
+  if (uv) {
+    m->uvs = malloc(nv * 2 * sizeof(float));
+    if (!m->uvs) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    read_floats(d, uv, 2, m->uvs);
+    if ((st = check_finite_array(c, m->uvs, nv * 2, el, "TEXCOORD_0"))) return st;
+  }
+  if (col) {
+    int nc = col->type == TYPE_VEC4 ? 4 : 3;
+    float *tmp = malloc(nv * (size_t)nc * sizeof(float));
+    m->colors = malloc(nv * 3 * sizeof(float));
+    if (!tmp || !m->colors) {
+      free(tmp);
+      return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    }
+    read_floats(d, col, nc, tmp);
+    for (size_t i = 0; i < nv; i++) /* alpha dropped: iris is opaque */
+      for (int k = 0; k < 3; k++) m->colors[3 * i + (size_t)k] = tmp[(size_t)nc * i + (size_t)k];
+    free(tmp);
+    if ((st = check_finite_array(c, m->colors, nv * 3, el, "COLOR_0"))) return st;
+  }
+
+  uint32_t *idx = malloc((ni ? ni : 1) * sizeof(uint32_t));
+  if (!idx) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (ia) {
+    read_indices(d, ia, idx);
+    for (size_t i = 0; i < ni; i++)
+      if (idx[i] >= nv) {
+        free(idx);
+        char iel[64];
+        ELEMENT(iel, "accessor %d", p->indices);
+        return fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i],
+                    i, nv, el);
+      }
+  } else {
+    for (size_t i = 0; i < ni; i++) idx[i] = (uint32_t)i;
+  }
+  /* Triangle list per glTF 2.0 section 3.7.2.1 (strip and fan orders). */
+  size_t nt = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
+  if (nt > UINT32_MAX) {
+    free(idx);
+    return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
+  }
+  m->indices = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
+  if (!m->indices) {
+    free(idx);
+    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  }
+  size_t kept = 0;
+  for (size_t t = 0; t < nt; t++) {
+    uint32_t a, b, e;
+    if (mode == MODE_TRIANGLES) {
+      a = idx[3 * t], b = idx[3 * t + 1], e = idx[3 * t + 2];
+    } else if (mode == MODE_STRIP) {
+      a = idx[t], b = idx[t + 1 + t % 2], e = idx[t + 2 - t % 2];
+    } else {
+      a = idx[t + 1], b = idx[t + 2], e = idx[0];
+    }
+    if (a == b || b == e || a == e) {
+      c->degenerate_dropped++;
+      continue;
+    }
+    m->indices[3 * kept] = a, m->indices[3 * kept + 1] = b, m->indices[3 * kept + 2] = e;
+    kept++;
+  }
+  free(idx);
+  m->triangle_count = (uint32_t)kept;
+  if (kept == 0) {
+    c->skipped_empty++;
+    free_mesh_arrays(m);
+    return IRIS_OK;
+  }
+  char name[256];
+  const char *base = gm->name && gm->name[0] ? gm->name : "mesh";
+  if (gm->primitive_count > 1)
+    snprintf(name, sizeof name, "%s#%zu", base, pi);
+  else
+    snprintf(name, sizeof name, "%s", base);
+  m->name = iris_strdup(name);
+  out->valid = true;
+  return IRIS_OK;
+}
+
+static iris_status convert_meshes(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  c->prims = calloc(d->mesh_count ? d->mesh_count : 1, sizeof *c->prims);
+  if (!c->prims) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  for (size_t mi = 0; mi < d->mesh_count; mi++) {
+    size_t np = d->meshes[mi].primitive_count;
+    if (np == 0) {
+      char el[32];
+      ELEMENT(el, "mesh %zu", mi);
+      return fail(c, IRIS_ERR_INVALID, el, "has no primitives");
+    }
+    c->prims[mi] = calloc(np, sizeof **c->prims);
+    if (!c->prims[mi]) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    for (size_t pi = 0; pi < np; pi++) {
+      iris_status st = convert_primitive(c, mi, pi, &c->prims[mi][pi]);
+      if (st) return st;
+    }
+  }
+  return IRIS_OK;
+}
+
+/* ---- textures and materials ---------------------------------------------- */
+
+static iris_status validate_textures(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  for (size_t i = 0; i < d->sampler_count; i++) {
+    const iris_gltf_sampler *s = &d->samplers[i];
+    ELEMENT(el, "sampler %zu", i);
+    int wraps[2] = {s->wrap_s, s->wrap_t};
+    for (int k = 0; k < 2; k++)
+      if (wraps[k] != WRAP_REPEAT && wraps[k] != WRAP_CLAMP && wraps[k] != WRAP_MIRROR)
+        return fail(c, IRIS_ERR_INVALID, el, "invalid wrap mode %d", wraps[k]);
+    if (s->mag_filter != -1 && s->mag_filter != FILTER_NEAREST && s->mag_filter != FILTER_LINEAR)
+      return fail(c, IRIS_ERR_INVALID, el, "invalid magFilter %d", s->mag_filter);
+  }
+  for (size_t i = 0; i < d->image_count; i++) {
+    const iris_gltf_image *im = &d->images[i];
+    ELEMENT(el, "image %zu", i);
+    if (im->view != -1 && (im->view < 0 || (size_t)im->view >= d->view_count))
+      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", im->view);
+  }
+  for (size_t i = 0; i < d->texture_count; i++) {
+    const iris_gltf_texture *t = &d->textures[i];
+    ELEMENT(el, "texture %zu", i);
+    if (t->source != -1 && (t->source < 0 || (size_t)t->source >= d->image_count))
+      return fail(c, IRIS_ERR_INVALID, el, "image %d does not exist (%zu images)", t->source,
+                  d->image_count);
+    if (t->sampler != -1 && (t->sampler < 0 || (size_t)t->sampler >= d->sampler_count))
+      return fail(c, IRIS_ERR_INVALID, el, "sampler %d does not exist (%zu samplers)", t->sampler,
+                  d->sampler_count);
+  }
+  return IRIS_OK;
+}
+
+static int hexval(char ch) {
+  if (ch >= '0' && ch <= '9') return ch - '0';
+  if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
+  if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
+  return -1;
+}
+
+/* Percent-decoding of a relative URI reference (RFC 3986). */
+static void uri_decode(const char *in, char *out, size_t size) {
+  size_t o = 0;
+  for (size_t i = 0; in[i] && o + 1 < size; i++) {
+    int h, l;
+    if (in[i] == '%' && (h = hexval(in[i + 1])) >= 0 && (l = hexval(in[i + 2])) >= 0) {
+      out[o++] = (char)(h * 16 + l);
+      i += 2;
+    } else {
+      out[o++] = in[i];
+    }
+  }
+  out[o] = '\0';
+}
+
+static void warn_dropped_image(ctx *c, size_t image, const char *why) {
+  iris_warnf("%s: image %zu: %s; the texture is ignored", c->file, image, why);
+  c->warned_bad_image = true;
+}
+
+/* Scene texture for glTF texture `ti`, created on first use; -2 when dropped with a warning. */
+static iris_status resolve_texture(ctx *c, int ti, int32_t *out) {
+  const iris_gltf_doc *d = c->doc;
+  if (c->texture_map[ti] != -1) {
+    *out = c->texture_map[ti];
+    return IRIS_OK;
+  }
+  *out = c->texture_map[ti] = -2;
+  const iris_gltf_texture *t = &d->textures[ti];
+  char el[64];
+  /* Textures naming the same image and sampler share one scene texture. */
+  for (int tj = 0; tj < (int)d->texture_count; tj++)
+    if (tj != ti && c->texture_map[tj] >= 0 && d->textures[tj].source == t->source &&
+        d->textures[tj].sampler == t->sampler) {
+      *out = c->texture_map[ti] = c->texture_map[tj];
+      return IRIS_OK;
+    }
+  if (t->source < 0) {
+    iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
+    return IRIS_OK;
+  }
+  const iris_gltf_image *im = &d->images[t->source];
+  ELEMENT(el, "image %d", t->source);
+  iris_texture tex;
+  memset(&tex, 0, sizeof tex);
+  const uint8_t *bytes = NULL;
+  size_t size = 0;
+  char mime[16] = "";
+  if (im->view >= 0) {
+    const iris_gltf_view *v = &d->views[im->view];
+    bytes = d->buffers[v->buffer].data + v->offset;
+    size = v->length;
+  } else if (im->data) {
+    bytes = im->data;
+    size = im->size;
+  }
+  if (bytes) {
+    if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
+    else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
+      snprintf(mime, sizeof mime, "image/jpeg");
+    if (!mime[0]) {
+      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG image");
+      return IRIS_OK;
+    }
+    tex.data = malloc(size);
+    if (!tex.data) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    memcpy(tex.data, bytes, size);
+    tex.data_size = size;
+  } else if (im->uri) {
+    if (strstr(im->uri, "://"))
+      return fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
+    if (!d->base_dir)
+      return fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
+    char rel[1024], joined[2048], abs_path[4096];
+    uri_decode(im->uri, rel, sizeof rel);
+    iris_path_join(d->base_dir, rel, joined, sizeof joined);
+    if (!im->file_found) return fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
+    /* Absolute, so the scene stays valid wherever it is written. */
+    char cwd[2048];
+    if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
+      snprintf(abs_path, sizeof abs_path, "%s", joined);
+    else
+      snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
+    if (!im->file_mime[0]) {
+      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG file");
+      return IRIS_OK;
+    }
+    snprintf(mime, sizeof mime, "%s", im->file_mime);
+    tex.path = iris_strdup(abs_path);
+    if (!tex.path) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  } else {
+    return fail(c, IRIS_ERR_INVALID, el, "has no data");
+  }
+  snprintf(tex.mime, sizeof tex.mime, "%s", mime);
+  tex.name = im->name && im->name[0] ? iris_strdup(im->name) : NULL;
+  tex.wrap_s = tex.wrap_t = IRIS_WRAP_REPEAT;
+  if (t->sampler >= 0) {
+    const iris_gltf_sampler *s = &d->samplers[t->sampler];
+    int w[2] = {s->wrap_s, s->wrap_t};
+    iris_wrap *dst[2] = {&tex.wrap_s, &tex.wrap_t};
+    for (int k = 0; k < 2; k++)
+      *dst[k] = w[k] == WRAP_CLAMP ? IRIS_WRAP_CLAMP : w[k] == WRAP_MIRROR ? IRIS_WRAP_MIRROR : IRIS_WRAP_REPEAT;
+    tex.nearest = s->mag_filter == FILTER_NEAREST;
+  }
+  int32_t id = iris_scene_add_texture(c->scene, &tex);
+  if (id < 0) {
+    free(tex.name), free(tex.path), free(tex.data);
+    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  }
+  *out = c->texture_map[ti] = id;
+  return IRIS_OK;
+}
+
+static iris_status check_range(ctx *c, const char *el, const char *what, double v, double lo, double hi) {
+  if (!isfinite(v) || v < lo || v > hi)
+    return fail(c, IRIS_ERR_INVALID, el, "%s %g is not in [%g, %g]", what, v, lo, hi);
+  return IRIS_OK;
+}
+
+/* Texture reference check: index in range; non-zero texCoord sets are not supported. */
+static iris_status texture_ref(ctx *c, const char *el, const char *what, iris_gltf_texture_ref r,
+                               int32_t *out) {
+  *out = -1;
+  if (r.texture == -1) return IRIS_OK;
+  if (r.texture < 0 || (size_t)r.texture >= c->doc->texture_count)
+    return fail(c, IRIS_ERR_INVALID, el, "%s: texture %d does not exist (%zu textures)", what,
+                r.texture, c->doc->texture_count);
+  if (r.texcoord < 0) return fail(c, IRIS_ERR_INVALID, el, "%s: negative texCoord", what);
+  if (r.texcoord != 0) {
+    c->warned_texcoord = true;
+    return IRIS_OK;
+  }
+  *out = r.texture; /* glTF index; turned into a scene index when the material is used */
+  return IRIS_OK;
+}
+
+/* glTF 2.0 Appendix B metallic-roughness material (+ the KHR_materials_* above). */
+static iris_status validate_materials(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  c->materials = calloc(d->material_count ? d->material_count : 1, sizeof *c->materials);
+  if (!c->materials) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  char el[64];
+  iris_status st;
+  for (size_t i = 0; i < d->material_count; i++) {
+    const iris_gltf_material *g = &d->materials[i];
+    iris_material *m = &c->materials[i];
+    ELEMENT(el, "material %zu", i);
+    *m = iris_material_default(IRIS_MATERIAL_GLTF);
+    if (g->bad_extension)
+      return fail(c, IRIS_ERR_INVALID, el, "%s: a value has the wrong JSON type", g->bad_extension);
+    if (g->base_color_len != 4)
+      return fail(c, IRIS_ERR_INVALID, el, "baseColorFactor has %zu values (4 expected)", g->base_color_len);
+    if (g->emissive_len != 3)
+      return fail(c, IRIS_ERR_INVALID, el, "emissiveFactor has %zu values (3 expected)", g->emissive_len);
+    for (int k = 0; k < 4; k++)
+      if ((st = check_range(c, el, "baseColorFactor component", g->base_color[k], 0, 1))) return st;
+    for (int k = 0; k < 3; k++)
+      if ((st = check_range(c, el, "emissiveFactor component", g->emissive[k], 0, 1))) return st;
+    if ((st = check_range(c, el, "metallicFactor", g->metallic, 0, 1)) ||
+        (st = check_range(c, el, "roughnessFactor", g->roughness, 0, 1)) ||
+        (st = check_range(c, el, "KHR_materials_emissive_strength emissiveStrength",
+                          g->emissive_strength, 0, HUGE_VAL)) ||
+        (st = check_range(c, el, "KHR_materials_specular specularFactor", g->specular, 0, 1)) ||
+        (st = check_range(c, el, "KHR_materials_transmission transmissionFactor", g->transmission, 0, 1)))
+      return st;
+    for (int k = 0; k < 3; k++)
+      if ((st = check_range(c, el, "KHR_materials_specular specularColorFactor component",
+                            g->specular_color[k], 0, HUGE_VAL)))
+        return st;
+    if (!isfinite(g->ior) || (g->ior != 0.0 && g->ior < 1.0))
+      return fail(c, IRIS_ERR_INVALID, el, "KHR_materials_ior ior %g is neither 0 nor >= 1", g->ior);
+
+    if (g->name && g->name[0]) m->name = (char *)g->name; /* copied when added */
+    for (int k = 0; k < 3; k++) {
+      m->color[k] = (float)g->base_color[k];
+      m->emission[k] = (float)(g->emissive[k] * g->emissive_strength);
+      m->specular_color[k] = (float)g->specular_color[k];
+    }
+    m->metallic = (float)g->metallic;
+    m->roughness = (float)g->roughness;
+    m->specular = (float)g->specular;
+    m->transmission = (float)g->transmission;
+    /* ior 0 is the extension's "F0 = 1" special case, which a dielectric cannot express. */
+    if (g->ior == 0.0) iris_warnf("%s: material %zu: KHR_materials_ior ior 0 is not supported; using 1.5", c->file, i);
+    m->ior = g->ior == 0.0 ? 1.5f : (float)g->ior;
+    m->double_sided = g->double_sided;
+    m->emission_two_sided = g->double_sided;
+    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &m->color_texture)) ||
+        (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
+                          &m->metallic_roughness_texture)) ||
+        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &m->emission_texture)))
+      return st;
+    if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
+      if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
+        return fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
+      c->warned_alpha = true;
+    }
+    if (g->has_normal_texture || g->has_occlusion_texture) c->warned_normal_occlusion = true;
+    if (g->has_specular_textures) c->warned_spec_tex = true;
+    if (g->has_transmission_texture) c->warned_trans_tex = true;
+  }
+  return IRIS_OK;
+}
+
+/* Scene material for glTF material `gi` (-1: the glTF default material). */
+static iris_status resolve_material(ctx *c, int gi, int32_t *out) {
+  if (gi < 0) {
+    if (c->default_material < 0) {
+      /* glTF 2.0 section 3.9.6: no material = base colour 1, metallic 1, roughness 1. */
+      iris_material m = iris_material_default(IRIS_MATERIAL_GLTF);
+      m.color[0] = m.color[1] = m.color[2] = 1.0f;
+      m.metallic = 1.0f;
+      m.roughness = 1.0f;
+      m.emission_two_sided = false;
+      m.name = iris_strdup("glTF default");
+      c->default_material = iris_scene_add_material(c->scene, &m);
+      if (c->default_material < 0) {
+        free(m.name);
+        return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      }
+    }
+    *out = c->default_material;
+    return IRIS_OK;
+  }
+  if (c->material_map[gi] >= 0) {
+    *out = c->material_map[gi];
+    return IRIS_OK;
+  }
+  iris_material m = c->materials[gi];
+  iris_status st;
+  int32_t *slots[3] = {&m.color_texture, &m.metallic_roughness_texture, &m.emission_texture};
+  for (int k = 0; k < 3; k++) {
+    if (*slots[k] < 0) continue;
+    int32_t id;
+    if ((st = resolve_texture(c, *slots[k], &id))) return st;
+    *slots[k] = id >= 0 ? id : -1;
+  }
+  m.name = m.name ? iris_strdup(m.name) : NULL;
+  int32_t id = iris_scene_add_material(c->scene, &m);
+  if (id < 0) {
+    free(m.name);
+    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  }
+  *out = c->material_map[gi] = id;
+  return IRIS_OK;
+}
+
+/* ---- nodes, cameras, lights ---------------------------------------------- */
+
+static iris_status validate_cameras_lights(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  iris_status st;
+  for (size_t i = 0; i < d->camera_count; i++) {
+    const iris_gltf_camera *cam = &d->cameras[i];
+    ELEMENT(el, "camera %zu", i);
+    if (strcmp(cam->type, "perspective") == 0) {
+      if (!isfinite(cam->yfov) || cam->yfov <= 0.0 || cam->yfov >= IRIS_PI)
+        return fail(c, IRIS_ERR_INVALID, el, "yfov %g is not in (0, pi)", cam->yfov);
+      if (!isfinite(cam->aspect) || cam->aspect < 0.0)
+        return fail(c, IRIS_ERR_INVALID, el, "aspectRatio %g is not positive", cam->aspect);
+    } else if (strcmp(cam->type, "orthographic") != 0) {
+      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", cam->type);
+    }
+  }
+  for (size_t i = 0; i < d->light_count; i++) {
+    const iris_gltf_light *l = &d->lights[i];
+    ELEMENT(el, "KHR_lights_punctual light %zu", i);
+    if (strcmp(l->type, "point") && strcmp(l->type, "spot") && strcmp(l->type, "directional"))
+      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", l->type);
+    if (l->color_len != 0 && l->color_len != 3)
+      return fail(c, IRIS_ERR_INVALID, el, "color has %zu values (3 expected)", l->color_len);
+    for (size_t k = 0; k < l->color_len; k++)
+      if ((st = check_range(c, el, "color component", l->color[k], 0, 1))) return st;
+    if ((st = check_range(c, el, "intensity", l->intensity, 0, HUGE_VAL)) ||
+        (st = check_range(c, el, "range", l->range, 0, HUGE_VAL)))
+      return st;
+    if (strcmp(l->type, "spot") == 0) {
+      if ((st = check_range(c, el, "spot.outerConeAngle", l->outer_cone, 0, IRIS_PI / 2 + 1e-6)) ||
+          (st = check_range(c, el, "spot.innerConeAngle", l->inner_cone, 0, l->outer_cone)))
+        return st;
+      if (l->inner_cone >= l->outer_cone)
+        return fail(c, IRIS_ERR_INVALID, el, "innerConeAngle must be less than outerConeAngle");
+    }
+  }
+  return IRIS_OK;
+}
+
+/* Local matrix of a node: `matrix` (column-major) or T * R * S. */
+static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
+  const iris_gltf_node *n = &c->doc->nodes[ni];
+  char el[32];
+  ELEMENT(el, "node %zu", ni);
+  if ((n->matrix_len != 0 && n->matrix_len != 16) || (n->translation_len != 0 && n->translation_len != 3) ||
+      (n->rotation_len != 0 && n->rotation_len != 4) || (n->scale_len != 0 && n->scale_len != 3))
+    return fail(c, IRIS_ERR_INVALID, el, "matrix/translation/rotation/scale has the wrong length");
+  if (!all_finite(n->matrix, n->matrix_len) || !all_finite(n->translation, n->translation_len) ||
+      !all_finite(n->rotation, n->rotation_len) || !all_finite(n->scale, n->scale_len))
+    return fail(c, IRIS_ERR_INVALID, el, "non-finite transform value");
+  *out = dmat4_identity();
+  if (n->matrix_len == 16) {
+    if (n->translation_len || n->rotation_len || n->scale_len) c->warned_matrix_trs = true;
+    for (int r = 0; r < 4; r++)
+      for (int col = 0; col < 4; col++) out->m[r][col] = n->matrix[col * 4 + r];
+    return IRIS_OK;
+  }
+  double t[3] = {0, 0, 0}, q[4] = {0, 0, 0, 1}, s[3] = {1, 1, 1};
+  if (n->translation_len) memcpy(t, n->translation, sizeof t);
+  if (n->rotation_len) memcpy(q, n->rotation, sizeof q);
+  if (n->scale_len) memcpy(s, n->scale, sizeof s);
+  double len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(len > 1e-12) || !isfinite(len))
+    return fail(c, IRIS_ERR_INVALID, el, "rotation quaternion has zero length");
+  for (int k = 0; k < 4; k++) q[k] /= len;
+  double x = q[0], y = q[1], z = q[2], w = q[3];
+  double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                    {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                    {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+  for (int r = 0; r < 3; r++) {
+    for (int col = 0; col < 3; col++) out->m[r][col] = R[r][col] * s[col];
+    out->m[r][3] = t[r];
+  }
+  return IRIS_OK;
+}
+
+/* Parents, single-parent rule and cycles (nodes unreachable from any root). */
+static iris_status validate_node_graph(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  size_t nn = d->node_count;
+  char el[32];
+  c->parent = malloc((nn ? nn : 1) * sizeof *c->parent);
+  int *stack = malloc((nn ? nn : 1) * sizeof *stack);
+  bool *seen = calloc(nn ? nn : 1, sizeof *seen);
+  if (!c->parent || !stack || !seen) {
+    free(stack), free(seen);
+    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  }
+  iris_status st = IRIS_OK;
+  for (size_t i = 0; i < nn; i++) c->parent[i] = -1;
+  for (size_t i = 0; i < nn && !st; i++) {
+    const iris_gltf_node *n = &d->nodes[i];
+    ELEMENT(el, "node %zu", i);
+    if (n->mesh != -1 && (n->mesh < 0 || (size_t)n->mesh >= d->mesh_count))
+      st = fail(c, IRIS_ERR_INVALID, el, "mesh %d does not exist (%zu meshes)", n->mesh, d->mesh_count);
+    else if (n->camera != -1 && (n->camera < 0 || (size_t)n->camera >= d->camera_count))
+      st = fail(c, IRIS_ERR_INVALID, el, "camera %d does not exist (%zu cameras)", n->camera, d->camera_count);
+    else if (n->light != -1 && (n->light < 0 || (size_t)n->light >= d->light_count))
+      st = fail(c, IRIS_ERR_INVALID, el, "KHR_lights_punctual light %d does not exist (%zu lights)",
+                n->light, d->light_count);
+    for (size_t k = 0; k < n->child_count && !st; k++) {
+      int ch = n->children[k];
+      if (ch < 0 || (size_t)ch >= nn)
+        st = fail(c, IRIS_ERR_INVALID, el, "child %d does not exist (%zu nodes)", ch, nn);
+      else if ((size_t)ch == i)
+        st = fail(c, IRIS_ERR_INVALID, el, "is its own child");
+      else if (c->parent[ch] >= 0)
+        st = fail(c, IRIS_ERR_INVALID, el, "child %d already has parent node %d (a node may have one parent)",
+                  ch, c->parent[ch]);
+      else
+        c->parent[ch] = (int)i;
+    }
+    if (n->skin >= 0) c->warned_skin = true;
+    if (n->has_weights) c->warned_morph = true;
+  }
+  /* With one parent each, the nodes not reachable from a root lie on or below a cycle. */
+  size_t top = 0;
+  for (size_t i = 0; i < nn && !st; i++)
+    if (c->parent[i] < 0) stack[top++] = (int)i;
+  while (top > 0 && !st) {
+    int ni = stack[--top];
+    seen[ni] = true;
+    for (size_t k = 0; k < d->nodes[ni].child_count; k++) stack[top++] = d->nodes[ni].children[k];
+  }
+  for (size_t i = 0; i < nn && !st; i++)
+    if (!seen[i]) {
+      ELEMENT(el, "node %zu", i);
+      st = fail(c, IRIS_ERR_INVALID, el, "is part of a cycle in the node hierarchy");
+    }
+  free(stack);
+  free(seen);
+  return st;
+}
+
+typedef struct camera_hit {
+  int node, camera;
+} camera_hit;
+
+static iris_status add_instance_prims(ctx *c, int mesh, const dmat4 *world) {
+  const iris_gltf_mesh *gm = &c->doc->meshes[mesh];
+  iris_status st;
+  for (size_t pi = 0; pi < gm->primitive_count; pi++) {
+    converted_prim *cp = &c->prims[mesh][pi];
+    if (!cp->valid) continue;
+    if (cp->scene_mesh < 0) {
+      if ((st = resolve_material(c, cp->gltf_material, &cp->mesh.material))) return st;
+      int32_t id = iris_scene_add_mesh(c->scene, &cp->mesh);
+      if (id < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      memset(&cp->mesh, 0, sizeof cp->mesh); /* the scene owns the arrays now */
+      cp->scene_mesh = id;
+    }
+    iris_instance inst;
+    inst.mesh = (uint32_t)cp->scene_mesh;
+    inst.transform = dmat4_to_float(world);
+    if (iris_scene_add_instance(c->scene, &inst) < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  }
+  return IRIS_OK;
+}
+
+static iris_status add_light(ctx *c, int node, const dmat4 *w) {
+  const iris_gltf_light *g = &c->doc->lights[c->doc->nodes[node].light];
+  iris_light l;
+  memset(&l, 0, sizeof l);
+  l.type = strcmp(g->type, "point") == 0 ? IRIS_LIGHT_POINT
+           : strcmp(g->type, "spot") == 0 ? IRIS_LIGHT_SPOT
+                                          : IRIS_LIGHT_DIRECTIONAL;
+  for (int k = 0; k < 3; k++) l.color[k] = g->color_len == 3 ? (float)g->color[k] : 1.0f;
+  l.intensity = (float)g->intensity;
+  l.range = (float)g->range;
+  l.inner_cone = (float)g->inner_cone;
+  l.outer_cone = (float)g->outer_cone;
+  for (int k = 0; k < 3; k++) l.position[k] = (float)w->m[k][3];
+  /* Lights shine along the node's local -Z (scale affects only the direction). */
+  double dir[3] = {-w->m[0][2], -w->m[1][2], -w->m[2][2]};
+  double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+  if (!(len > 1e-12) || !isfinite(len)) {
+    iris_warnf("%s: node %d: light direction is degenerate (zero scale); light skipped", c->file, node);
+    return IRIS_OK;
+  }
+  for (int k = 0; k < 3; k++) l.direction[k] = (float)(dir[k] / len);
+  const char *name = g->name && g->name[0] ? g->name : c->doc->nodes[node].name;
+  l.name = name && name[0] ? iris_strdup(name) : NULL;
+  if (iris_scene_add_light(c->scene, &l) < 0) {
+    free(l.name);
+    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  }
+  return IRIS_OK;
+}
+
+/* Camera frame without scale: -Z (view) and +Y (up) kept, Gram-Schmidt, right-handed. */
+static bool camera_frame(const dmat4 *w, iris_mat4 *out) {
+  double z[3], y[3], x[3];
+  for (int k = 0; k < 3; k++) z[k] = w->m[k][2], y[k] = w->m[k][1];
+  double lz = sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]);
+  if (!(lz > 1e-12)) return false;
+  for (int k = 0; k < 3; k++) z[k] /= lz;
+  double dy = y[0] * z[0] + y[1] * z[1] + y[2] * z[2];
+  for (int k = 0; k < 3; k++) y[k] -= dy * z[k];
+  double ly = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+  if (!(ly > 1e-12)) return false;
+  for (int k = 0; k < 3; k++) y[k] /= ly;
+  x[0] = y[1] * z[2] - y[2] * z[1], x[1] = y[2] * z[0] - y[0] * z[2], x[2] = y[0] * z[1] - y[1] * z[0];
+  dmat4 r = dmat4_identity();
+  for (int k = 0; k < 3; k++) r.m[k][0] = x[k], r.m[k][1] = y[k], r.m[k][2] = z[k], r.m[k][3] = w->m[k][3];
+  *out = dmat4_to_float(&r);
+  return true;
+}
+
+static const char *camera_label(ctx *c, const camera_hit *h) {
+  const char *n = c->doc->cameras[h->camera].name;
+  if (n && n[0]) return n;
+  n = c->doc->nodes[h->node].name;
+  return n && n[0] ? n : NULL;
+}
+
+static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
+  size_t chosen = 0;
+  const char *want = c->opts ? c->opts->camera_name : NULL;
+  if (want && want[0]) {
+    size_t i;
+    for (i = 0; i < n; i++) {
+      const char *cn = c->doc->cameras[hits[i].camera].name, *nn = c->doc->nodes[hits[i].node].name;
+      if ((cn && strcmp(cn, want) == 0) || (nn && strcmp(nn, want) == 0)) break;
+    }
+    if (i == n) {
+      char list[400] = "";
+      size_t used = 0;
+      for (size_t k = 0; k < n && used + 1 < sizeof list; k++) {
+        const char *l = camera_label(c, &hits[k]);
+        int w = snprintf(list + used, sizeof list - used, "%s'%s'", k ? ", " : "", l ? l : "(unnamed)");
+        if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
+      }
+      return fail(c, IRIS_ERR_USAGE, "cameras", "no perspective camera named '%s' (available: %s)", want,
+                  n ? list : "none");
+    }
+    chosen = i;
+  }
+  /* The chosen camera goes first; the others follow in traversal order. */
+  for (size_t k = 0; k < n; k++) {
+    size_t i = k == 0 ? chosen : (k <= chosen ? k - 1 : k);
+    const iris_gltf_camera *g = &c->doc->cameras[hits[i].camera];
+    iris_camera cam;
+    memset(&cam, 0, sizeof cam);
+    if (!camera_frame(&c->world[hits[i].node], &cam.to_world)) {
+      iris_warnf("%s: node %d: camera transform is degenerate; camera skipped", c->file, hits[i].node);
+      continue;
+    }
+    cam.yfov = (float)g->yfov;
+    cam.aspect = (float)g->aspect;
+    const char *l = camera_label(c, &hits[i]);
+    cam.name = l ? iris_strdup(l) : NULL;
+    if (iris_scene_add_camera(c->scene, &cam) < 0) {
+      free(cam.name);
+      return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    }
+  }
+  return IRIS_OK;
+}
+
+static iris_status traverse(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  size_t nn = d->node_count;
+  char el[32];
+  /* Roots: the default scene (or scene 0), else every parentless node. */
+  const int *roots = NULL;
+  size_t root_count = 0;
+  int *all_roots = malloc((nn ? nn : 1) * sizeof *all_roots);
+  int *stack = malloc((nn ? nn : 1) * sizeof *stack);
+  camera_hit *hits = malloc((nn ? nn : 1) * sizeof *hits);
+  bool *listed = calloc(nn ? nn : 1, sizeof *listed);
+  c->world = malloc((nn ? nn : 1) * sizeof *c->world);
+  iris_status st = IRIS_OK;
+  size_t hit_count = 0;
+  if (!all_roots || !stack || !hits || !listed || !c->world) {
+    st = fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    goto done;
+  }
+  if (d->default_scene != -1 && (d->default_scene < 0 || (size_t)d->default_scene >= d->scene_count)) {
+    st = fail(c, IRIS_ERR_INVALID, "scene", "default scene %d does not exist (%zu scenes)",
+              d->default_scene, d->scene_count);
+    goto done;
+  }
+  for (size_t s = 0; s < d->scene_count; s++) /* every scene must be valid, even unused ones */
+    for (size_t k = 0; k < d->scenes[s].node_count; k++) {
+      int r = d->scenes[s].nodes[k];
+      ELEMENT(el, "scene %zu", s);
+      if (r < 0 || (size_t)r >= nn) {
+        st = fail(c, IRIS_ERR_INVALID, el, "node %d does not exist (%zu nodes)", r, nn);
+        goto done;
+      }
+      if (c->parent[r] >= 0) {
+        st = fail(c, IRIS_ERR_INVALID, el, "node %d is not a root (child of node %d)", r, c->parent[r]);
+        goto done;
+      }
+    }
+  if (d->scene_count > 0) {
+    size_t s = d->default_scene >= 0 ? (size_t)d->default_scene : 0;
+    roots = d->scenes[s].nodes;
+    root_count = d->scenes[s].node_count;
+    if (d->scene_count > 1)
+      iris_warnf("%s: %zu scenes; importing scene %zu only", c->file, d->scene_count, s);
+  } else {
+    for (size_t i = 0; i < nn; i++)
+      if (c->parent[i] < 0) all_roots[root_count++] = (int)i;
+    roots = all_roots;
+  }
+  /* Pre-order, children in order (this fixes which camera is "first"). */
+  for (size_t r = 0; r < root_count; r++) {
+    int root = roots[r];
+    if (listed[root]) {
+      ELEMENT(el, "scene");
+      st = fail(c, IRIS_ERR_INVALID, el, "root node %d is listed twice", root);
+      goto done;
+    }
+    listed[root] = true;
+    dmat4 local;
+    if ((st = node_local(c, (size_t)root, &local))) goto done;
+    c->world[root] = local;
+    size_t top = 0;
+    stack[top++] = root;
+    while (top > 0) {
+      int ni = stack[--top];
+      const iris_gltf_node *n = &d->nodes[ni];
+      if (n->mesh >= 0 && (st = add_instance_prims(c, n->mesh, &c->world[ni]))) goto done;
+      if (n->light >= 0 && (st = add_light(c, ni, &c->world[ni]))) goto done;
+      if (n->camera >= 0) {
+        if (strcmp(d->cameras[n->camera].type, "perspective") == 0)
+          hits[hit_count++] = (camera_hit){ni, n->camera};
+        else
+          c->warned_ortho = true;
+      }
+      for (size_t k = n->child_count; k-- > 0;) {
+        int ch = n->children[k];
+        if ((st = node_local(c, (size_t)ch, &local))) goto done;
+        c->world[ch] = dmat4_mul(&c->world[ni], &local);
+        stack[top++] = ch;
+      }
+    }
+  }
+  st = add_cameras(c, hits, hit_count);
+done:
+  free(all_roots);
+  free(stack);
+  free(hits);
+  free(listed);
+  return st;
+}
+
+/* ---- top level ----------------------------------------------------------- */
+
+static iris_status check_asset(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  const char *v = d->version ? d->version : "";
+  if (strncmp(v, "2.", 2) != 0)
+    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "version '%s' is not glTF 2.x", v);
+  if (d->min_version && d->min_version[0] && strcmp(d->min_version, "2.0") != 0)
+    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "minVersion '%s' is newer than 2.0", d->min_version);
+  iris_status st = iris_gltf_check_required(d->extensions_required, d->extensions_required_count,
+                                            c->file, c->err);
+  if (st) return st;
+  char list[400] = "";
+  size_t used = 0;
+  for (size_t i = 0; i < d->extensions_used_count; i++) {
+    if (is_supported_extension(d->extensions_used[i])) continue;
+    int w = snprintf(list + used, sizeof list - used, "%s%s", used ? ", " : "", d->extensions_used[i]);
+    if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
+  }
+  if (used) iris_warnf("%s: ignoring unsupported extensions: %s", c->file, list);
+  return IRIS_OK;
+}
+
+static void report_ignored(ctx *c) {
+  const char *f = c->file;
+  if (c->ignored_attributes[0]) iris_warnf("%s: ignoring vertex attributes: %s", f, c->ignored_attributes);
+  if (c->skipped_points_lines)
+    iris_warnf("%s: skipped %zu point/line primitive(s) (iris renders triangles)", f, c->skipped_points_lines);
+  if (c->skipped_no_position)
+    iris_warnf("%s: skipped %zu primitive(s) without POSITION", f, c->skipped_no_position);
+  if (c->skipped_empty) iris_warnf("%s: skipped %zu primitive(s) with no triangles", f, c->skipped_empty);
+  if (c->degenerate_dropped)
+    iris_warnf("%s: dropped %zu degenerate triangle(s) (repeated vertex)", f, c->degenerate_dropped);
+  if (c->zero_normals)
+    iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped", f, c->zero_normals);
+  if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_1 or higher are ignored", f);
+  if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
+  if (c->warned_normal_occlusion) iris_warnf("%s: normal and occlusion textures are ignored", f);
+  if (c->warned_spec_tex) iris_warnf("%s: KHR_materials_specular textures are ignored", f);
+  if (c->warned_trans_tex) iris_warnf("%s: KHR_materials_transmission texture is ignored", f);
+  if (c->warned_morph) iris_warnf("%s: morph targets ignored (base shape used)", f);
+  if (c->warned_skin) iris_warnf("%s: skins ignored (bind pose used)", f);
+  if (c->warned_ortho) iris_warnf("%s: orthographic cameras skipped", f);
+  if (c->warned_matrix_trs) iris_warnf("%s: nodes with both matrix and TRS: matrix used", f);
+  if (c->doc->animation_count) iris_warnf("%s: %zu animation(s) ignored", f, c->doc->animation_count);
+  if (c->scene->instance_count == 0) iris_warnf("%s: the scene has no mesh instances", f);
+}
+
+static void ctx_free(ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  if (c->prims) {
+    for (size_t mi = 0; mi < d->mesh_count; mi++) {
+      if (!c->prims[mi]) continue;
+      for (size_t pi = 0; pi < d->meshes[mi].primitive_count; pi++) free_mesh_arrays(&c->prims[mi][pi].mesh);
+      free(c->prims[mi]);
+    }
+    free(c->prims);
+  }
+  free(c->materials);
+  free(c->material_map);
+  free(c->texture_map);
+  free(c->parent);
+  free(c->world);
+}
+
+iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_options *opts,
+                              iris_scene **out, iris_error *err) {
+  ctx c;
+  memset(&c, 0, sizeof c);
+  c.doc = doc;
+  c.opts = opts;
+  c.file = doc->file;
+  c.err = err;
+  c.default_material = -1;
+  *out = NULL;
+  iris_status st = check_asset(&c);
+  if (st) return st;
+  c.scene = iris_scene_create();
+  c.material_map = malloc((doc->material_count ? doc->material_count : 1) * sizeof *c.material_map);
+  c.texture_map = malloc((doc->texture_count ? doc->texture_count : 1) * sizeof *c.texture_map);
+  if (!c.scene || !c.material_map || !c.texture_map) {
+    st = fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    goto done;
+  }
+  for (size_t i = 0; i < doc->material_count; i++) c.material_map[i] = -1;
+  for (size_t i = 0; i < doc->texture_count; i++) c.texture_map[i] = -1;
+  /* Validate everything first (even what the scene does not use), then build. */
+  if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = validate_textures(&c)) ||
+      (st = validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
+      (st = validate_node_graph(&c)) || (st = convert_meshes(&c)) || (st = traverse(&c)))
+    goto done;
+  snprintf(c.scene->units, sizeof c.scene->units, "m"); /* glTF 2.0: metres */
+  c.scene->source_path = iris_strdup(doc->file);
+  report_ignored(&c);
+  st = iris_scene_validate(c.scene, c.file, err);
+done:
+  ctx_free(&c);
+  if (st != IRIS_OK) {
+    iris_scene_destroy(c.scene);
+    return st;
+  }
+  *out = c.scene;
+  return IRIS_OK;
+}
