@@ -1,0 +1,460 @@
+/* Guiding preprocess and guided direction sampler (thesis 4.2, 5.1-5.2);
+ * docs/guiding.md. */
+#include "renderer/guiding/guiding.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/log.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "renderer/guiding/photons.h"
+
+#define CAMERA_SAMPLE_INDEX 0x63616d6361636865ULL /* streams apart from pixels and photons */
+#define MAX_SPECULAR_CHAIN 8
+#define TIE_EPS 1e-4f
+/* Photons whose surface normal differs more than this from the cache's (the
+ * other side of a thin wall, the neighbouring wall in a corner) are not
+ * splatted: their directions describe another surface's hemisphere. */
+#define PHOTON_NORMAL_COS 0.5f
+
+iris_guiding_params iris_guiding_params_default(void) {
+  iris_guiding_params p;
+  memset(&p, 0, sizeof p);
+  p.pdf_floor = -1.0f;
+  p.alpha_max = 0.9f;
+  p.cos_min = 0.9f;
+  p.splat = IRIS_SPLAT_NEAREST;
+  return p;
+}
+
+/* ---- cache placement ----------------------------------------------------- */
+
+typedef struct seed_point {
+  iris_vec3 p, n;
+  uint8_t valid, transmits;
+} seed_point;
+
+typedef struct camera_ctx {
+  const iris_guide_setup *setup;
+  int stride, cols, rows;
+  seed_point *out; /* rows * cols */
+} camera_ctx;
+
+static void camera_rows(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  camera_ctx *c = ctx;
+  const iris_guide_setup *s = c->setup;
+  for (uint64_t r = begin; r < end; ++r) {
+    for (int col = 0; col < c->cols; ++col) {
+      seed_point *sp_out = &c->out[r * (uint64_t)c->cols + (uint64_t)col];
+      memset(sp_out, 0, sizeof *sp_out);
+      float fx = (float)(col * c->stride) + 0.5f * (float)c->stride;
+      float fy = (float)((int)r * c->stride) + 0.5f * (float)c->stride;
+      iris_sampler rng = iris_sampler_start(s->seed, r * (uint64_t)c->cols + (uint64_t)col, CAMERA_SAMPLE_INDEX);
+      iris_ray ray = iris_pinhole_ray(s->camera, fx, fy);
+      /* Follow specular chains to the first non-specular hit (thesis 4.2.2). */
+      for (int depth = 0; depth <= MAX_SPECULAR_CHAIN; ++depth) {
+        iris_hit hit;
+        if (!iris_accel_intersect(s->accel, &ray, &hit)) break;
+        iris_interaction si;
+        iris_accel_interaction(s->accel, ray.d, &hit, &si);
+        iris_shading_point sp;
+        iris_integrator_shade(s->integrator, &si, iris_normalize(iris_neg(ray.d)), depth, &sp);
+        if (!sp.delta) {
+          sp_out->p = si.p;
+          sp_out->n = sp.frame.n;
+          sp_out->valid = 1;
+          sp_out->transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
+          break;
+        }
+        iris_direction_sample ds;
+        if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) break;
+        ray = iris_spawn_ray(&sp.si, ds.wi);
+      }
+    }
+  }
+}
+
+/* ---- filling -------------------------------------------------------------- */
+
+typedef struct fill_ctx {
+  iris_guiding *g;
+  const iris_photon_map *photons;
+  const iris_kdtree *photon_tree;
+  uint32_t k;
+  float **hist;     /* per thread, sphere-map sized */
+  uint32_t **ids;   /* per thread, k */
+  float **d2;       /* per thread, k */
+} fill_ctx;
+
+static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  fill_ctx *c = ctx;
+  iris_guiding *g = c->g;
+  float *hist = c->hist[thread_index];
+  uint32_t *ids = c->ids[thread_index];
+  float *d2 = c->d2[thread_index];
+  for (uint64_t i = begin; i < end; ++i) {
+    iris_cache *cache = &g->caches[i];
+    const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
+    memset(hist, 0, sizeof(float) * map->texel_count);
+    uint32_t n = iris_kdtree_knn(c->photon_tree, cache->p, c->k, INFINITY, ids, d2);
+    uint32_t used = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+      const iris_photon *ph = &c->photons->photons[ids[j]];
+      if (iris_dot(ph->n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
+      iris_vec3 wl = iris_frame_to_local(&cache->frame, ph->wi);
+      used += iris_cache_splat(map, hist, wl, ph->energy, g->params.splat);
+    }
+    cache->photons = used;
+    if (!used || !iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + cache->table,
+                                          g->cdf + cache->table))
+      cache->photons = 0;
+  }
+}
+
+/* ---- budget ---------------------------------------------------------------- */
+
+static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int *stride) {
+  int64_t pixels = (int64_t)s->camera->width * s->camera->height;
+  if (p->caches <= 0) {
+    int64_t c = pixels / 32; /* one camera cache per 8x8 pixels, as many from photons */
+    p->caches = c < 1024 ? 1024 : (c > 65536 ? 65536 : c);
+  }
+  int64_t cam = p->caches / 2 > 0 ? p->caches / 2 : 1;
+  int st = (int)lrint(sqrt((double)pixels / (double)cam));
+  *stride = st < 1 ? 1 : st;
+  if (p->cache_res <= 0) p->cache_res = 16;
+  if (p->cache_k <= 0) p->cache_k = 200;
+  if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
+  if (p->photons <= 0) {
+    /* Enough photons that each cache's k nearest stay local: about 2.5 stored
+     * photons per path on the benchmark scenes, so paths = caches * k / 20
+     * gives every cache ~ 1/8 of its neighbourhood to itself; more lights
+     * need more photons to cover each one. */
+    int64_t n = p->caches * (int64_t)p->cache_k / 20;
+    n = (int64_t)((double)n * (1.0 + 0.05 * (double)(s->lights->count > 1 ? s->lights->count - 1 : 0)));
+    p->photons = n < 100000 ? 100000 : (n > 4000000 ? 4000000 : n);
+  }
+  if (!(p->alpha_max >= 0.0f)) p->alpha_max = 0.0f;
+  if (p->alpha_max > 0.9999f) p->alpha_max = 0.9999f; /* BSDF sampling must keep some probability */
+}
+
+static void skip(iris_guiding *g, const char *why) {
+  g->stats.skipped = true;
+  snprintf(g->stats.reason, sizeof g->stats.reason, "%s", why);
+}
+
+static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int stride,
+                                iris_error *err) {
+  iris_guiding_params *p = &g->params;
+  double t0 = iris_time_now();
+  iris_photon_map photons;
+  iris_status st = iris_photons_trace(s, (uint64_t)p->photons, &photons, err);
+  if (st != IRIS_OK) return st;
+  g->stats.photon_paths = photons.paths;
+  g->stats.photons_stored = photons.count;
+  g->stats.photons_indirect = photons.indirect;
+  double t1 = iris_time_now();
+  g->stats.photon_seconds = t1 - t0;
+  if (photons.count == 0 && !p->force) {
+    iris_photons_destroy(&photons);
+    skip(g, "no photon reached a non-specular surface");
+    return IRIS_OK;
+  }
+  if (p->use_nee && !p->force && (double)photons.indirect < 0.01 * (double)photons.count) {
+    iris_photons_destroy(&photons);
+    skip(g, "the scene is lit only directly: light sampling already covers it");
+    return IRIS_OK;
+  }
+  /* Camera caches. */
+  camera_ctx cc;
+  cc.setup = s;
+  cc.stride = stride;
+  cc.cols = (s->camera->width + stride - 1) / stride;
+  cc.rows = (s->camera->height + stride - 1) / stride;
+  cc.out = malloc(sizeof(seed_point) * (size_t)cc.cols * (size_t)cc.rows);
+  if (!cc.out) {
+    iris_photons_destroy(&photons);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  }
+  iris_parallel_for((uint64_t)cc.rows, 1, s->threads, camera_rows, &cc);
+  size_t ncam = 0;
+  for (size_t i = 0; i < (size_t)cc.cols * (size_t)cc.rows; ++i) ncam += cc.out[i].valid;
+  if (ncam == 0 && !p->force) {
+    free(cc.out);
+    iris_photons_destroy(&photons);
+    skip(g, "every visible surface is a perfect mirror or glass (or nothing is visible)");
+    return IRIS_OK;
+  }
+  size_t nph = (size_t)(p->caches - (int64_t)ncam > 0 ? p->caches - (int64_t)ncam : 0);
+  if (nph > photons.count) nph = photons.count;
+  size_t total = ncam + nph;
+  g->caches = calloc(total ? total : 1, sizeof(iris_cache));
+  if (!g->caches) {
+    free(cc.out);
+    iris_photons_destroy(&photons);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %zu caches", total);
+  }
+  size_t at = 0, floats = 0;
+  for (size_t i = 0; i < (size_t)cc.cols * (size_t)cc.rows; ++i) {
+    if (!cc.out[i].valid) continue;
+    iris_cache *c = &g->caches[at++];
+    c->p = cc.out[i].p;
+    c->frame = iris_frame_from_normal(cc.out[i].n);
+    c->sphere = cc.out[i].transmits;
+    c->from_camera = 1;
+  }
+  free(cc.out);
+  for (size_t i = 0; i < nph; ++i) { /* the first n photons (thesis 4.2.2) */
+    iris_cache *c = &g->caches[at++];
+    c->p = photons.photons[i].p;
+    c->frame = iris_frame_from_normal(photons.photons[i].n);
+    c->sphere = photons.photons[i].transmits;
+  }
+  for (size_t i = 0; i < total; ++i) {
+    g->caches[i].table = (uint32_t)floats;
+    floats += g->caches[i].sphere ? g->sphere.texel_count : g->hemi.texel_count;
+  }
+  g->pdf = malloc(sizeof(float) * (floats ? floats : 1));
+  g->cdf = malloc(sizeof(float) * (floats ? floats : 1));
+  iris_kdtree ptree;
+  memset(&ptree, 0, sizeof ptree);
+  if (!g->pdf || !g->cdf || floats > UINT32_MAX)
+    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
+  if (st == IRIS_OK)
+    st = iris_kdtree_build(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count, err);
+  /* Fill in parallel with per-thread scratch. */
+  int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
+  fill_ctx fc = {g, &photons, &ptree, (uint32_t)p->cache_k, NULL, NULL, NULL};
+  if (st == IRIS_OK) {
+    fc.hist = calloc((size_t)threads, sizeof(float *));
+    fc.ids = calloc((size_t)threads, sizeof(uint32_t *));
+    fc.d2 = calloc((size_t)threads, sizeof(float *));
+    bool ok = fc.hist && fc.ids && fc.d2;
+    for (int t = 0; ok && t < threads; ++t) {
+      fc.hist[t] = malloc(sizeof(float) * g->sphere.texel_count);
+      fc.ids[t] = malloc(sizeof(uint32_t) * (size_t)p->cache_k);
+      fc.d2[t] = malloc(sizeof(float) * (size_t)p->cache_k);
+      ok = fc.hist[t] && fc.ids[t] && fc.d2[t];
+    }
+    if (ok) {
+      g->cache_count = total;
+      iris_parallel_for(total, 64, threads, fill_caches, &fc);
+    } else {
+      st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+    }
+    for (int t = 0; t < threads; ++t) {
+      if (fc.hist) free(fc.hist[t]);
+      if (fc.ids) free(fc.ids[t]);
+      if (fc.d2) free(fc.d2[t]);
+    }
+    free(fc.hist);
+    free(fc.ids);
+    free(fc.d2);
+  }
+  iris_kdtree_destroy(&ptree);
+  iris_photons_destroy(&photons); /* thesis 4.2.4: photons are not needed any more */
+  if (st != IRIS_OK) return st;
+  /* Keep the caches that received photons; their tables stay where they are. */
+  size_t kept = 0;
+  for (size_t i = 0; i < total; ++i) {
+    if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
+    else g->stats.empty_caches++;
+  }
+  g->cache_count = kept;
+  for (size_t i = 0; i < kept; ++i) g->stats.camera_caches += g->caches[i].from_camera;
+  g->stats.caches = kept;
+  if (kept == 0 && !p->force) {
+    skip(g, "no cache received photons");
+    return IRIS_OK;
+  }
+  st = iris_kdtree_build(&g->tree, &g->caches[0].p, sizeof(iris_cache), (uint32_t)kept, err);
+  if (st != IRIS_OK) return st;
+  g->stats.memory_bytes = sizeof(iris_cache) * kept + 2 * sizeof(float) * floats +
+                          (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
+                          sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count);
+  g->stats.cache_seconds = iris_time_now() - t1;
+  return IRIS_OK;
+}
+
+iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
+                               iris_guiding **out, iris_error *err) {
+  *out = NULL;
+  double t0 = iris_time_now();
+  iris_guiding *g = calloc(1, sizeof *g);
+  if (!g) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  g->params = params ? *params : iris_guiding_params_default();
+  if (g->params.cache_k > 100000 || g->params.photons > ((int64_t)1 << 32) ||
+      g->params.caches > ((int64_t)1 << 26)) {
+    free(g);
+    return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, "guiding",
+                          "guiding budget too large (photons <= 2^32, caches <= 2^26, k <= 100000)");
+  }
+  int stride = 1;
+  choose_budget(&g->params, setup, &stride);
+  g->stats.cache_res = g->params.cache_res;
+  g->stats.cache_k = g->params.cache_k;
+  g->stats.camera_stride = stride;
+  g->stats.pdf_floor = g->params.pdf_floor;
+  iris_status st = iris_octmap_create(&g->hemi, g->params.cache_res, false, err);
+  if (st == IRIS_OK) st = iris_octmap_create(&g->sphere, g->params.cache_res, true, err);
+  if (st == IRIS_OK) {
+    if (setup->lights->count == 0 && !g->params.force) skip(g, "the scene has no lights");
+    else st = build_caches(g, setup, stride, err);
+  }
+  if (st != IRIS_OK) {
+    iris_guiding_destroy(g);
+    return st;
+  }
+  g->stats.total_seconds = iris_time_now() - t0;
+  *out = g;
+  return IRIS_OK;
+}
+
+void iris_guiding_destroy(iris_guiding *g) {
+  if (!g) return;
+  iris_octmap_destroy(&g->hemi);
+  iris_octmap_destroy(&g->sphere);
+  iris_kdtree_destroy(&g->tree);
+  free(g->caches);
+  free(g->pdf);
+  free(g->cdf);
+  free(g);
+}
+
+/* ---- rendering (thesis 5.1-5.2) --------------------------------------------- */
+
+int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t ids[IRIS_GUIDING_PICK_K]) {
+  if (g->cache_count == 0) return 0;
+  uint32_t near[IRIS_GUIDING_PICK_K];
+  float d2[IRIS_GUIDING_PICK_K], cosv[IRIS_GUIDING_PICK_K];
+  uint32_t m = iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, INFINITY, near, d2);
+  float best = -2.0f;
+  for (uint32_t i = 0; i < m; ++i) {
+    cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);
+    best = fmaxf(best, cosv[i]);
+  }
+  if (!(best > g->params.cos_min)) return 0;
+  int count = 0;
+  for (uint32_t i = 0; i < m; ++i)
+    if (cosv[i] >= best - TIE_EPS) ids[count++] = near[i];
+  return count;
+}
+
+float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, iris_vec3 wi) {
+  float sum = 0.0f;
+  for (int i = 0; i < m; ++i) {
+    const iris_cache *c = &g->caches[ids[i]];
+    const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+    sum += iris_cache_pdf(map, g->pdf + c->table, iris_frame_to_local(&c->frame, wi));
+  }
+  return m > 0 ? sum / (float)m : 0.0f;
+}
+
+float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
+  if (sp->delta) return 0.0f;
+  float r = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
+  return fminf(r, g->params.alpha_max);
+}
+
+static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
+                          iris_direction_sample *out) {
+  const iris_guiding *g = ctx;
+  float alpha = iris_guiding_alpha(g, sp);
+  uint32_t ids[IRIS_GUIDING_PICK_K];
+  int m = alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, ids) : 0;
+  /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
+  if (m == 0) return iris_integrator_sample_bsdf(sp, rng, out);
+  float u = iris_sampler_next(rng);
+  if (u >= alpha) {
+    if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;
+    if (out->delta) { /* only the BSDF strategy reaches a delta lobe */
+      out->pdf *= 1.0f - alpha;
+      return true;
+    }
+    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guiding_cache_pdf(g, ids, m, out->wi);
+    return out->pdf > 0.0f;
+  }
+  /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
+  float uc = iris_sampler_next(rng), u0 = iris_sampler_next(rng), u1 = iris_sampler_next(rng),
+        u2 = iris_sampler_next(rng);
+  int j = (int)(uc * (float)m);
+  const iris_cache *c = &g->caches[ids[j < m ? j : m - 1]];
+  const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+  float pdf_one;
+  iris_vec3 wl = iris_cache_sample(map, g->pdf + c->table, g->cdf + c->table, u0, u1, u2, &pdf_one);
+  iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
+  iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
+  out->wi = wi;
+  out->f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wi_local);
+  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) +
+             alpha * iris_guiding_cache_pdf(g, ids, m, wi);
+  out->delta = false;
+  bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
+  out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
+              ((sp->lobes & IRIS_LOBE_DIFFUSE) ? IRIS_LOBE_DIFFUSE : IRIS_LOBE_GLOSSY);
+  return out->pdf > 0.0f && iris_max3(out->f) > 0.0f;
+}
+
+static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
+  const iris_guiding *g = ctx;
+  float alpha = iris_guiding_alpha(g, sp);
+  uint32_t ids[IRIS_GUIDING_PICK_K];
+  int m = alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, ids) : 0;
+  float pb = iris_integrator_bsdf_pdf(sp, wi);
+  if (m == 0) return pb;
+  return (1.0f - alpha) * pb + alpha * iris_guiding_cache_pdf(g, ids, m, wi);
+}
+
+iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
+  iris_direction_sampler s;
+  memset(&s, 0, sizeof s);
+  if (!g || g->stats.skipped || g->cache_count == 0) return s;
+  s.ctx = g;
+  s.sample = guided_sample;
+  s.pdf = guided_pdf;
+  return s;
+}
+
+void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
+  const iris_guiding_stats *s = &g->stats;
+  if (s->skipped) {
+    snprintf(buf, size, "guiding skipped (BSDF sampling instead): %s", s->reason);
+    return;
+  }
+  snprintf(buf, size,
+           "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
+           "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g; "
+           "preprocessing %.2f s (photons %.2f s); cache memory %.1f MiB",
+           (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
+           s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
+           (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
+           (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, s->cache_k,
+           (double)s->pdf_floor, s->total_seconds, s->photon_seconds,
+           (double)s->memory_bytes / (1024.0 * 1024.0));
+}
+
+/* ---- iris_render provider ---------------------------------------------------- */
+
+static iris_status provider_build(const iris_guide_setup *setup, iris_direction_sampler *out,
+                                  void **state, iris_error *err) {
+  iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
+                                         : iris_guiding_params_default();
+  p.use_nee = setup->integrator && iris_method_uses_nee(setup->integrator->method);
+  iris_guiding *g = NULL;
+  iris_status st = iris_guiding_build(setup, &p, &g, err);
+  if (st != IRIS_OK) return st;
+  char line[512];
+  iris_guiding_describe(g, line, sizeof line);
+  iris_infof("%s", line);
+  *out = iris_guiding_sampler(g);
+  *state = g;
+  return IRIS_OK;
+}
+
+static void provider_destroy(void *state) { iris_guiding_destroy(state); }
+
+const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy};

@@ -1,0 +1,104 @@
+/* Irradiance-cache guiding (thesis chapters 4-5): preprocessing (photons ->
+ * cache placement -> filling -> cache kd-tree) and the guided direction
+ * sampler the integrator calls: one-sample MIS between BSDF sampling
+ * (probability 1 - alpha) and cache sampling (alpha = min(roughness,
+ * alpha_max)), balance heuristic. docs/guiding.md derives the estimator and
+ * gives the measured defaults. */
+#ifndef IRIS_RENDERER_GUIDING_GUIDING_H
+#define IRIS_RENDERER_GUIDING_GUIDING_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "renderer/guiding/cache.h"
+#include "renderer/guiding/kdtree.h"
+#include "renderer/guiding/octmap.h"
+#include "renderer/integrator.h"
+#include "renderer/render.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IRIS_GUIDING_PICK_K 5 /* Algorithm 1: the 5 nearest caches */
+
+/* Every parameter has a flag in `iris render`; <= 0 (or < 0 for the floor)
+ * means "choose from the scene" (docs/guiding.md, "Budget"). */
+typedef struct iris_guiding_params {
+  int64_t photons;      /* photon paths emitted (--photons) */
+  int64_t caches;       /* caches, half from camera rays, half from photons (--caches) */
+  int cache_res;        /* octahedral map texels per side (--cache-res) */
+  int cache_k;          /* photons per cache (--cache-k) */
+  float pdf_floor;      /* minimum texel probability before renormalising (--pdf-floor) */
+  float alpha_max;      /* cap on the cache-sampling probability (--alpha-max), default 0.9 */
+  float cos_min;        /* Algorithm 1 threshold (--cos-min), default 0.9 */
+  iris_splat_mode splat;/* nearest (thesis) or bilinear */
+  bool force;           /* build caches even where the budget would skip guiding */
+  bool use_nee;         /* the render also samples lights (guided-nee): skip if lit only directly */
+} iris_guiding_params;
+
+iris_guiding_params iris_guiding_params_default(void);
+
+/* A cache (thesis 4.2.4): position, frame, and an offset into the shared tables. */
+typedef struct iris_cache {
+  iris_vec3 p;
+  iris_frame frame;
+  uint32_t table;    /* first float of this cache's pdf/cdf in iris_guiding.pdf/.cdf */
+  uint32_t photons;  /* photons splatted */
+  uint8_t sphere;    /* full-sphere map (transmissive surface) */
+  uint8_t from_camera;
+} iris_cache;
+
+typedef struct iris_guiding_stats {
+  uint64_t photon_paths, photons_stored, photons_indirect;
+  uint64_t caches, camera_caches, empty_caches;
+  int cache_res, cache_k, camera_stride;
+  float pdf_floor;
+  double photon_seconds, cache_seconds, total_seconds;
+  size_t memory_bytes; /* caches + tables + kd-tree */
+  bool skipped;        /* guiding off: sampler falls back to the BSDF */
+  char reason[160];
+} iris_guiding_stats;
+
+typedef struct iris_guiding {
+  iris_guiding_params params;
+  iris_octmap hemi, sphere;
+  iris_cache *caches;
+  size_t cache_count;
+  float *pdf, *cdf;    /* all tables, pdf over solid angle and CDF per texel */
+  iris_kdtree tree;    /* over caches[i].p */
+  iris_guiding_stats stats;
+} iris_guiding;
+
+iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
+                               iris_guiding **out, iris_error *err);
+void iris_guiding_destroy(iris_guiding *g);
+
+/* The integrator hook; sample == NULL when guiding was skipped. */
+iris_direction_sampler iris_guiding_sampler(iris_guiding *g);
+
+/* Algorithm 1 without the coin flips: the caches among the 5 nearest to p
+ * whose normal has the best cosine with n (ties within 1e-4), none if that
+ * cosine is <= cos_min. The guided strategy samples one of them uniformly
+ * (with the path's sampler) and its density is their average, so `pdf`
+ * evaluates exactly what `sample` does. Returns how many (<= 5). */
+int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t ids[IRIS_GUIDING_PICK_K]);
+/* Solid-angle density of cache sampling for world direction wi at a point
+ * with picked caches ids[0..m). */
+float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, iris_vec3 wi);
+/* Cache-sampling probability alpha = min(roughness, alpha_max) at a shading point. */
+float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp);
+
+/* Builds the guide from `options` (an iris_guiding_params, NULL = defaults)
+ * for iris_render; destroy frees it. */
+extern const iris_guide_provider iris_guiding_provider;
+
+/* One-line summaries for `iris render`. */
+void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,132 @@
+/* Photon tracing (thesis 4.2.1); docs/guiding.md "Photons". */
+#include "renderer/guiding/photons.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/parallel.h"
+#include "core/rng.h"
+
+#define BLOCK_PATHS 4096u
+/* Stream offset that keeps photon random numbers apart from camera pixels. */
+#define PHOTON_SAMPLE_INDEX 0x70686f746f6eULL
+
+typedef struct photon_block {
+  iris_photon *items;
+  size_t count, cap;
+  bool oom;
+} photon_block;
+
+typedef struct trace_ctx {
+  const iris_guide_setup *setup;
+  uint64_t paths;
+  photon_block *blocks;
+} trace_ctx;
+
+static void block_push(photon_block *b, const iris_photon *ph) {
+  if (b->oom) return;
+  if (b->count == b->cap) {
+    size_t cap = b->cap ? 2 * b->cap : 1024;
+    iris_photon *n = realloc(b->items, cap * sizeof *n);
+    if (!n) {
+      b->oom = true;
+      return;
+    }
+    b->items = n;
+    b->cap = cap;
+  }
+  b->items[b->count++] = *ph;
+}
+
+static void trace_path(const iris_guide_setup *s, uint64_t index, photon_block *out) {
+  iris_sampler rng = iris_sampler_start(s->seed, index, PHOTON_SAMPLE_INDEX);
+  float us = iris_sampler_next(&rng), u0 = iris_sampler_next(&rng), u1 = iris_sampler_next(&rng),
+        u2 = iris_sampler_next(&rng), u3 = iris_sampler_next(&rng);
+  iris_photon_emission e;
+  if (!iris_lights_sample_emission(s->lights, us, u0, u1, u2, u3, &e)) return;
+  iris_vec3 beta = e.power;
+  if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;
+  iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
+  for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
+    iris_hit hit;
+    if (!iris_accel_intersect(s->accel, &ray, &hit)) return;
+    iris_interaction si;
+    iris_accel_interaction(s->accel, ray.d, &hit, &si);
+    iris_vec3 wo = iris_normalize(iris_neg(ray.d));
+    iris_shading_point sp;
+    iris_integrator_shade(s->integrator, &si, wo, bounce, &sp);
+    if (!sp.delta) {
+      iris_photon ph;
+      ph.p = si.p;
+      ph.n = sp.frame.n;
+      ph.wi = wo;
+      ph.energy = iris_avg3(beta);
+      ph.bounce = (uint8_t)(bounce > 255 ? 255 : bounce);
+      ph.transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
+      block_push(out, &ph);
+    }
+    iris_direction_sample ds;
+    if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    float cosv = fabsf(iris_dot(ds.wi, sp.frame.n));
+    iris_vec3 w = ds.delta ? ds.f : iris_scale(ds.f, cosv);
+    beta = iris_scale(iris_mul(beta, w), 1.0f / ds.pdf);
+    if (!iris_isfinite3(beta)) return;
+    /* Russian roulette on the throughput relative to the emitted power. */
+    if (bounce >= 2) {
+      float q = fminf(1.0f, iris_max3(beta) / fmaxf(iris_max3(e.power), 1e-30f));
+      if (!(iris_sampler_next(&rng) < q)) return;
+      beta = iris_scale(beta, 1.0f / q);
+    }
+    if (!(iris_max3(beta) > 0.0f)) return;
+    ray = iris_spawn_ray(&sp.si, ds.wi);
+  }
+}
+
+static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  trace_ctx *c = ctx;
+  for (uint64_t b = begin; b < end; ++b) {
+    uint64_t lo = b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
+    if (hi > c->paths) hi = c->paths;
+    for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, i, &c->blocks[b]);
+  }
+}
+
+iris_status iris_photons_trace(const iris_guide_setup *setup, uint64_t paths,
+                               iris_photon_map *out, iris_error *err) {
+  memset(out, 0, sizeof *out);
+  if (paths == 0 || setup->lights->count == 0) return IRIS_OK;
+  uint64_t nblocks = (paths + BLOCK_PATHS - 1) / BLOCK_PATHS;
+  photon_block *blocks = calloc(nblocks, sizeof *blocks);
+  if (!blocks) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
+  trace_ctx c = {setup, paths, blocks};
+  iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
+  size_t total = 0;
+  bool oom = false;
+  for (uint64_t b = 0; b < nblocks; ++b) {
+    total += blocks[b].count;
+    oom |= blocks[b].oom;
+  }
+  iris_photon *all = oom ? NULL : malloc((total ? total : 1) * sizeof *all);
+  if (all) {
+    size_t at = 0;
+    for (uint64_t b = 0; b < nblocks; ++b) {
+      if (blocks[b].count) memcpy(all + at, blocks[b].items, blocks[b].count * sizeof *all);
+      at += blocks[b].count;
+    }
+  }
+  for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items);
+  free(blocks);
+  if (!all)
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %zu photons", total);
+  out->photons = all;
+  out->count = total;
+  out->paths = paths;
+  for (size_t i = 0; i < total; ++i) out->indirect += all[i].bounce > 0;
+  return IRIS_OK;
+}
+
+void iris_photons_destroy(iris_photon_map *map) {
+  free(map->photons);
+  memset(map, 0, sizeof *map);
+}

@@ -1,0 +1,50 @@
+/* Photon tracing for the guiding preprocess (thesis 4.2.1): photons leave the
+ * lights in proportion to power, follow BSDF sampling with Russian roulette up
+ * to 32 bounces, and one photon is stored at every non-specular hit. Parallel
+ * and deterministic: photon path i draws from iris_sampler_start(seed, i, ...)
+ * and paths are processed in fixed blocks concatenated in order, so the photon
+ * array does not depend on the thread count. */
+#ifndef IRIS_RENDERER_GUIDING_PHOTONS_H
+#define IRIS_RENDERER_GUIDING_PHOTONS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "renderer/render.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IRIS_PHOTON_MAX_BOUNCES 32
+
+/* One stored photon (32 bytes + padding). Energy is a single float, the mean
+ * of the RGB power (the thesis's choice): the caches only need the relative
+ * distribution of incident power over directions, not its colour. */
+typedef struct iris_photon {
+  iris_vec3 p;      /* hit position */
+  iris_vec3 n;      /* shading normal, on the side the photon arrived from (transmissive: front) */
+  iris_vec3 wi;     /* unit world direction back towards where the photon came from */
+  float energy;     /* mean of the RGB photon power */
+  uint8_t bounce;   /* 0: straight from the light (direct illumination) */
+  uint8_t transmits;/* the surface has transmission lobes (full-sphere cache) */
+} iris_photon;
+
+typedef struct iris_photon_map {
+  iris_photon *photons;
+  size_t count;
+  uint64_t paths;     /* photon paths emitted */
+  uint64_t indirect;  /* stored photons with bounce >= 1 */
+} iris_photon_map;
+
+/* Traces `paths` photon paths. */
+iris_status iris_photons_trace(const iris_guide_setup *setup, uint64_t paths,
+                               iris_photon_map *out, iris_error *err);
+void iris_photons_destroy(iris_photon_map *map);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
