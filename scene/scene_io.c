@@ -109,19 +109,50 @@ static void relative_path(const char *from, const char *to, char *out, size_t si
 /* The camera as position/target/up when iris_mat4_look_at rebuilds exactly
  * the same matrix from them (true for most hand-placed cameras); otherwise
  * the raw matrix, so a written scene always loads back bit for bit. */
+static iris_vec3 plus_zero(iris_vec3 v) { return iris_v3(v.x + 0.0f, v.y + 0.0f, v.z + 0.0f); }
+
+/* Rounds each component to 6 significant digits and flushes values that are
+ * tiny next to `scale` to 0, so that 5.80000019 becomes 5.8. */
+static iris_vec3 snap(iris_vec3 v, float scale) {
+  float c[3];
+  iris_v3_store(v, c);
+  for (int i = 0; i < 3; i++) {
+    char buf[32];
+    snprintf(buf, sizeof buf, "%.6g", (double)c[i]);
+    c[i] = fabsf(c[i]) < 1e-5f * scale ? 0.0f : strtof(buf, NULL);
+  }
+  return plus_zero(iris_v3_load(c));
+}
+
+/* The camera as position/target/up when iris_mat4_look_at rebuilds exactly
+ * the same matrix from them; otherwise the raw matrix, so a written scene
+ * always loads back bit for bit. Candidate targets are points on the view
+ * ray that people pick (where it crosses a coordinate plane, the point
+ * nearest the origin, one unit ahead), each also rounded to 6 digits. */
 static void add_camera_placement(cJSON *o, const iris_mat4 *m) {
-  /* +0.0f turns -0 into +0, as the JSON would. */
-  iris_vec3 eye = iris_v3(m->m[0][3] + 0.0f, m->m[1][3] + 0.0f, m->m[2][3] + 0.0f);
+  iris_vec3 eye = plus_zero(iris_v3(m->m[0][3], m->m[1][3], m->m[2][3]));
   iris_vec3 back = iris_v3(m->m[0][2], m->m[1][2], m->m[2][2]);
-  iris_vec3 target = iris_sub(eye, back);
-  target = iris_v3(target.x + 0.0f, target.y + 0.0f, target.z + 0.0f);
+  float scale = fmaxf(1.0f, iris_max3(iris_v3(fabsf(eye.x), fabsf(eye.y), fabsf(eye.z))));
+  float ahead[5];
+  int n = 0;
+  float e[3], b[3];
+  iris_v3_store(eye, e);
+  iris_v3_store(back, b);
+  for (int axis = 0; axis < 3; axis++)
+    if (fabsf(b[axis]) > 1e-6f && e[axis] / b[axis] > 0.0f) ahead[n++] = e[axis] / b[axis];
+  float bb = iris_dot(back, back);
+  if (bb > 0.0f && iris_dot(eye, back) / bb > 0.0f) ahead[n++] = iris_dot(eye, back) / bb;
+  ahead[n++] = 1.0f;
   iris_vec3 ups[3] = {iris_v3(0, 1, 0), iris_v3(0, 0, 1),
-                      iris_v3(m->m[0][1] + 0.0f, m->m[1][1] + 0.0f, m->m[2][1] + 0.0f)};
-  for (int u = 0; u < 3; u++) {
-    iris_mat4 r = iris_mat4_look_at(eye, target, ups[u]);
-    if (floats_equal(&r.m[0][0], &m->m[0][0], 16)) {
-      float e[3], t[3], up[3];
-      iris_v3_store(eye, e);
+                      plus_zero(iris_v3(m->m[0][1], m->m[1][1], m->m[2][1]))};
+  for (int k = 0; k < 2 * n; k++) {
+    iris_vec3 target = plus_zero(iris_madd(eye, back, -ahead[k / 2]));
+    if (k % 2 == 0) target = snap(target, scale);
+    if (target.x == eye.x && target.y == eye.y && target.z == eye.z) continue;
+    for (int u = 0; u < 3; u++) {
+      iris_mat4 r = iris_mat4_look_at(eye, target, ups[u]);
+      if (!floats_equal(&r.m[0][0], &m->m[0][0], 16)) continue;
+      float t[3], up[3];
       iris_v3_store(target, t);
       iris_v3_store(ups[u], up);
       add_floats(o, "position", e, 3);
