@@ -87,6 +87,7 @@ typedef struct iris_integrator {
   int max_depth;      /* Cycles' bounces: 0 = direct light only, B = B+1 surface hits */
   int rr_depth;       /* Russian roulette from this bounce on (default 3) */
   iris_direction_sampler guide; /* used by the guided methods; sample == NULL: BSDF */
+  iris_material default_material; /* for meshes with material -1 (diffuse 0.8) */
 } iris_integrator;
 
 /* Per-thread counters (summed after the render; integer sums do not depend on
@@ -113,6 +114,11 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
  * guided methods. False ends the path. */
 bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shading_point *sp,
                                       iris_sampler *rng, iris_direction_sample *out);
+/* BSDF sampling alone (what the non-guided methods use; guides mix it in). */
+bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
+                                 iris_direction_sample *out);
+float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi);
+
 /* THE density of that choice for a given world direction (for MIS weights of
  * light samples and of emitters hit by the path). */
 float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shading_point *sp,

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "renderer/accel.h"
+#include "renderer/sampling.h"
 #include "renderer/texture.h"
 #include "scene/scene.h"
 
@@ -48,7 +49,7 @@ typedef struct iris_lights {
   const iris_textures *textures;
   iris_light_entry *entries;
   size_t count;
-  float *cdf;             /* count + 1 entries, cdf[0] = 0, cdf[count] = 1 */
+  iris_distrib1d select;  /* over entries, in proportion to power */
   uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
   int32_t environment;    /* entry index of the environment, or -1 */
   iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */

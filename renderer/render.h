@@ -31,6 +31,7 @@ typedef struct iris_guide_setup {
   const iris_integrator *integrator; /* for iris_integrator_shade */
   uint64_t seed;
   int threads;
+  const void *options; /* the guide's own options (iris_render_params.guide_options) */
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;
@@ -43,12 +44,12 @@ typedef struct iris_guide_provider {
 
 typedef struct iris_render_params {
   int width, height;        /* <= 0: derive (camera.h) */
-  int spp;                  /* samples per pixel (used when time_budget <= 0) */
+  int spp;                  /* samples per pixel (used when time_budget <= 0); 0: scene or 64 */
   double time_budget;       /* > 0: whole passes until this many seconds */
   uint64_t seed;
   int threads;              /* <= 0: all cores */
-  iris_method method;
-  int max_depth;            /* Cycles' bounce count */
+  iris_method method;       /* IRIS_METHOD_COUNT: the scene's, else mis */
+  int max_depth;            /* Cycles' bounce count; < 0: the scene's, else 64 */
   int rr_depth;             /* first bounce with Russian roulette */
   const char *camera_name;  /* NULL: the scene's first camera */
   /* Set asynchronously (e.g. by a signal handler) to stop after the current pass. */
@@ -57,11 +58,14 @@ typedef struct iris_render_params {
   void (*progress)(void *ctx, int spp_done, int spp_total, double elapsed, double eta);
   void *progress_ctx;
   const iris_guide_provider *guide; /* needed by the guided methods */
+  const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
 } iris_render_params;
 
-/* Defaults: 64 spp, seed 0, all cores, mis, max depth 64, RR from bounce 3. */
+/* Defaults: everything unset (taken from the scene, else 64 spp, mis, max
+ * depth 64), seed 0, all cores, Russian roulette from bounce 3. */
 iris_render_params iris_render_params_default(void);
-/* Fills unset params (spp, max depth, method) from the scene's render settings. */
+/* Fills unset params (spp, max depth, method, seed) from the scene's render
+ * settings and then from the defaults. */
 void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scene);
 
 typedef struct iris_render_result {

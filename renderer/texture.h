@@ -27,6 +27,7 @@ typedef struct iris_texture_image {
 typedef struct iris_textures {
   iris_texture_image *images; /* one per scene texture */
   size_t count;
+  float srgb_table[256]; /* 8-bit sRGB -> linear */
 } iris_textures;
 
 /* Decodes every texture of the scene (a texture that cannot be decoded is an error). */

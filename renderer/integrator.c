@@ -1,0 +1,220 @@
+/* The path tracer; see integrator.h and docs/rendering.md. */
+#include "renderer/integrator.h"
+
+#include <string.h>
+
+static const char *const METHOD_NAMES[IRIS_METHOD_COUNT] = {"bsdf", "nee", "mis", "guided",
+                                                             "guided-nee"};
+
+const char *iris_method_name(iris_method method) {
+  return (unsigned)method < IRIS_METHOD_COUNT ? METHOD_NAMES[method] : "unknown";
+}
+
+bool iris_method_parse(const char *name, iris_method *out) {
+  for (int i = 0; i < IRIS_METHOD_COUNT; i++)
+    if (strcmp(name, METHOD_NAMES[i]) == 0) {
+      *out = (iris_method)i;
+      return true;
+    }
+  return false;
+}
+
+bool iris_method_uses_nee(iris_method m) {
+  return m == IRIS_METHOD_NEE || m == IRIS_METHOD_MIS || m == IRIS_METHOD_GUIDED_NEE;
+}
+bool iris_method_uses_guiding(iris_method m) {
+  return m == IRIS_METHOD_GUIDED || m == IRIS_METHOD_GUIDED_NEE;
+}
+/* Methods that weight emitters hit by sampled directions against light sampling. */
+static bool method_uses_mis(iris_method m) {
+  return m == IRIS_METHOD_MIS || m == IRIS_METHOD_GUIDED_NEE;
+}
+
+iris_integrator iris_integrator_default(const iris_scene *scene, const iris_accel *accel,
+                                        const iris_lights *lights, const iris_textures *textures) {
+  iris_integrator it;
+  memset(&it, 0, sizeof it);
+  it.scene = scene;
+  it.accel = accel;
+  it.lights = lights;
+  it.textures = textures;
+  it.method = IRIS_METHOD_MIS;
+  it.max_depth = IRIS_DEFAULT_MAX_DEPTH;
+  it.rr_depth = IRIS_DEFAULT_RR_DEPTH;
+  it.default_material = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  return it;
+}
+
+void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
+                           int depth, iris_shading_point *sp) {
+  const iris_material *m = si->material >= 0 && (size_t)si->material < it->scene->material_count
+                               ? &it->scene->materials[si->material]
+                               : &it->default_material;
+  iris_vec3 color = iris_mul(iris_v3_load(m->color), si->color);
+  if (m->color_texture >= 0) {
+    float t[4];
+    iris_texture_lookup(it->textures, m->color_texture, si->uv[0], si->uv[1], true, t);
+    color = iris_mul(color, iris_v3(t[0], t[1], t[2]));
+  }
+  float roughness = m->roughness, metallic = m->metallic;
+  if (m->type == IRIS_MATERIAL_GLTF && m->metallic_roughness_texture >= 0) {
+    float t[4];
+    iris_texture_lookup(it->textures, m->metallic_roughness_texture, si->uv[0], si->uv[1], false, t);
+    roughness *= t[1];
+    metallic *= t[2];
+  }
+  sp->si = *si;
+  sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
+  sp->lobes = iris_bsdf_lobes(&sp->bsdf);
+  sp->delta = iris_bsdf_is_delta(&sp->bsdf);
+  sp->depth = depth;
+  sp->wo = wo;
+  /* Two-sided shading for everything that does not transmit: put both normals
+   * on wo's side. Transmissive BSDFs keep the front (outward) normal, so that
+   * wo.z < 0 means "inside". */
+  if (!(sp->lobes & IRIS_LOBE_TRANSMISSION) && iris_dot(wo, si->ng) < 0.0f) {
+    sp->si.ng = iris_neg(si->ng);
+    sp->si.ns = iris_neg(si->ns);
+  }
+  sp->frame = iris_frame_from_normal(sp->si.ns);
+  sp->wo_local = iris_frame_to_local(&sp->frame, wo);
+}
+
+/* A direction that leaves a non-transmissive surface below its geometric
+ * plane would reflect through the surface (shading normals): both sampling
+ * strategies reject it alike, so they estimate the same integral. */
+static bool direction_allowed(const iris_shading_point *sp, iris_vec3 wi) {
+  if (sp->lobes & IRIS_LOBE_TRANSMISSION) return true;
+  return iris_dot(wi, sp->si.ng) > 0.0f;
+}
+
+bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
+                                 iris_direction_sample *out) {
+  float u_lobe = iris_sampler_next(rng);
+  float u0 = iris_sampler_next(rng);
+  float u1 = iris_sampler_next(rng);
+  struct iris_bsdf_sample bs;
+  if (!iris_bsdf_sample(&sp->bsdf, sp->wo_local, u_lobe, u0, u1, &bs)) return false;
+  if (!(bs.pdf > 0.0f)) return false;
+  out->wi = iris_normalize(iris_frame_to_world(&sp->frame, bs.wi));
+  out->f = bs.f;
+  out->pdf = bs.pdf;
+  out->lobe = bs.lobe;
+  out->delta = (bs.lobe & IRIS_LOBE_DELTA) != 0;
+  return true;
+}
+
+float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi) {
+  return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
+}
+
+bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shading_point *sp,
+                                      iris_sampler *rng, iris_direction_sample *out) {
+  if (iris_method_uses_guiding(it->method) && it->guide.sample)
+    return it->guide.sample(it->guide.ctx, sp, rng, out);
+  return iris_integrator_sample_bsdf(sp, rng, out);
+}
+
+float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shading_point *sp,
+                                    iris_vec3 wi) {
+  if (iris_method_uses_guiding(it->method) && it->guide.pdf)
+    return it->guide.pdf(it->guide.ctx, sp, wi);
+  return iris_integrator_bsdf_pdf(sp, wi);
+}
+
+/* Power heuristic (beta = 2), Veach 1997 eq. 9.13, for one sample of each. */
+static float power_heuristic(float pa, float pb) {
+  if (!(pa > 0.0f)) return 0.0f;
+  if (!isfinite(pa)) return 1.0f;
+  float a = pa * pa, b = pb * pb;
+  return a / (a + b);
+}
+
+/* Direct light at a shading point by light sampling (NEE), MIS-weighted
+ * against the path's direction sampler when `mis`. */
+static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
+                               iris_sampler *rng, bool mis, iris_path_stats *stats) {
+  float u_sel = iris_sampler_next(rng);
+  float u0 = iris_sampler_next(rng);
+  float u1 = iris_sampler_next(rng);
+  iris_light_sample ls;
+  if (!iris_lights_sample(it->lights, sp->si.p, u_sel, u0, u1, &ls)) return iris_v3(0, 0, 0);
+  if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
+  iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
+  iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
+  if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return iris_v3(0, 0, 0);
+  iris_ray shadow;
+  if (isfinite(ls.dist) && !ls.delta) {
+    shadow = iris_spawn_ray_to(sp->si.p, sp->si.ng, ls.p, ls.n);
+  } else {
+    shadow = iris_spawn_ray(&sp->si, ls.wi);
+    if (isfinite(ls.dist)) shadow.tmax = ls.dist * (1.0f - 1e-5f);
+  }
+  stats->shadow_rays++;
+  if (iris_accel_occluded(it->accel, &shadow)) return iris_v3(0, 0, 0);
+  float w = 1.0f;
+  if (mis && !ls.delta) w = power_heuristic(ls.pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
+  return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / ls.pdf);
+}
+
+iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                                   iris_path_stats *stats) {
+  const bool nee = iris_method_uses_nee(it->method) && it->lights->count > 0;
+  const bool mis = nee && method_uses_mis(it->method);
+  iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
+  bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
+  float prev_pdf = 0.0f;
+  iris_vec3 prev_p = ray.o;
+  stats->paths++;
+  for (int bounce = 0;; bounce++) {
+    iris_hit hit;
+    stats->rays++;
+    if (!iris_accel_intersect(it->accel, &ray, &hit)) {
+      iris_vec3 le = iris_lights_environment(it->lights, ray.d);
+      if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
+        float w = 1.0f;
+        if (!prev_delta && nee)
+          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, ray.d)) : 0.0f;
+        L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+      }
+      break;
+    }
+    iris_interaction si;
+    iris_accel_interaction(it->accel, ray.d, &hit, &si);
+    iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
+    if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
+      float w = 1.0f;
+      if (!prev_delta && nee)
+        w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_triangle(it->lights, prev_p, &si)) : 0.0f;
+      L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+    }
+    if (bounce > it->max_depth) break;
+
+    iris_shading_point sp;
+    iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
+    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, rng, mis, stats)));
+
+    iris_direction_sample ds;
+    if (!iris_integrator_sample_direction(it, &sp, rng, &ds)) break;
+    if (!direction_allowed(&sp, ds.wi)) break;
+    float cos_i = fabsf(iris_dot(ds.wi, sp.si.ns));
+    beta = iris_mul(beta, iris_scale(ds.f, cos_i / ds.pdf));
+    if (!iris_isfinite3(beta) || iris_max3(beta) <= 0.0f) break;
+    prev_delta = ds.delta;
+    prev_pdf = ds.pdf;
+    prev_p = sp.si.p;
+    ray = iris_spawn_ray(&sp.si, ds.wi);
+
+    /* Russian roulette (docs/rendering.md): survive with q = min(0.95, max beta). */
+    if (bounce + 1 >= it->rr_depth) {
+      float q = fminf(0.95f, iris_max3(beta));
+      if (iris_sampler_next(rng) >= q) break;
+      beta = iris_scale(beta, 1.0f / q);
+    }
+  }
+  if (!iris_isfinite3(L)) {
+    stats->nan_count++;
+    return iris_v3(0, 0, 0);
+  }
+  return L;
+}

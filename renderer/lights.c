@@ -1,0 +1,353 @@
+/* Light list, next-event sampling and photon emission; see lights.h. */
+#include "renderer/lights.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static float luminance(iris_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+static bool is_emissive(const iris_material *m) {
+  return m && (m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f);
+}
+
+static const iris_material *material_of(const iris_scene *scene, int32_t index) {
+  return index >= 0 && (size_t)index < scene->material_count ? &scene->materials[index] : NULL;
+}
+
+static float triangle_area(const iris_vec3 v[3]) {
+  return 0.5f * iris_length(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));
+}
+
+/* glTF KHR_lights_punctual spot attenuation (the specification's squared ramp). */
+static float spot_falloff(const iris_light *l, iris_vec3 travel) {
+  float cd = iris_dot(iris_v3_load(l->direction), travel);
+  float co = cosf(l->outer_cone), ci = cosf(l->inner_cone);
+  float scale = 1.0f / fmaxf(0.001f, ci - co);
+  float a = iris_clampf((cd - co) * scale, 0.0f, 1.0f);
+  return a * a;
+}
+
+iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
+                              const iris_textures *textures, iris_lights *out, iris_error *err) {
+  memset(out, 0, sizeof *out);
+  out->scene = scene;
+  out->accel = accel;
+  out->textures = textures;
+  out->environment = -1;
+  iris_vec3 lo, hi;
+  if (iris_accel_bounds(accel, &lo, &hi)) {
+    out->center = iris_scale(iris_add(lo, hi), 0.5f);
+    out->radius = fmaxf(0.5f * iris_length(iris_sub(hi, lo)), 1e-3f);
+  } else {
+    out->center = iris_v3(0, 0, 0);
+    out->radius = 1.0f;
+  }
+  uint32_t tri_count = iris_accel_triangle_count(accel);
+  size_t emissive = 0;
+  for (uint32_t t = 0; t < tri_count; t++)
+    if (is_emissive(material_of(scene, iris_accel_triangle_material(accel, t)))) emissive++;
+  bool env = scene->has_environment &&
+             (scene->environment[0] > 0 || scene->environment[1] > 0 || scene->environment[2] > 0);
+  size_t cap = emissive + scene->light_count + (env ? 1 : 0);
+  out->light_of_prim = malloc(sizeof(uint32_t) * (tri_count ? tri_count : 1));
+  out->entries = calloc(cap ? cap : 1, sizeof *out->entries);
+  if (!out->light_of_prim || !out->entries) {
+    iris_lights_destroy(out);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+  }
+  size_t n = 0;
+  for (uint32_t t = 0; t < tri_count; t++) {
+    out->light_of_prim[t] = UINT32_MAX;
+    const iris_material *m = material_of(scene, iris_accel_triangle_material(accel, t));
+    if (!is_emissive(m)) continue;
+    iris_vec3 v[3];
+    iris_accel_triangle(accel, t, v);
+    float area = triangle_area(v);
+    if (!(area > 0.0f) || !isfinite(area)) continue; /* degenerate: never sampled, never hit */
+    iris_light_entry *e = &out->entries[n];
+    e->kind = IRIS_LIGHT_KIND_TRIANGLE;
+    e->prim = t;
+    e->area = area;
+    e->two_sided = m->emission_two_sided;
+    e->radiance = iris_v3_load(m->emission);
+    e->power = luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
+    out->light_of_prim[t] = (uint32_t)n;
+    n++;
+  }
+  for (size_t i = 0; i < scene->light_count; i++) {
+    const iris_light *l = &scene->lights[i];
+    iris_vec3 c = iris_scale(iris_v3_load(l->color), l->intensity);
+    if (!(luminance(c) > 0.0f)) continue;
+    iris_light_entry *e = &out->entries[n];
+    e->prim = (uint32_t)i;
+    e->radiance = c;
+    switch (l->type) {
+      case IRIS_LIGHT_POINT:
+        e->kind = IRIS_LIGHT_KIND_POINT;
+        e->power = luminance(c) * 4.0f * IRIS_PI;
+        break;
+      case IRIS_LIGHT_SPOT:
+        e->kind = IRIS_LIGHT_KIND_SPOT;
+        e->power = luminance(c) * 2.0f * IRIS_PI *
+                   (1.0f - cosf(0.5f * (l->inner_cone + l->outer_cone)));
+        break;
+      case IRIS_LIGHT_DIRECTIONAL:
+      default:
+        e->kind = IRIS_LIGHT_KIND_DIRECTIONAL;
+        e->power = luminance(c) * IRIS_PI * out->radius * out->radius;
+        break;
+    }
+    n++;
+  }
+  if (env) {
+    iris_light_entry *e = &out->entries[n];
+    e->kind = IRIS_LIGHT_KIND_ENVIRONMENT;
+    e->radiance = iris_v3_load(scene->environment);
+    /* Power of a constant sky through the scene's bounding sphere (pbrt-v4). */
+    e->power = luminance(e->radiance) * 4.0f * IRIS_PI * IRIS_PI * out->radius * out->radius;
+    out->environment = (int32_t)n;
+    n++;
+  }
+  out->count = n;
+  if (n > 0) {
+    float *w = malloc(sizeof(float) * n);
+    if (!w) {
+      iris_lights_destroy(out);
+      return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+    }
+    double total = 0.0;
+    for (size_t i = 0; i < n; i++) {
+      w[i] = out->entries[i].power;
+      total += w[i];
+    }
+    out->total_power = total;
+    iris_status st = iris_distrib1d_create(&out->select, w, n, err);
+    free(w);
+    if (st != IRIS_OK) {
+      iris_lights_destroy(out);
+      return st;
+    }
+  }
+  return IRIS_OK;
+}
+
+void iris_lights_destroy(iris_lights *lights) {
+  if (!lights) return;
+  free(lights->entries);
+  free(lights->light_of_prim);
+  iris_distrib1d_destroy(&lights->select);
+  lights->entries = NULL;
+  lights->light_of_prim = NULL;
+  lights->count = 0;
+}
+
+float iris_lights_select_pmf(const iris_lights *lights, uint32_t index) {
+  if (index >= lights->count) return 0.0f;
+  return iris_distrib1d_pmf(&lights->select, index);
+}
+
+uint32_t iris_lights_select(const iris_lights *lights, float u, float *pmf) {
+  if (lights->count == 0) {
+    *pmf = 0.0f;
+    return 0;
+  }
+  return (uint32_t)iris_distrib1d_sample(&lights->select, u, pmf, NULL);
+}
+
+static iris_vec3 surface_emission(const iris_lights *lights, const iris_material *m,
+                                  const iris_interaction *si) {
+  iris_vec3 le = iris_v3_load(m->emission);
+  if (m->emission_texture >= 0) {
+    float t[4];
+    iris_texture_lookup(lights->textures, m->emission_texture, si->uv[0], si->uv[1], true, t);
+    le = iris_mul(le, iris_v3(t[0], t[1], t[2]));
+  }
+  return le;
+}
+
+iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction *si, iris_vec3 d) {
+  const iris_material *m = material_of(lights->scene, si->material);
+  if (!is_emissive(m)) return iris_v3(0, 0, 0);
+  if (!m->emission_two_sided && iris_dot(d, si->ng) >= 0.0f) return iris_v3(0, 0, 0);
+  return surface_emission(lights, m, si);
+}
+
+bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
+                        float u1, iris_light_sample *s) {
+  if (lights->count == 0) return false;
+  float pmf;
+  uint32_t i = iris_lights_select(lights, u_select, &pmf);
+  if (!(pmf > 0.0f)) return false;
+  const iris_light_entry *e = &lights->entries[i];
+  s->light = i;
+  s->delta = e->kind != IRIS_LIGHT_KIND_TRIANGLE && e->kind != IRIS_LIGHT_KIND_ENVIRONMENT;
+  switch (e->kind) {
+    case IRIS_LIGHT_KIND_TRIANGLE: {
+      float b0, b1;
+      iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+      iris_interaction si;
+      iris_accel_surface_at(lights->accel, e->prim, b1, 1.0f - b0 - b1, &si);
+      iris_vec3 to = iris_sub(si.p, ref);
+      float d2 = iris_dot(to, to);
+      if (!(d2 > 0.0f)) return false;
+      float dist = sqrtf(d2);
+      iris_vec3 wi = iris_scale(to, 1.0f / dist);
+      float cos_l = -iris_dot(wi, si.ng);
+      if (!e->two_sided && cos_l <= 0.0f) return false;
+      cos_l = fabsf(cos_l);
+      if (!(cos_l > 0.0f)) return false;
+      const iris_material *m = material_of(lights->scene, si.material);
+      s->wi = wi;
+      s->dist = dist;
+      s->p = si.p;
+      s->n = si.ng;
+      s->L = surface_emission(lights, m, &si);
+      s->pdf = pmf * d2 / (cos_l * e->area);
+      return isfinite(s->pdf) && s->pdf > 0.0f;
+    }
+    case IRIS_LIGHT_KIND_POINT:
+    case IRIS_LIGHT_KIND_SPOT: {
+      const iris_light *l = &lights->scene->lights[e->prim];
+      iris_vec3 p = iris_v3_load(l->position);
+      iris_vec3 to = iris_sub(p, ref);
+      float d2 = iris_dot(to, to);
+      if (!(d2 > 0.0f)) return false;
+      float dist = sqrtf(d2);
+      s->wi = iris_scale(to, 1.0f / dist);
+      s->dist = dist;
+      s->p = p;
+      s->n = iris_neg(s->wi);
+      float fall = e->kind == IRIS_LIGHT_KIND_SPOT ? spot_falloff(l, iris_neg(s->wi)) : 1.0f;
+      if (!(fall > 0.0f)) return false;
+      s->L = iris_scale(e->radiance, fall / d2);
+      s->pdf = pmf;
+      return true;
+    }
+    case IRIS_LIGHT_KIND_DIRECTIONAL: {
+      const iris_light *l = &lights->scene->lights[e->prim];
+      s->wi = iris_neg(iris_normalize(iris_v3_load(l->direction)));
+      s->dist = INFINITY;
+      s->p = iris_madd(ref, s->wi, 2.0f * lights->radius);
+      s->n = iris_neg(s->wi);
+      s->L = e->radiance;
+      s->pdf = pmf;
+      return true;
+    }
+    case IRIS_LIGHT_KIND_ENVIRONMENT:
+    default: {
+      s->wi = iris_sample_uniform_sphere(u0, u1);
+      s->dist = INFINITY;
+      s->p = iris_madd(ref, s->wi, 2.0f * lights->radius);
+      s->n = iris_neg(s->wi);
+      s->L = e->radiance;
+      s->pdf = pmf * iris_sample_uniform_sphere_pdf();
+      return true;
+    }
+  }
+}
+
+float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
+                               const iris_interaction *si) {
+  if (si->prim >= iris_accel_triangle_count(lights->accel)) return 0.0f;
+  uint32_t i = lights->light_of_prim[si->prim];
+  if (i == UINT32_MAX) return 0.0f;
+  const iris_light_entry *e = &lights->entries[i];
+  iris_vec3 to = iris_sub(si->p, ref);
+  float d2 = iris_dot(to, to);
+  float cos_l = fabsf(iris_dot(to, si->ng)) / sqrtf(d2);
+  if (!(cos_l > 0.0f) || !(d2 > 0.0f)) return 0.0f;
+  return iris_lights_select_pmf(lights, i) * d2 / (cos_l * e->area);
+}
+
+iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {
+  (void)d;
+  if (lights->environment < 0) return iris_v3(0, 0, 0);
+  return lights->entries[lights->environment].radiance;
+}
+
+float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 d) {
+  (void)d;
+  if (lights->environment < 0) return 0.0f;
+  return iris_lights_select_pmf(lights, (uint32_t)lights->environment) *
+         iris_sample_uniform_sphere_pdf();
+}
+
+bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
+                                 float u2, float u3, iris_photon_emission *e) {
+  if (lights->count == 0) return false;
+  float pmf, u_side;
+  uint32_t i = (uint32_t)iris_distrib1d_sample(&lights->select, u_select, &pmf, &u_side);
+  if (!(pmf > 0.0f)) return false;
+  const iris_light_entry *le = &lights->entries[i];
+  memset(e, 0, sizeof *e);
+  e->light = i;
+  e->prim = le->prim;
+  switch (le->kind) {
+    case IRIS_LIGHT_KIND_TRIANGLE: {
+      float b0, b1;
+      iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+      iris_interaction si;
+      iris_accel_surface_at(lights->accel, le->prim, b1, 1.0f - b0 - b1, &si);
+      float p_side = 1.0f;
+      iris_vec3 n = si.ng;
+      if (le->two_sided) {
+        p_side = 0.5f;
+        if (u_side >= 0.5f) n = iris_neg(n);
+      }
+      iris_frame f = iris_frame_from_normal(n);
+      iris_vec3 local = iris_sample_cosine_hemisphere(u2, u3);
+      e->dir = iris_normalize(iris_frame_to_world(&f, local));
+      e->n = n;
+      e->p = iris_offset_origin(si.p, si.ng, e->dir);
+      e->pdf_pos = 1.0f / le->area;
+      e->pdf_dir = p_side * iris_sample_cosine_hemisphere_pdf(local.z);
+      /* Le cos / (pmf pdf_pos pdf_dir) = Le pi area / (pmf p_side). */
+      iris_vec3 L = surface_emission(lights, material_of(lights->scene, si.material), &si);
+      e->power = iris_scale(L, IRIS_PI * le->area / (pmf * p_side));
+      return true;
+    }
+    case IRIS_LIGHT_KIND_POINT:
+    case IRIS_LIGHT_KIND_SPOT: {
+      const iris_light *l = &lights->scene->lights[le->prim];
+      e->p = iris_v3_load(l->position);
+      e->pdf_pos = 1.0f;
+      if (le->kind == IRIS_LIGHT_KIND_SPOT) {
+        float cos_max = cosf(l->outer_cone);
+        iris_frame f = iris_frame_from_normal(iris_normalize(iris_v3_load(l->direction)));
+        iris_vec3 local = iris_sample_uniform_cone(u2, u3, cos_max);
+        e->dir = iris_normalize(iris_frame_to_world(&f, local));
+        e->pdf_dir = iris_sample_uniform_cone_pdf(local.z, cos_max);
+        if (!(e->pdf_dir > 0.0f)) return false;
+        e->power = iris_scale(le->radiance, spot_falloff(l, e->dir) / (pmf * e->pdf_dir));
+      } else {
+        e->dir = iris_sample_uniform_sphere(u2, u3);
+        e->pdf_dir = iris_sample_uniform_sphere_pdf();
+        e->power = iris_scale(le->radiance, 1.0f / (pmf * e->pdf_dir));
+      }
+      e->n = e->dir;
+      return true;
+    }
+    case IRIS_LIGHT_KIND_DIRECTIONAL:
+    case IRIS_LIGHT_KIND_ENVIRONMENT:
+    default: {
+      float r = lights->radius;
+      if (le->kind == IRIS_LIGHT_KIND_DIRECTIONAL) {
+        e->dir = iris_normalize(iris_v3_load(lights->scene->lights[le->prim].direction));
+        e->pdf_dir = 1.0f;
+      } else {
+        e->dir = iris_sample_uniform_sphere(u2, u3);
+        e->pdf_dir = iris_sample_uniform_sphere_pdf();
+      }
+      /* A disk of the bounding sphere's radius, facing along dir, behind the scene. */
+      iris_frame f = iris_frame_from_normal(e->dir);
+      float x, y;
+      iris_sample_concentric_disk(u0, u1, &x, &y);
+      e->p = iris_add(iris_madd(lights->center, e->dir, -r),
+                      iris_add(iris_scale(f.s, x * r), iris_scale(f.t, y * r)));
+      e->n = e->dir;
+      e->pdf_pos = 1.0f / (IRIS_PI * r * r);
+      e->power = iris_scale(le->radiance, 1.0f / (pmf * e->pdf_pos * e->pdf_dir));
+      return true;
+    }
+  }
+}

@@ -1,0 +1,223 @@
+/* The render loop: set-up, passes of samples over all pixels, output files. */
+#include "renderer/render.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/image.h"
+#include "core/parallel.h"
+
+#define TILE 8
+/* Aim for passes of about this many paths: short enough to stop quickly on a
+ * signal or a time budget, long enough that thread start-up does not show. */
+#define PASS_PATHS (1u << 18)
+
+iris_render_params iris_render_params_default(void) {
+  iris_render_params p;
+  memset(&p, 0, sizeof p);
+  p.spp = 0;
+  p.method = IRIS_METHOD_COUNT;
+  p.max_depth = -1;
+  p.rr_depth = IRIS_DEFAULT_RR_DEPTH;
+  p.threads = 0;
+  return p;
+}
+
+void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scene) {
+  const iris_render_settings *rs = &scene->render;
+  if (p->spp <= 0) p->spp = rs->spp > 0 ? rs->spp : IRIS_RENDER_DEFAULT_SPP;
+  if (p->max_depth < 0) p->max_depth = rs->max_depth >= 0 ? rs->max_depth : IRIS_DEFAULT_MAX_DEPTH;
+  if (p->method == IRIS_METHOD_COUNT) {
+    iris_method m;
+    p->method = rs->method[0] && iris_method_parse(rs->method, &m) ? m : IRIS_METHOD_MIS;
+  }
+}
+
+typedef struct pass_ctx {
+  const iris_integrator *it;
+  const iris_pinhole *cam;
+  iris_film *film;
+  uint64_t seed;
+  int s0, s1; /* sample indices of this pass */
+  int tiles_x;
+  iris_path_stats *stats; /* one per thread */
+} pass_ctx;
+
+static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  pass_ctx *c = (pass_ctx *)vctx;
+  iris_path_stats *st = &c->stats[thread];
+  const int w = c->film->width, h = c->film->height;
+  for (uint64_t t = begin; t < end; t++) {
+    int tx = (int)(t % (uint64_t)c->tiles_x) * TILE, ty = (int)(t / (uint64_t)c->tiles_x) * TILE;
+    for (int y = ty; y < ty + TILE && y < h; y++)
+      for (int x = tx; x < tx + TILE && x < w; x++) {
+        uint64_t pixel = (uint64_t)y * (uint64_t)w + (uint64_t)x;
+        for (int s = c->s0; s < c->s1; s++) {
+          iris_sampler rng = iris_sampler_start(c->seed, pixel, (uint64_t)s);
+          float fx = (float)x + iris_sampler_next(&rng);
+          float fy = (float)y + iris_sampler_next(&rng);
+          iris_ray ray = iris_pinhole_ray(c->cam, fx, fy);
+          iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, st);
+          iris_film_add(c->film, x, y, L);
+        }
+      }
+  }
+}
+
+iris_status iris_render(const iris_scene *scene, const iris_render_params *params_in,
+                        iris_render_result *res, iris_error *err) {
+  memset(res, 0, sizeof *res);
+  iris_render_params p = *params_in;
+  iris_render_params_from_scene(&p, scene);
+  if (p.threads <= 0) p.threads = iris_parallel_default_threads();
+  if (iris_method_uses_guiding(p.method) && (!p.guide || !p.guide->build))
+    return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
+                          "method '%s' needs the guiding module, which is not linked in",
+                          iris_method_name(p.method));
+  double t0 = iris_time_now();
+  iris_status st = iris_pinhole_setup(scene, p.camera_name, p.width, p.height, &res->camera, err);
+  if (st != IRIS_OK) return st;
+  iris_accel *accel = NULL;
+  iris_textures textures;
+  iris_lights lights;
+  memset(&textures, 0, sizeof textures);
+  memset(&lights, 0, sizeof lights);
+  void *guide_state = NULL;
+  iris_path_stats *stats = NULL;
+  st = iris_accel_build(scene, &accel, err);
+  if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
+  if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
+  iris_integrator it;
+  if (st == IRIS_OK) {
+    it = iris_integrator_default(scene, accel, &lights, &textures);
+    it.method = p.method;
+    it.max_depth = p.max_depth;
+    it.rr_depth = p.rr_depth;
+  }
+  if (st == IRIS_OK && iris_method_uses_guiding(p.method)) {
+    iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
+                           p.guide_options};
+    st = p.guide->build(&gs, &it.guide, &guide_state, err);
+  }
+  if (st == IRIS_OK) st = iris_film_create(&res->film, res->camera.width, res->camera.height, err);
+  if (st == IRIS_OK) {
+    stats = calloc((size_t)p.threads, sizeof *stats);
+    if (!stats) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
+  }
+  res->method = p.method;
+  res->seed = p.seed;
+  res->threads = p.threads;
+  double t1 = iris_time_now();
+  res->setup_seconds = t1 - t0;
+
+  if (st == IRIS_OK) {
+    const uint64_t pixels = (uint64_t)res->camera.width * (uint64_t)res->camera.height;
+    pass_ctx c = {&it, &res->camera, &res->film, p.seed, 0, 0, 0, stats};
+    c.tiles_x = (res->camera.width + TILE - 1) / TILE;
+    int tiles_y = (res->camera.height + TILE - 1) / TILE;
+    uint64_t tiles = (uint64_t)c.tiles_x * (uint64_t)tiles_y;
+    int pass_spp = (int)((PASS_PATHS + pixels - 1) / pixels);
+    if (pass_spp < 1) pass_spp = 1;
+    const bool timed = p.time_budget > 0.0;
+    const int target = timed ? 0 : p.spp;
+    int done = 0;
+    double sec_per_spp = 0.0;
+    for (;;) {
+      if (p.cancel && *p.cancel) {
+        res->interrupted = true;
+        break;
+      }
+      int n = pass_spp;
+      double elapsed = iris_time_now() - t1;
+      if (timed) {
+        if (done > 0) {
+          double left = p.time_budget - elapsed;
+          int fit = sec_per_spp > 0.0 ? (int)(left / sec_per_spp) : n;
+          if (fit < 1) break; /* the next whole pass would overrun the budget */
+          if (fit < n) n = fit;
+        } else {
+          n = 1; /* measure first */
+        }
+      } else {
+        if (done >= target) break;
+        if (n > target - done) n = target - done;
+      }
+      c.s0 = done;
+      c.s1 = done + n;
+      double tp = iris_time_now();
+      uint64_t grain = tiles / (uint64_t)(8 * p.threads) + 1;
+      if (grain > 4) grain = 4;
+      iris_parallel_for(tiles, grain, p.threads, render_tiles, &c);
+      double dt = iris_time_now() - tp;
+      done += n;
+      sec_per_spp = dt / n;
+      double now = iris_time_now() - t1;
+      if (p.progress) {
+        int total = timed ? done + (int)((p.time_budget - now) / (sec_per_spp > 0 ? sec_per_spp : 1)) : target;
+        if (total < done) total = done;
+        double eta = timed ? (p.time_budget - now > 0 ? p.time_budget - now : 0)
+                           : (target - done) * sec_per_spp;
+        p.progress(p.progress_ctx, done, total, now, eta);
+      }
+    }
+    res->spp = done;
+    res->seconds = iris_time_now() - t1;
+    for (int i = 0; i < p.threads; i++) {
+      res->stats.paths += stats[i].paths;
+      res->stats.rays += stats[i].rays;
+      res->stats.shadow_rays += stats[i].shadow_rays;
+      res->stats.nan_count += stats[i].nan_count;
+    }
+  }
+  free(stats);
+  if (guide_state && p.guide && p.guide->destroy) p.guide->destroy(guide_state);
+  iris_lights_destroy(&lights);
+  iris_textures_destroy(&textures);
+  iris_accel_destroy(accel);
+  if (st != IRIS_OK) iris_film_destroy(&res->film);
+  return st;
+}
+
+void iris_render_result_destroy(iris_render_result *r) {
+  if (r) iris_film_destroy(&r->film);
+}
+
+iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
+                                  const char *scene_name, bool variance, iris_error *err) {
+  iris_image img;
+  iris_status st = iris_film_to_image(&r->film, variance, &img, err);
+  if (st != IRIS_OK) return st;
+  iris_image_meta meta[12];
+  size_t n = 0;
+#define META(k, ...) \
+  do { \
+    snprintf(meta[n].key, sizeof meta[n].key, "iris:%s", k); \
+    snprintf(meta[n].value, sizeof meta[n].value, __VA_ARGS__); \
+    n++; \
+  } while (0)
+  META("version", "%s", IRIS_VERSION_STRING);
+  META("scene", "%s", scene_name ? scene_name : "");
+  META("method", "%s", iris_method_name(r->method));
+  META("spp", "%d", r->spp);
+  META("seed", "%llu", (unsigned long long)r->seed);
+  META("render_seconds", "%.3f", r->seconds);
+  META("interrupted", "%s", r->interrupted ? "true" : "false");
+  META("camera", "%s", r->camera.name);
+  META("threads", "%d", r->threads);
+  META("nan_count", "%llu", (unsigned long long)r->stats.nan_count);
+#undef META
+  st = iris_exr_write(path, &img, meta, n, err);
+  iris_image_destroy(&img);
+  return st;
+}
+
+iris_status iris_render_write_png(const iris_render_result *r, const char *path, float exposure,
+                                  iris_error *err) {
+  iris_image img;
+  iris_status st = iris_film_to_image(&r->film, false, &img, err);
+  if (st != IRIS_OK) return st;
+  st = iris_png_write(path, &img, 0, exposure, err);
+  iris_image_destroy(&img);
+  return st;
+}

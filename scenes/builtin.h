@@ -1,0 +1,40 @@
+/* Built-in scenes generated in code, with the published numbers (docs/rendering.md,
+ * "Built-in scenes"): `cornell-box` (Bitterli's Cornell box) and `veach-mis`
+ * (Veach's four-light multiple-importance-sampling scene). Also small analytic
+ * scenes for tests: `furnace-diffuse`, `furnace-glossy` (albedo-1 spheres under
+ * a uniform sky of radiance 1) and `inside-sphere` (a sphere of radiance 1 seen
+ * from inside). */
+#ifndef IRIS_SCENES_BUILTIN_H
+#define IRIS_SCENES_BUILTIN_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/error.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* NULL-terminated list of the built-in scene names. */
+const char *const *iris_builtin_names(void);
+bool iris_builtin_exists(const char *name);
+/* Creates the named scene (IRIS_ERR_USAGE for an unknown name). */
+iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *err);
+
+/* Appends a UV sphere with `segments` around and segments / 2 from pole to
+ * pole (vertices on the sphere, shared, smooth normals, outward winding) and
+ * an identity instance. Returns the mesh index or -1 when out of memory. */
+int32_t iris_builtin_add_sphere(iris_scene *scene, iris_vec3 center, float radius, int segments,
+                                int32_t material, const char *name);
+/* Appends the parallelogram c + s*a + t*b, (s, t) in [-1, 1]^2, split into
+ * n x n quads, and an identity instance; the front face is on the side of
+ * cross(a, b). */
+int32_t iris_builtin_add_quad(iris_scene *scene, iris_vec3 c, iris_vec3 a, iris_vec3 b, int n,
+                              int32_t material, const char *name);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
