@@ -608,11 +608,12 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     read_indices(d, ia, idx);
     for (size_t i = 0; i < ni; i++)
       if (idx[i] >= nv) {
-        free(idx);
         char iel[64];
         ELEMENT(iel, "accessor %d", p->indices);
-        return fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i],
-                    i, nv, el);
+        st = fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i,
+                  nv, el);
+        free(idx);
+        return st;
       }
   } else {
     for (size_t i = 0; i < ni; i++) idx[i] = (uint32_t)i;
