@@ -11,6 +11,7 @@
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/import.h"
+#include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 #include "tools/cli.h"
@@ -86,6 +87,7 @@ static bool output_dir_ok(const char *path) {
 
 int iris_cmd_render(int argc, char **argv) {
   iris_render_params p = iris_render_params_default();
+  iris_guiding_params gp = iris_guiding_params_default();
   const char *input = NULL, *out_exr = NULL, *out_png = NULL, *camera = NULL;
   bool variance = false, quiet = false, json = false, have_spp = false, have_seed = false;
   double exposure = 0.0;
@@ -157,6 +159,43 @@ int iris_cmd_render(int argc, char **argv) {
         p.width = (int)lv;
       else
         p.height = (int)lv;
+    } else if (strcmp(a, "--photons") == 0 || strcmp(a, "--caches") == 0) {
+      bool photons = strcmp(a, "--photons") == 0;
+      NEED_VALUE();
+      if (!iris_cli_parse_int(CMD, a, val, 1, 1L << 40, &lv)) return IRIS_EXIT_USAGE;
+      if (photons)
+        gp.photons = lv;
+      else
+        gp.caches = lv;
+    } else if (strcmp(a, "--cache-res") == 0 || strcmp(a, "--cache-k") == 0) {
+      bool res = strcmp(a, "--cache-res") == 0;
+      NEED_VALUE();
+      if (!iris_cli_parse_int(CMD, a, val, 1, res ? 256 : 1000000, &lv)) return IRIS_EXIT_USAGE;
+      if (res)
+        gp.cache_res = (int)lv;
+      else
+        gp.cache_k = (int)lv;
+    } else if (strcmp(a, "--pdf-floor") == 0 || strcmp(a, "--alpha-max") == 0 ||
+               strcmp(a, "--cos-min") == 0) {
+      NEED_VALUE();
+      bool cosmin = strcmp(a, "--cos-min") == 0;
+      if (!iris_cli_parse_float(CMD, a, val, cosmin ? -1.0 : 0.0, 1.0, &dv)) return IRIS_EXIT_USAGE;
+      if (strcmp(a, "--pdf-floor") == 0)
+        gp.pdf_floor = (float)dv;
+      else if (cosmin)
+        gp.cos_min = (float)dv;
+      else
+        gp.alpha_max = (float)dv;
+    } else if (strcmp(a, "--splat") == 0) {
+      NEED_VALUE();
+      if (strcmp(val, "nearest") == 0)
+        gp.splat = IRIS_SPLAT_NEAREST;
+      else if (strcmp(val, "bilinear") == 0)
+        gp.splat = IRIS_SPLAT_BILINEAR;
+      else
+        return iris_cli_usage_error(CMD, "unknown splat mode '%s' (nearest, bilinear)", val);
+    } else if (strcmp(a, "--force-guiding") == 0) {
+      gp.force = true;
     } else if (strcmp(a, "--camera") == 0) {
       NEED_VALUE();
       camera = val;
@@ -171,7 +210,7 @@ int iris_cmd_render(int argc, char **argv) {
       input = a;
     }
     if (val && (strcmp(a, "--variance") == 0 || strcmp(a, "--quiet") == 0 ||
-                strcmp(a, "--json") == 0))
+                strcmp(a, "--json") == 0 || strcmp(a, "--force-guiding") == 0))
       return iris_cli_usage_error(CMD, "option %s takes no value", a);
 #undef NEED_VALUE
   }
@@ -187,9 +226,10 @@ int iris_cmd_render(int argc, char **argv) {
   if (variance && !out_exr) return iris_cli_usage_error(CMD, "--variance needs -o OUT.exr");
   if ((out_exr && !output_dir_ok(out_exr)) || (out_png && !output_dir_ok(out_png)))
     return iris_cli_usage_error(CMD, "the folder of the output file does not exist");
-  if (iris_method_uses_guiding(p.method) && !p.guide)
-    return iris_cli_usage_error(CMD, "method '%s' is not available in this build (guiding not linked)",
-                                iris_method_name(p.method));
+  if (iris_method_uses_guiding(p.method)) {
+    p.guide = &iris_guiding_provider;
+    p.guide_options = &gp;
+  }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
   iris_error err;
