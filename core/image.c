@@ -98,9 +98,16 @@ typedef struct exr_stream {
   char message[256];
 } exr_stream;
 
+/* OpenEXRCore calls the error handler with the context's lock held, so the
+ * handler cannot ask the context for its user data; the stream in use is
+ * found through this per-thread pointer instead (set for the duration of one
+ * read or write call). */
+static _Thread_local exr_stream *exr_current_stream;
+
 static void exr_on_error(exr_const_context_t ctxt, exr_result_t code, const char *msg) {
-  exr_stream *s = NULL;
-  if (ctxt && exr_get_user_data(ctxt, (void **)&s) == EXR_ERR_SUCCESS && s && !s->message[0])
+  (void)ctxt;
+  exr_stream *s = exr_current_stream;
+  if (s && !s->message[0])
     snprintf(s->message, sizeof s->message, "%s", msg ? msg : exr_get_default_error_message(code));
 }
 
@@ -203,6 +210,7 @@ iris_status iris_exr_write(const char *path, const iris_image *img, const iris_i
   if (st != IRIS_OK) return st;
 
   exr_stream s = {.fd = fileno(af.fp), .size = 0, .message = ""};
+  exr_current_stream = &s;
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = exr_on_error;
   init.user_data = &s;
@@ -217,16 +225,22 @@ iris_status iris_exr_write(const char *path, const iris_image *img, const iris_i
     for (int k = 0; k < c; k++)
       if (strcmp(img->channel_names[k], img->channel_names[c]) == 0) {
         exr_finish(&ctx);
+        exr_current_stream = NULL;
         iris_atomic_abort(&af);
         return iris_error_set(err, IRIS_ERR_INVALID, path, 0, NULL,
                               "cannot write EXR: duplicate channel '%s'", img->channel_names[c]);
       }
     rv = exr_add_channel(ctx, part, img->channel_names[c], EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR, 1, 1);
   }
+  /* Names over 31 bytes need the (OpenEXR 1.7+) long-name header flag. */
+  bool long_names = false;
+  for (size_t i = 0; i < meta_count; i++) long_names |= strlen(meta[i].key) > 31;
+  if (long_names && rv == EXR_ERR_SUCCESS) rv = exr_set_longname_support(ctx, 1);
   for (size_t i = 0; i < meta_count && rv == EXR_ERR_SUCCESS; i++)
     rv = exr_attr_set_string(ctx, part, meta[i].key, meta[i].value);
-  if (rv == EXR_ERR_SUCCESS) rv = exr_write_header(ctx);
   if (rv != EXR_ERR_SUCCESS) {
+    st = exr_fail(err, IRIS_ERR_INVALID, path, &s, rv, "cannot write EXR header");
+  } else if ((rv = exr_write_header(ctx)) != EXR_ERR_SUCCESS) {
     st = exr_fail(err, IRIS_ERR_IO, path, &s, rv, "cannot write EXR");
   } else {
     st = exr_write_pixels(ctx, img, path, &s, err);
@@ -235,6 +249,7 @@ iris_status iris_exr_write(const char *path, const iris_image *img, const iris_i
     rv = exr_finish(&ctx); /* writes the chunk offset table */
     if (rv != EXR_ERR_SUCCESS && st == IRIS_OK) st = exr_fail(err, IRIS_ERR_IO, path, &s, rv, "cannot write EXR");
   }
+  exr_current_stream = NULL;
   if (st != IRIS_OK) {
     iris_atomic_abort(&af);
     return st;
@@ -367,6 +382,7 @@ iris_status iris_exr_read(const char *path, iris_image *img, iris_image_meta **m
     return iris_error_set(err, IRIS_ERR_IO, path, 0, NULL, "not a regular file");
   }
   s.size = (int64_t)sb.st_size;
+  exr_current_stream = &s;
 
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.error_handler_fn = exr_on_error;
@@ -445,6 +461,7 @@ iris_status iris_exr_read(const char *path, iris_image *img, iris_image_meta **m
   if (st != IRIS_OK) iris_image_destroy(img);
 done:
   if (ctx) exr_finish(&ctx);
+  exr_current_stream = NULL;
   close(s.fd);
   return st;
 }
