@@ -18,6 +18,7 @@
 #define OBJ_MAX_FILE_SIZE ((size_t)1 << 34) /* 16 GiB */
 #define OBJ_NAME_MAX 256
 #define OBJ_NO_INDEX (-1)
+#define OBJ_FLAT (-2) /* vn of a corner of a face outside any smoothing group */
 
 /* ---- small growable arrays --------------------------------------------- */
 
@@ -86,7 +87,6 @@ typedef struct obj_ctx {
   char cur_name[OBJ_NAME_MAX];
   char cur_material[OBJ_NAME_MAX];
   bool smooth;
-  long flat_faces; /* counter for FLAT markers */
 
   /* max positive index seen for v, vt, vn and where */
   int64_t max_idx[3];
@@ -424,12 +424,9 @@ static iris_status parse_face(obj_ctx *c, const char *p, const char *le, long li
     if (c->smooth) {
       g->needs_normals = true;
     } else {
-      /* Flat face: its corners get their own vertices with the face normal.
-       * The marker keeps them apart in vertex deduplication. */
-      int32_t marker = -2 - (int32_t)(c->flat_faces++ % (INT32_MAX - 2));
       g->any_flat = true;
       for (size_t i = first; i < g->corner_count; i++)
-        if (g->corners[3 * i + 2] == OBJ_NO_INDEX) g->corners[3 * i + 2] = marker;
+        if (g->corners[3 * i + 2] == OBJ_NO_INDEX) g->corners[3 * i + 2] = OBJ_FLAT;
     }
   }
   if (!grow((void **)&g->face_sizes, &g->face_cap, g->face_count + 1, sizeof(uint32_t)))
@@ -681,6 +678,8 @@ typedef struct build_scratch {
   uint32_t *stamp;
   int32_t *chain;   /* per local vertex: next with the same position */
   size_t chain_cap;
+  int64_t *vkey;    /* per local vertex: its normal key */
+  size_t vkey_cap;
   float *smooth_normals; /* per position, angle-weighted; NULL when not needed */
 } build_scratch;
 
@@ -720,7 +719,8 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, 0, g->name,
                           "mesh too large (more than 2^32 triangles)");
   /* Deduplicate corners into vertices keyed by (v, vt, vn). */
-  if (!grow((void **)&s->chain, &s->chain_cap, g->corner_count, sizeof(int32_t)))
+  if (!grow((void **)&s->chain, &s->chain_cap, g->corner_count, sizeof(int32_t)) ||
+      !grow((void **)&s->vkey, &s->vkey_cap, g->corner_count, sizeof(int64_t)))
     return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
   uint32_t *corner_vertex = malloc(g->corner_count * sizeof(uint32_t));
   uint32_t *first_corner = malloc(g->corner_count * sizeof(uint32_t)); /* per vertex */
@@ -728,24 +728,34 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
     free(corner_vertex), free(first_corner);
     return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
   }
+  /* Once a mesh has normals every vertex needs one, whatever compute_normals
+   * says; a mesh of flat faces only keeps none (the geometric normal). */
+  const bool want_normals = g->any_vn || (g->needs_normals && c->opts->compute_normals);
   const uint32_t stamp = (uint32_t)gi + 1;
   uint32_t nv = 0;
-  for (size_t i = 0; i < g->corner_count; i++) {
-    const int32_t *k = g->corners + 3 * i;
-    int32_t v = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
-    while (v >= 0) {
-      const int32_t *o = g->corners + 3 * (size_t)first_corner[v];
-      if (o[1] == k[1] && o[2] == k[2]) break;
-      v = s->chain[v];
+  size_t i = 0;
+  for (size_t f = 0; f < g->face_count; f++) {
+    for (uint32_t j = 0; j < g->face_sizes[f]; j++, i++) {
+      const int32_t *k = g->corners + 3 * i;
+      /* Corners of flat faces get their own vertices (with the face normal)
+       * when the mesh has normals; the key -3 - f keeps them apart. */
+      const int64_t kn = k[2] == OBJ_FLAT ? (want_normals ? -3 - (int64_t)f : OBJ_NO_INDEX) : k[2];
+      int32_t v = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
+      while (v >= 0) {
+        const int32_t *o = g->corners + 3 * (size_t)first_corner[v];
+        if (o[1] == k[1] && s->vkey[v] == kn) break;
+        v = s->chain[v];
+      }
+      if (v < 0) {
+        v = (int32_t)nv++;
+        first_corner[v] = (uint32_t)i;
+        s->vkey[v] = kn;
+        s->chain[v] = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
+        s->head[k[0]] = v;
+        s->stamp[k[0]] = stamp;
+      }
+      corner_vertex[i] = (uint32_t)v;
     }
-    if (v < 0) {
-      v = (int32_t)nv++;
-      first_corner[v] = (uint32_t)i;
-      s->chain[v] = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
-      s->head[k[0]] = v;
-      s->stamp[k[0]] = stamp;
-    }
-    corner_vertex[i] = (uint32_t)v;
   }
   iris_mesh m;
   memset(&m, 0, sizeof m);
@@ -754,8 +764,6 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
   m.triangle_count = (uint32_t)tri_count;
   m.positions = malloc(3 * (size_t)nv * sizeof(float));
   m.indices = malloc(3 * tri_count * sizeof(uint32_t) + 1);
-  /* Once a mesh has normals every vertex needs one, whatever compute_normals says. */
-  const bool want_normals = g->any_vn || (c->opts->compute_normals && g->needs_normals) || g->any_flat;
   bool ok = m.positions && m.indices;
   if (ok && g->any_vt) ok = (m.uvs = malloc(2 * (size_t)nv * sizeof(float))) != NULL;
   if (ok && c->has_colors) ok = (m.colors = malloc(3 * (size_t)nv * sizeof(float))) != NULL;
@@ -770,7 +778,7 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
     size_t corner = 0;
     for (size_t f = 0; f < g->face_count; f++) {
       const uint32_t n = g->face_sizes[f];
-      if (g->corners[3 * corner + 2] <= -2) {
+      if (g->corners[3 * corner + 2] == OBJ_FLAT) {
         float fn[3];
         polygon_normal(c->pos.v, g->corners + 3 * corner, n, fn);
         for (uint32_t i = 0; i < n; i++) memcpy(m.normals + 3 * (size_t)corner_vertex[corner + i], fn, sizeof fn);
@@ -846,7 +854,7 @@ static iris_status build_scene(obj_ctx *c) {
   bool any_smooth = false;
   for (size_t gi = 0; gi < c->group_count; gi++) {
     const obj_group *g = &c->groups[gi];
-    any_smooth |= g->needs_normals && (c->opts->compute_normals || g->any_vn || g->any_flat);
+    any_smooth |= g->needs_normals && (c->opts->compute_normals || g->any_vn);
   }
   if (any_smooth) {
     s.smooth_normals = calloc(3 * nv, sizeof(float));
@@ -858,7 +866,7 @@ static iris_status build_scene(obj_ctx *c) {
     }
     for (size_t gi = 0; gi < c->group_count; gi++) {
       const obj_group *g = &c->groups[gi];
-      if (!g->needs_normals) continue;
+      if (!g->needs_normals || !(c->opts->compute_normals || g->any_vn)) continue;
       size_t tri_count;
       if (!triangulate_group(c, g, &s, &tri_count) ||
           !grow((void **)&vtris, &vcap, 3 * tri_count, sizeof(uint32_t))) {
@@ -886,7 +894,7 @@ static iris_status build_scene(obj_ctx *c) {
   for (size_t gi = 0; gi < c->group_count && st == IRIS_OK; gi++) st = build_group(c, gi, &s, stem);
 done:
   iris_polygon_triangulator_destroy(s.tri);
-  free(s.poly), free(s.ptris), free(s.tris), free(s.head), free(s.stamp), free(s.chain);
+  free(s.poly), free(s.ptris), free(s.tris), free(s.head), free(s.stamp), free(s.chain), free(s.vkey);
   free(s.smooth_normals);
   return st;
 }
@@ -915,7 +923,7 @@ iris_status iris_import_obj_memory(const char *data, size_t size, const char *pa
   c.opts = opts ? opts : &defaults;
   c.err = err;
   c.cur_group = SIZE_MAX;
-  c.smooth = true;
+  c.smooth = false; /* OBJ: smoothing groups are off until an 's N' line */
   c.scene = iris_scene_create();
   if (!c.scene) return iris_error_set(err, IRIS_ERR_NOMEM, c.path, 0, NULL, "out of memory");
   iris_status st = parse_obj(&c, data ? data : "", data ? size : 0);
