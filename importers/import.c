@@ -6,13 +6,6 @@
 
 #include "core/fileio.h"
 
-/* Until every importer has landed in the tree the dispatcher links against
- * whichever exist; a missing one reports itself instead of breaking the link.
- * TODO(scene): drop these once obj.c, ply.c and gltf.cpp define them. */
-#pragma weak iris_import_obj
-#pragma weak iris_import_ply
-#pragma weak iris_import_gltf
-
 iris_import_options iris_import_options_default(void) {
   iris_import_options o;
   memset(&o, 0, sizeof o);
@@ -45,9 +38,6 @@ iris_status iris_import_file(const char *path, const iris_import_options *opts, 
                           "unknown file type '%s%s' (iris reads .obj, .ply, .gltf, .glb and iris "
                           "scene .json files)",
                           ext[0] ? "." : "", ext[0] ? ext : "no extension");
-  if (!fn)
-    return iris_error_set(err, IRIS_ERR_UNSUPPORTED, path, 0, NULL,
-                          "the .%s importer is not built into this iris", ext);
   iris_status st = fn(path, opts, out, err);
   if (st != IRIS_OK) return st;
   /* Every importer validates its result; checking again here costs one pass
