@@ -13,6 +13,7 @@
 
 #include "core/fileio.h"
 #include "core/log.h"
+#include "importers/meshproc.h"
 
 /* glTF constants (the numeric codes of the spec; tinygltf uses the same). */
 enum {
@@ -648,7 +649,13 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   }
   free(idx);
   m->triangle_count = (uint32_t)kept;
-  if (kept == 0) {
+  /* Shared last step (meshproc.h): zero-area triangles out, angle-weighted
+   * normals where the file has none, optional welding. */
+  uint32_t removed = 0;
+  if (kept > 0 && !iris_mesh_finish(m, c->opts->compute_normals, c->opts->weld, &removed))
+    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  c->degenerate_dropped += removed;
+  if (m->triangle_count == 0) {
     c->skipped_empty++;
     free_mesh_arrays(m);
     return IRIS_OK;
@@ -1355,7 +1362,8 @@ static void report_ignored(ctx *c) {
     iris_warnf("%s: skipped %zu primitive(s) without POSITION", f, c->skipped_no_position);
   if (c->skipped_empty) iris_warnf("%s: skipped %zu primitive(s) with no triangles", f, c->skipped_empty);
   if (c->degenerate_dropped)
-    iris_warnf("%s: dropped %zu degenerate triangle(s) (repeated vertex)", f, c->degenerate_dropped);
+    iris_warnf("%s: dropped %zu degenerate triangle(s) (repeated vertex or zero area)", f,
+               c->degenerate_dropped);
   if (c->zero_normals)
     iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped", f, c->zero_normals);
   if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_1 or higher are ignored", f);
@@ -1392,8 +1400,9 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
                               iris_scene **out, iris_error *err) {
   ctx c;
   memset(&c, 0, sizeof c);
+  iris_import_options defaults = iris_import_options_default();
   c.doc = doc;
-  c.opts = opts;
+  c.opts = opts ? opts : &defaults;
   c.file = doc->file;
   c.err = err;
   c.default_material = -1;

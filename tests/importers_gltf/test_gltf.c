@@ -440,18 +440,20 @@ static void check_synthetic(void) {
     EXPECT(fan->triangle_count == 3 && fan->indices[0] == 1 && fan->indices[1] == 2 && fan->indices[2] == 0 &&
                fan->indices[8] == 0 && fan->indices[6] == 3,
            "fan triangles %u", fan->triangle_count);
-    EXPECT(!fan->normals, "fan has no normals in the file");
+    /* No NORMAL in the file: angle-weighted normals computed; the fan lies in z = 0, CCW from +z. */
+    EXPECT(fan->normals && fabsf(fan->normals[2] - 1.0f) < 1e-6f, "fan normals computed (+z)");
     /* Mirrored node: transform kept as-is (det < 0); the renderer flips winding. */
     EXPECT(s->instances[0].transform.m[0][0] == -1.0f, "mirror kept in the instance transform");
   }
   iris_scene_destroy(s);
   free(j);
 
-  /* Sparse accessor over zeros: element 4 gets (2,0,0) from sparse values. Normalized u8 indices are invalid. */
+  /* Sparse accessor over zeros: elements 2 and 3 (u8 indices at byte 2) get (1,1,0) and
+   * (2,0,0) from the positions at byte 36; the fan keeps its one non-degenerate triangle. */
   snprintf(rest, sizeof rest,
-           "\"accessors\":[{\"componentType\":5126,\"count\":5,\"type\":\"VEC3\",\"sparse\":{\"count\":1,"
-           "\"indices\":{\"bufferView\":1,\"byteOffset\":5,\"componentType\":5121},"
-           "\"values\":{\"bufferView\":0,\"byteOffset\":48}}},"
+           "\"accessors\":[{\"componentType\":5126,\"count\":5,\"type\":\"VEC3\",\"sparse\":{\"count\":2,"
+           "\"indices\":{\"bufferView\":1,\"byteOffset\":2,\"componentType\":5121},"
+           "\"values\":{\"bufferView\":0,\"byteOffset\":36}}},"
            "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}],"
            "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":1}},{\"attributes\":{\"POSITION\":0},\"mode\":6}]}],"
            "\"nodes\":[{\"mesh\":0}]");
@@ -460,8 +462,9 @@ static void check_synthetic(void) {
   EXPECT(st == IRIS_OK, "sparse: %s", msg);
   if (st == IRIS_OK && s->mesh_count == 2) {
     const float *p = s->meshes[1].positions;
-    EXPECT(p[12] == 2.0f && p[13] == 0.0f && p[0] == 0.0f && p[3] == 0.0f, "sparse substitution: %g %g", p[12],
-           p[3]);
+    EXPECT(p[6] == 1.0f && p[7] == 1.0f && p[9] == 2.0f && p[10] == 0.0f && p[3] == 0.0f && p[12] == 0.0f,
+           "sparse substitution: %g %g %g", p[6], p[9], p[12]);
+    EXPECT(s->meshes[1].triangle_count == 1, "sparse fan: %u triangles", s->meshes[1].triangle_count);
   } else {
     EXPECT(0, "sparse: %zu meshes", s ? s->mesh_count : 0);
   }
