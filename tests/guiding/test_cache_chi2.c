@@ -1,0 +1,77 @@
+/* Chi-square of cache sampling (Algorithm 2, uniform in solid angle inside the
+ * texel) against the cache pdf, with the shared harness: hemisphere and
+ * sphere maps, several fill patterns, nearest and bilinear splatting. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "check.h"
+#include "chi2.h"
+#include "core/rng.h"
+#include "renderer/guiding/cache.h"
+
+typedef struct cache_ctx {
+  iris_octmap map;
+  float *pdf, *cdf;
+} cache_ctx;
+
+static bool sample_fn(void *ctx, const double u[3], double dir[3]) {
+  cache_ctx *c = ctx;
+  float p;
+  iris_vec3 d = iris_cache_sample(&c->map, c->pdf, c->cdf, (float)u[0], (float)u[1], (float)u[2], &p);
+  dir[0] = d.x;
+  dir[1] = d.y;
+  dir[2] = d.z;
+  return p > 0.0f;
+}
+
+static double pdf_fn(void *ctx, const double dir[3]) {
+  cache_ctx *c = ctx;
+  return iris_cache_pdf(&c->map, c->pdf, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+static iris_vec3 uniform_sphere(float u0, float u1) {
+  float z = 1.0f - 2.0f * u0, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * IRIS_PI * u1;
+  return iris_v3(r * cosf(phi), r * sinf(phi), z);
+}
+
+#define N_TESTS 11
+
+static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
+  cache_ctx c;
+  iris_octmap_create(&c.map, res, sphere, NULL);
+  float *hist = calloc(c.map.texel_count, sizeof(float));
+  c.pdf = calloc(c.map.texel_count, sizeof(float));
+  c.cdf = calloc(c.map.texel_count, sizeof(float));
+  iris_vec3 lobe = iris_normalize(iris_v3(-0.4f, 0.7f, 0.3f));
+  for (int i = 0; i < 3000; ++i) {
+    iris_sampler s = iris_sampler_start(42 + pattern, (uint64_t)i, 0);
+    iris_vec3 d = uniform_sphere(iris_sampler_next(&s), iris_sampler_next(&s));
+    float e = 1.0f;
+    if (pattern == 0) e = powf(fmaxf(0.0f, iris_dot(d, lobe)), 30.0f); /* narrow lobe */
+    if (pattern == 1) e = 0.2f + fabsf(d.z);                          /* smooth */
+    if (pattern == 2) e = (d.x > 0.0f) ? 1.0f : 0.0f;                   /* half dark: floor only */
+    iris_cache_splat(&c.map, hist, d, e, mode);
+  }
+  CHECK(iris_cache_build_tables(&c.map, hist, 2e-4f, c.pdf, c.cdf));
+  chi2_domain dom = {sphere ? CHI2_SPHERE : CHI2_HEMISPHERE, 0, 0, 1234 + (uint64_t)pattern};
+  chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 300000, 0.01, N_TESTS);
+  iris_check_record(r.passed, __FILE__, __LINE__, "res %d sphere %d pattern %d splat %d: %s", res, sphere,
+                    pattern, mode, r.message);
+  CHECK_NEAR(r.pdf_integral, 1.0, 2e-3);
+  free(hist);
+  free(c.pdf);
+  free(c.cdf);
+  iris_octmap_destroy(&c.map);
+}
+
+int main(void) {
+  for (int s = 0; s < 2; ++s)
+    for (int pattern = 0; pattern < 3; ++pattern) run(8, s, pattern, IRIS_SPLAT_NEAREST);
+  run(16, false, 0, IRIS_SPLAT_BILINEAR);
+  run(12, true, 1, IRIS_SPLAT_BILINEAR);
+  run(5, false, 0, IRIS_SPLAT_BILINEAR); /* odd resolution: texel split by both diagonals */
+  run(5, true, 2, IRIS_SPLAT_NEAREST);
+  run(3, true, 0, IRIS_SPLAT_BILINEAR);
+  return TEST_SUMMARY();
+}
