@@ -1,0 +1,945 @@
+/* Blender 3.4 exporter (exporters/blender.h, docs/export.md).
+ * The script is a fixed Python prelude (the functions that build a scene from
+ * plain data tables and set the fair-comparison Cycles settings) followed by
+ * the data tables of this scene and a call to main(). Mesh arrays are stored
+ * once, little-endian, in a sidecar file (or a base64 blob in the script) and
+ * read with numpy + foreach_set, the fast path for large meshes. */
+#include "exporters/blender.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
+
+/* clang-format off */
+static const char *const PRELUDE[] = {
+/* BEGIN PRELUDE */
+    "import argparse",
+    "import base64",
+    "import math",
+    "import os",
+    "import sys",
+    "import time",
+    "",
+    "import bpy",
+    "import numpy as np",
+    "from mathutils import Matrix, Vector",
+    "",
+    "HERE = os.path.dirname(os.path.abspath(__file__))",
+    "",
+    "",
+    "def text(b):",
+    "    return b.decode(\"utf-8\", \"replace\")",
+    "",
+    "",
+    "def parse_args():",
+    "    argv = sys.argv[sys.argv.index(\"--\") + 1:] if \"--\" in sys.argv else []",
+    "    ap = argparse.ArgumentParser(prog=\"blender -b --factory-startup --python-exit-code 1 -P scene.py --\")",
+    "    ap.add_argument(\"--output\", required=True, help=\"EXR file to write (float32 RGB)\")",
+    "    ap.add_argument(\"--spp\", type=int, default=SETTINGS[\"spp\"])",
+    "    ap.add_argument(\"--threads\", type=int, default=os.cpu_count() or 1)",
+    "    ap.add_argument(\"--seed\", type=int, default=SETTINGS[\"seed\"])",
+    "    ap.add_argument(\"--width\", type=int, default=SETTINGS[\"width\"])",
+    "    ap.add_argument(\"--height\", type=int, default=SETTINGS[\"height\"])",
+    "    ap.add_argument(\"--max-bounces\", type=int, default=SETTINGS[\"max_depth\"])",
+    "    a = ap.parse_args(argv)",
+    "    if a.spp < 1 or a.threads < 1 or a.width < 1 or a.height < 1 or a.max_bounces < 0:",
+    "        ap.error(\"--spp, --threads, --width, --height must be >= 1 and --max-bounces >= 0\")",
+    "    return a",
+    "",
+    "",
+    "class MeshData:",
+    "    \"\"\"Reads the arrays of one mesh from the sidecar file or the embedded blob.\"\"\"",
+    "",
+    "    def __init__(self):",
+    "        if BLOB is not None:",
+    "            self.buf = base64.b64decode(BLOB)",
+    "        else:",
+    "            with open(os.path.join(HERE, os.fsdecode(SIDECAR)), \"rb\") as f:",
+    "                self.buf = f.read()",
+    "",
+    "    def array(self, offset, dtype, count):",
+    "        if offset < 0:",
+    "            return None",
+    "        return np.frombuffer(self.buf, dtype=dtype, count=count, offset=offset)",
+    "",
+    "",
+    "def build_mesh(data, m):",
+    "    nv, nt = m[\"nv\"], m[\"nt\"]",
+    "    pos = data.array(m[\"pos\"], \"<f4\", 3 * nv)",
+    "    idx = data.array(m[\"idx\"], \"<u4\", 3 * nt).astype(np.int32)",
+    "    me = bpy.data.meshes.new(text(m[\"name\"]))",
+    "    me.vertices.add(nv)",
+    "    me.vertices.foreach_set(\"co\", pos)",
+    "    me.loops.add(3 * nt)",
+    "    me.loops.foreach_set(\"vertex_index\", idx)",
+    "    me.polygons.add(nt)",
+    "    me.polygons.foreach_set(\"loop_start\", np.arange(0, 3 * nt, 3, dtype=np.int32))",
+    "    me.polygons.foreach_set(\"loop_total\", np.full(nt, 3, dtype=np.int32))",
+    "    uv = data.array(m[\"uv\"], \"<f4\", 2 * nv)",
+    "    if uv is not None:",
+    "        # iris (glTF) UVs have v down from the image's top; Blender's v goes up.",
+    "        corner = uv.reshape(-1, 2)[idx].copy()",
+    "        corner[:, 1] = 1.0 - corner[:, 1]",
+    "        me.uv_layers.new(name=\"UVMap\").data.foreach_set(\"uv\", corner.ravel())",
+    "    col = data.array(m[\"col\"], \"<f4\", 3 * nv)",
+    "    if col is not None:",
+    "        rgba = np.ones((nv, 4), dtype=np.float32)",
+    "        rgba[:, :3] = col.reshape(-1, 3)",
+    "        attr = me.color_attributes.new(\"Col\", \"FLOAT_COLOR\", \"POINT\")",
+    "        attr.data.foreach_set(\"color\", rgba.ravel())",
+    "    me.update(calc_edges=True)",
+    "    if m[\"validate\"]:",
+    "        me.validate(clean_customdata=False)",
+    "    nrm = data.array(m[\"nrm\"], \"<f4\", 3 * nv)",
+    "    if nrm is not None:",
+    "        me.polygons.foreach_set(\"use_smooth\", np.ones(len(me.polygons), dtype=bool))",
+    "        me.use_auto_smooth = True",
+    "        me.auto_smooth_angle = math.pi",
+    "        me.normals_split_custom_set_from_vertices(nrm.reshape(-1, 3))",
+    "    if m[\"material\"] >= 0:",
+    "        me.materials.append(MATERIAL_BLOCKS[m[\"material\"]])",
+    "    return me",
+    "",
+    "",
+    "# ---- materials ------------------------------------------------------------",
+    "",
+    "IMAGES = {}",
+    "",
+    "",
+    "def image(tex_index, colorspace):",
+    "    key = (tex_index, colorspace)",
+    "    if key not in IMAGES:",
+    "        path = os.fsdecode(TEXTURES[tex_index][\"path\"])",
+    "        if not os.path.isabs(path):",
+    "            path = os.path.join(HERE, path)",
+    "        img = bpy.data.images.load(path, check_existing=False)",
+    "        img.colorspace_settings.name = colorspace",
+    "        IMAGES[key] = img",
+    "    return IMAGES[key]",
+    "",
+    "",
+    "def texture_node(nt, tex_index, colorspace):",
+    "    t = TEXTURES[tex_index]",
+    "    node = nt.nodes.new(\"ShaderNodeTexImage\")",
+    "    node.image = image(tex_index, colorspace)",
+    "    node.interpolation = \"Closest\" if t[\"nearest\"] else \"Linear\"",
+    "    ws, wt = t[\"wrap_s\"], t[\"wrap_t\"]",
+    "    if ws == wt and ws in (\"REPEAT\", \"CLAMP\"):",
+    "        node.extension = \"REPEAT\" if ws == \"REPEAT\" else \"EXTEND\"",
+    "        return node",
+    "    # Per-axis wrap modes (and mirror, which Blender 3.4's Image Texture lacks)",
+    "    # are applied to the UVs, then the image is sampled with EXTEND.",
+    "    node.extension = \"EXTEND\"",
+    "    uvmap = nt.nodes.new(\"ShaderNodeUVMap\")",
+    "    sep = nt.nodes.new(\"ShaderNodeSeparateXYZ\")",
+    "    comb = nt.nodes.new(\"ShaderNodeCombineXYZ\")",
+    "    nt.links.new(uvmap.outputs[\"UV\"], sep.inputs[0])",
+    "    for axis, mode in ((\"X\", ws), (\"Y\", wt)):",
+    "        if mode == \"CLAMP\":",
+    "            nt.links.new(sep.outputs[axis], comb.inputs[axis])",
+    "            continue",
+    "        op = nt.nodes.new(\"ShaderNodeMath\")",
+    "        if mode == \"REPEAT\":",
+    "            op.operation = \"FRACT\"",
+    "        else:",
+    "            op.operation = \"PINGPONG\"",
+    "            op.inputs[1].default_value = 1.0",
+    "        nt.links.new(sep.outputs[axis], op.inputs[0])",
+    "        nt.links.new(op.outputs[0], comb.inputs[axis])",
+    "    nt.links.new(comb.outputs[0], node.inputs[\"Vector\"])",
+    "    return node",
+    "",
+    "",
+    "def multiply(nt, a, b):",
+    "    \"\"\"Product of two colour sockets (no clamping).\"\"\"",
+    "    node = nt.nodes.new(\"ShaderNodeMixRGB\")",
+    "    node.blend_type = \"MULTIPLY\"",
+    "    node.use_clamp = False",
+    "    node.inputs[\"Fac\"].default_value = 1.0",
+    "    nt.links.new(a, node.inputs[\"Color1\"])",
+    "    nt.links.new(b, node.inputs[\"Color2\"])",
+    "    return node.outputs[\"Color\"]",
+    "",
+    "",
+    "def color_socket(nt, rgb, tex_index, vertex_colors):",
+    "    \"\"\"Returns a socket for rgb x texture x vertex colour, or None when constant.\"\"\"",
+    "    sock = None",
+    "    if tex_index >= 0:",
+    "        sock = texture_node(nt, tex_index, \"sRGB\").outputs[\"Color\"]",
+    "    if vertex_colors:",
+    "        vc = nt.nodes.new(\"ShaderNodeVertexColor\")",
+    "        vc.layer_name = \"Col\"",
+    "        sock = vc.outputs[\"Color\"] if sock is None else multiply(nt, sock, vc.outputs[\"Color\"])",
+    "    if sock is None or tuple(rgb) == (1.0, 1.0, 1.0):",
+    "        return sock",
+    "    const = nt.nodes.new(\"ShaderNodeRGB\")",
+    "    const.outputs[0].default_value = (*rgb, 1.0)",
+    "    return multiply(nt, const.outputs[0], sock)",
+    "",
+    "",
+    "def set_color(nt, socket, rgb, tex_index, vertex_colors):",
+    "    s = color_socket(nt, rgb, tex_index, vertex_colors)",
+    "    if s is None:",
+    "        socket.default_value = (*rgb, 1.0)",
+    "    else:",
+    "        nt.links.new(s, socket)",
+    "",
+    "",
+    "def scalar(nt, socket, value, from_socket):",
+    "    \"\"\"socket = value x from_socket (or the constant value).\"\"\"",
+    "    if from_socket is None:",
+    "        socket.default_value = value",
+    "        return",
+    "    mul = nt.nodes.new(\"ShaderNodeMath\")",
+    "    mul.operation = \"MULTIPLY\"",
+    "    mul.inputs[1].default_value = value",
+    "    nt.links.new(from_socket, mul.inputs[0])",
+    "    nt.links.new(mul.outputs[0], socket)",
+    "",
+    "",
+    "def build_material(m):",
+    "    mat = bpy.data.materials.new(text(m[\"name\"]))",
+    "    mat.use_nodes = True",
+    "    nt = mat.node_tree",
+    "    nt.nodes.clear()",
+    "    out = nt.nodes.new(\"ShaderNodeOutputMaterial\")",
+    "    kind, vc = m[\"type\"], m[\"vertex_colors\"]",
+    "    if kind == \"diffuse\":",
+    "        bsdf = nt.nodes.new(\"ShaderNodeBsdfDiffuse\")",
+    "        bsdf.inputs[\"Roughness\"].default_value = 0.0",
+    "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
+    "    elif kind == \"glossy\":",
+    "        bsdf = nt.nodes.new(\"ShaderNodeBsdfGlossy\")",
+    "        bsdf.distribution = \"GGX\"",
+    "        bsdf.inputs[\"Roughness\"].default_value = m[\"roughness\"]",
+    "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
+    "    elif kind == \"glass\":",
+    "        bsdf = nt.nodes.new(\"ShaderNodeBsdfGlass\")",
+    "        bsdf.distribution = \"GGX\"",
+    "        bsdf.inputs[\"Roughness\"].default_value = m[\"roughness\"]",
+    "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
+    "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
+    "    else:",
+    "        bsdf = nt.nodes.new(\"ShaderNodeBsdfPrincipled\")",
+    "        bsdf.distribution = \"GGX\"",
+    "        set_color(nt, bsdf.inputs[\"Base Color\"], m[\"color\"], m[\"color_tex\"], vc)",
+    "        metal = rough = None",
+    "        if m[\"mr_tex\"] >= 0:",
+    "            sep = nt.nodes.new(\"ShaderNodeSeparateColor\")",
+    "            nt.links.new(texture_node(nt, m[\"mr_tex\"], \"Non-Color\").outputs[\"Color\"], sep.inputs[0])",
+    "            metal, rough = sep.outputs[\"Blue\"], sep.outputs[\"Green\"]",
+    "        scalar(nt, bsdf.inputs[\"Metallic\"], m[\"metallic\"], metal)",
+    "        scalar(nt, bsdf.inputs[\"Roughness\"], m[\"roughness\"], rough)",
+    "        bsdf.inputs[\"Specular\"].default_value = m[\"principled_specular\"]",
+    "        bsdf.inputs[\"Specular Tint\"].default_value = 0.0",
+    "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
+    "        bsdf.inputs[\"Transmission\"].default_value = m[\"transmission\"]",
+    "        bsdf.inputs[\"Transmission Roughness\"].default_value = 0.0",
+    "    shader = bsdf.outputs[0]",
+    "    if max(m[\"emission\"]) > 0.0:",
+    "        em = nt.nodes.new(\"ShaderNodeEmission\")",
+    "        em.inputs[\"Strength\"].default_value = 1.0",
+    "        set_color(nt, em.inputs[\"Color\"], m[\"emission\"], m[\"emission_tex\"], False)",
+    "        emitted = em.outputs[0]",
+    "        if not m[\"emission_two_sided\"]:",
+    "            # Cycles emits from both faces; a back face gets a Mix Shader whose",
+    "            # second input is left empty, i.e. no emission.",
+    "            geo = nt.nodes.new(\"ShaderNodeNewGeometry\")",
+    "            mix = nt.nodes.new(\"ShaderNodeMixShader\")",
+    "            nt.links.new(geo.outputs[\"Backfacing\"], mix.inputs[\"Fac\"])",
+    "            nt.links.new(emitted, mix.inputs[1])",
+    "            emitted = mix.outputs[0]",
+    "        add = nt.nodes.new(\"ShaderNodeAddShader\")",
+    "        nt.links.new(shader, add.inputs[0])",
+    "        nt.links.new(emitted, add.inputs[1])",
+    "        shader = add.outputs[0]",
+    "    nt.links.new(shader, out.inputs[\"Surface\"])",
+    "    return mat",
+    "",
+    "",
+    "# ---- lights, camera, world ------------------------------------------------",
+    "",
+    "def orient(obj, direction):",
+    "    \"\"\"Rotates obj so that its local -Z points along direction.\"\"\"",
+    "    obj.rotation_euler = Vector(direction).to_track_quat(\"-Z\", \"Y\").to_euler()",
+    "",
+    "",
+    "def spot_falloff_nodes(light, cos_inner, cos_outer):",
+    "    \"\"\"Cycles 3.4 spot lights multiply the intensity by cos(angle to the axis)",
+    "    (measured); this node tree divides it out and applies the glTF falloff",
+    "    t^2, t = clamp((cos - cos_outer) / (cos_inner - cos_outer)).\"\"\"",
+    "    light.use_nodes = True",
+    "    nt = light.node_tree",
+    "    em = nt.nodes[\"Emission\"]",
+    "    coord = nt.nodes.new(\"ShaderNodeTexCoord\")",
+    "    sep = nt.nodes.new(\"ShaderNodeSeparateXYZ\")",
+    "    nt.links.new(coord.outputs[\"Normal\"], sep.inputs[0])",
+    "    cos = nt.nodes.new(\"ShaderNodeMath\")  # cos = -z of the light-local direction",
+    "    cos.operation = \"MULTIPLY\"",
+    "    cos.inputs[1].default_value = -1.0",
+    "    nt.links.new(sep.outputs[\"Z\"], cos.inputs[0])",
+    "    t = nt.nodes.new(\"ShaderNodeMapRange\")",
+    "    t.clamp = True",
+    "    t.inputs[\"From Min\"].default_value = cos_outer",
+    "    t.inputs[\"From Max\"].default_value = max(cos_inner, cos_outer + 1e-6)",
+    "    nt.links.new(cos.outputs[0], t.inputs[\"Value\"])",
+    "    t2 = nt.nodes.new(\"ShaderNodeMath\")",
+    "    t2.operation = \"POWER\"",
+    "    t2.inputs[1].default_value = 2.0",
+    "    nt.links.new(t.outputs[\"Result\"], t2.inputs[0])",
+    "    div = nt.nodes.new(\"ShaderNodeMath\")",
+    "    div.operation = \"DIVIDE\"",
+    "    nt.links.new(t2.outputs[0], div.inputs[0])",
+    "    safe = nt.nodes.new(\"ShaderNodeMath\")",
+    "    safe.operation = \"MAXIMUM\"",
+    "    safe.inputs[1].default_value = 1e-6",
+    "    nt.links.new(cos.outputs[0], safe.inputs[0])",
+    "    nt.links.new(safe.outputs[0], div.inputs[1])",
+    "    nt.links.new(div.outputs[0], em.inputs[\"Strength\"])",
+    "",
+    "",
+    "def build_light(sc, l):",
+    "    light = bpy.data.lights.new(text(l[\"name\"]), l[\"type\"])",
+    "    light.color = l[\"color\"]",
+    "    light.energy = l[\"strength\"]",
+    "    light.cycles.cast_shadow = True",
+    "    if l[\"type\"] == \"SUN\":",
+    "        light.angle = 0.0",
+    "    else:",
+    "        light.shadow_soft_size = 0.0",
+    "    if l[\"type\"] == \"SPOT\":",
+    "        light.spot_size = min(math.pi, 2.0 * math.acos(l[\"cos_outer\"]))",
+    "        light.spot_blend = 0.0",
+    "        light.show_cone = False",
+    "        spot_falloff_nodes(light, l[\"cos_inner\"], l[\"cos_outer\"])",
+    "    obj = bpy.data.objects.new(light.name, light)",
+    "    obj.location = l[\"position\"]",
+    "    if l[\"type\"] != \"POINT\":",
+    "        orient(obj, l[\"direction\"])",
+    "    sc.collection.objects.link(obj)",
+    "",
+    "",
+    "def build_camera(sc):",
+    "    cam = bpy.data.cameras.new(text(CAMERA[\"name\"]))",
+    "    cam.type = \"PERSP\"",
+    "    cam.sensor_fit = \"VERTICAL\"",
+    "    cam.angle_y = CAMERA[\"yfov\"]",
+    "    cam.clip_start = CAMERA[\"clip_start\"]",
+    "    cam.clip_end = CAMERA[\"clip_end\"]",
+    "    cam.shift_x = cam.shift_y = 0.0",
+    "    obj = bpy.data.objects.new(cam.name, cam)",
+    "    obj.matrix_world = Matrix(CAMERA[\"matrix\"])",
+    "    sc.collection.objects.link(obj)",
+    "    sc.camera = obj",
+    "",
+    "",
+    "def build_world(sc):",
+    "    world = bpy.data.worlds.new(\"World\")",
+    "    world.use_nodes = True",
+    "    bg = world.node_tree.nodes[\"Background\"]",
+    "    if WORLD is None:",
+    "        bg.inputs[\"Color\"].default_value = (0.0, 0.0, 0.0, 1.0)",
+    "        bg.inputs[\"Strength\"].default_value = 0.0",
+    "    else:",
+    "        bg.inputs[\"Color\"].default_value = (*WORLD, 1.0)",
+    "        bg.inputs[\"Strength\"].default_value = 1.0",
+    "    sc.world = world",
+    "",
+    "",
+    "# ---- fair-comparison render settings (docs/export.md) ---------------------",
+    "",
+    "def configure(sc, a):",
+    "    r, c = sc.render, sc.cycles",
+    "    r.engine = \"CYCLES\"",
+    "    c.device = \"CPU\"",
+    "    c.feature_set = \"SUPPORTED\"",
+    "    c.samples = a.spp",
+    "    c.use_adaptive_sampling = False",
+    "    c.seed = a.seed",
+    "    c.use_animated_seed = False",
+    "    c.pixel_filter_type = \"BOX\"",
+    "    c.max_bounces = a.max_bounces",
+    "    c.diffuse_bounces = a.max_bounces",
+    "    c.glossy_bounces = a.max_bounces",
+    "    c.transmission_bounces = a.max_bounces",
+    "    c.volume_bounces = a.max_bounces",
+    "    c.transparent_max_bounces = a.max_bounces",
+    "    c.min_light_bounces = 0",
+    "    c.min_transparent_bounces = 0",
+    "    c.light_sampling_threshold = 0.0",
+    "    c.sample_clamp_direct = 0.0",
+    "    c.sample_clamp_indirect = 0.0",
+    "    c.blur_glossy = 0.0",
+    "    c.caustics_reflective = True",
+    "    c.caustics_refractive = True",
+    "    c.use_fast_gi = False",
+    "    c.use_denoising = False",
+    "    c.use_preview_denoising = False",
+    "    for vl in sc.view_layers:",
+    "        vl.cycles.use_denoising = False",
+    "    c.film_exposure = 1.0",
+    "    r.film_transparent = False",
+    "    sc.view_settings.view_transform = \"Standard\"",
+    "    sc.view_settings.look = \"None\"",
+    "    sc.view_settings.exposure = 0.0",
+    "    sc.view_settings.gamma = 1.0",
+    "    r.threads_mode = \"FIXED\"",
+    "    r.threads = a.threads",
+    "    r.resolution_x = a.width",
+    "    r.resolution_y = a.height",
+    "    r.resolution_percentage = 100",
+    "    r.pixel_aspect_x = r.pixel_aspect_y = 1.0",
+    "    r.use_border = False",
+    "    r.use_compositing = False",
+    "    r.use_sequencer = False",
+    "    s = r.image_settings",
+    "    s.file_format = \"OPEN_EXR\"",
+    "    s.color_depth = \"32\"",
+    "    s.color_mode = \"RGB\"",
+    "    s.exr_codec = \"ZIP\"",
+    "    r.use_file_extension = False",
+    "    r.filepath = os.path.abspath(a.output)",
+    "",
+    "",
+    "def main():",
+    "    a = parse_args()",
+    "    t0 = time.perf_counter()",
+    "    bpy.ops.wm.read_factory_settings(use_empty=True)",
+    "    sc = bpy.context.scene",
+    "    build_world(sc)",
+    "    global MATERIAL_BLOCKS",
+    "    MATERIAL_BLOCKS = [build_material(m) for m in MATERIALS]",
+    "    data = MeshData()",
+    "    blocks = [build_mesh(data, m) for m in MESHES]",
+    "    del data",
+    "    for i, (mesh, matrix) in enumerate(INSTANCES):",
+    "        obj = bpy.data.objects.new(\"%s.%d\" % (blocks[mesh].name, i), blocks[mesh])",
+    "        obj.matrix_world = Matrix(matrix)",
+    "        sc.collection.objects.link(obj)",
+    "    for l in LIGHTS:",
+    "        build_light(sc, l)",
+    "    build_camera(sc)",
+    "    configure(sc, a)",
+    "    t1 = time.perf_counter()",
+    "    bpy.ops.render.render(write_still=True)",
+    "    t2 = time.perf_counter()",
+    "    if not os.path.isfile(sc.render.filepath):",
+    "        print(\"iris-blender: error: Cycles wrote no image to %s\" % sc.render.filepath, file=sys.stderr)",
+    "        sys.exit(1)",
+    "    print(\"IRIS_BLENDER build_seconds=%.3f render_seconds=%.3f spp=%d threads=%d width=%d height=%d\"",
+    "          % (t1 - t0, t2 - t1, a.spp, a.threads, a.width, a.height), flush=True)",
+    /* END PRELUDE */
+};
+/* clang-format on */
+
+/* ---- small writers --------------------------------------------------------- */
+
+/* Python float literal: shortest round-trip form of a finite float. */
+static void put_float(FILE *fp, float v) {
+  if (!isfinite(v)) v = 0.0f; /* unreachable after validation; keeps the script valid */
+  char buf[32];
+  snprintf(buf, sizeof buf, "%.9g", (double)v);
+  /* "1e+10" and "3" are valid Python floats/ints; make integers floats. */
+  if (!strpbrk(buf, ".eEn")) strcat(buf, ".0");
+  fputs(buf, fp);
+}
+
+static void put_vec3(FILE *fp, const float *v) {
+  fputc('(', fp);
+  for (int i = 0; i < 3; i++) {
+    if (i) fputs(", ", fp);
+    put_float(fp, v[i]);
+  }
+  fputc(')', fp);
+}
+
+/* A Python bytes literal holding the exact bytes of s (NULL -> b""). Names are
+ * decoded with errors="replace" by the prelude's text(); paths with os.fsdecode. */
+static void put_bytes(FILE *fp, const char *s) {
+  fputs("b\"", fp);
+  for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; p++) {
+    if (*p == '"' || *p == '\\')
+      fprintf(fp, "\\%c", *p);
+    else if (*p < 0x20 || *p >= 0x7f)
+      fprintf(fp, "\\x%02x", *p);
+    else
+      fputc(*p, fp);
+  }
+  fputc('"', fp);
+}
+
+static void put_matrix(FILE *fp, const iris_mat4 *m) {
+  fputc('(', fp);
+  for (int r = 0; r < 4; r++) {
+    fputs(r ? ", (" : "(", fp);
+    for (int c = 0; c < 4; c++) {
+      if (c) fputs(", ", fp);
+      put_float(fp, m->m[r][c]);
+    }
+    fputc(')', fp);
+  }
+  fputc(')', fp);
+}
+
+/* ---- mesh blob layout ------------------------------------------------------ */
+
+typedef struct mesh_layout {
+  int64_t pos, nrm, uv, col, idx; /* byte offsets, -1 when absent */
+} mesh_layout;
+
+static uint64_t align16(uint64_t v) { return (v + 15u) & ~(uint64_t)15u; }
+
+static uint64_t layout_meshes(const iris_scene *scene, mesh_layout *lay) {
+  uint64_t off = 0;
+  for (size_t i = 0; i < scene->mesh_count; i++) {
+    const iris_mesh *m = &scene->meshes[i];
+    uint64_t nv = m->vertex_count, nt = m->triangle_count;
+    lay[i].pos = (int64_t)off;
+    off = align16(off + 12u * nv);
+    lay[i].nrm = m->normals ? (int64_t)off : -1;
+    if (m->normals) off = align16(off + 12u * nv);
+    lay[i].uv = m->uvs ? (int64_t)off : -1;
+    if (m->uvs) off = align16(off + 8u * nv);
+    lay[i].col = m->colors ? (int64_t)off : -1;
+    if (m->colors) off = align16(off + 12u * nv);
+    lay[i].idx = (int64_t)off;
+    off = align16(off + 12u * nt);
+  }
+  return off;
+}
+
+/* Byte sink for the blob: raw into the sidecar, or base64 into the script. */
+typedef struct blob_sink {
+  FILE *fp;
+  bool base64;
+  uint64_t written;
+  unsigned char carry[3];
+  int carry_count;
+} blob_sink;
+
+static const char B64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+static void b64_group(FILE *fp, const unsigned char *in, int n) {
+  char out[4];
+  uint32_t v = (uint32_t)in[0] << 16 | (uint32_t)(n > 1 ? in[1] : 0) << 8 | (uint32_t)(n > 2 ? in[2] : 0);
+  out[0] = B64[(v >> 18) & 63];
+  out[1] = B64[(v >> 12) & 63];
+  out[2] = n > 1 ? B64[(v >> 6) & 63] : '=';
+  out[3] = n > 2 ? B64[v & 63] : '=';
+  fwrite(out, 1, 4, fp);
+}
+
+static void sink_write(blob_sink *s, const void *data, size_t size) {
+  const unsigned char *p = data;
+  s->written += size;
+  if (!s->base64) {
+    fwrite(p, 1, size, s->fp);
+    return;
+  }
+  while (size > 0 && s->carry_count > 0 && s->carry_count < 3) {
+    s->carry[s->carry_count++] = *p++;
+    size--;
+    if (s->carry_count == 3) {
+      b64_group(s->fp, s->carry, 3);
+      s->carry_count = 0;
+    }
+  }
+  for (; size >= 3; size -= 3, p += 3) b64_group(s->fp, p, 3);
+  for (; size > 0; size--) s->carry[s->carry_count++] = *p++;
+}
+
+static void sink_finish(blob_sink *s) {
+  if (s->base64 && s->carry_count > 0) b64_group(s->fp, s->carry, s->carry_count);
+  s->carry_count = 0;
+}
+
+static void sink_pad(blob_sink *s, uint64_t to) {
+  static const unsigned char zeros[16] = {0};
+  while (s->written < to) {
+    uint64_t n = to - s->written;
+    sink_write(s, zeros, n > 16 ? 16 : (size_t)n);
+  }
+}
+
+static bool host_is_little_endian(void) {
+  const uint32_t one = 1;
+  unsigned char b;
+  memcpy(&b, &one, 1);
+  return b == 1;
+}
+
+/* 32-bit words written little-endian whatever the host. */
+static void sink_words(blob_sink *s, const void *words, size_t count) {
+  if (host_is_little_endian()) {
+    sink_write(s, words, count * 4);
+    return;
+  }
+  const unsigned char *p = words;
+  for (size_t i = 0; i < count; i++, p += 4) {
+    unsigned char w[4] = {p[3], p[2], p[1], p[0]};
+    sink_write(s, w, 4);
+  }
+}
+
+static void write_blob(blob_sink *s, const iris_scene *scene, const mesh_layout *lay) {
+  for (size_t i = 0; i < scene->mesh_count; i++) {
+    const iris_mesh *m = &scene->meshes[i];
+    size_t nv = m->vertex_count, nt = m->triangle_count;
+    sink_pad(s, (uint64_t)lay[i].pos);
+    sink_words(s, m->positions, 3 * nv);
+    if (m->normals) {
+      sink_pad(s, (uint64_t)lay[i].nrm);
+      sink_words(s, m->normals, 3 * nv);
+    }
+    if (m->uvs) {
+      sink_pad(s, (uint64_t)lay[i].uv);
+      sink_words(s, m->uvs, 2 * nv);
+    }
+    if (m->colors) {
+      sink_pad(s, (uint64_t)lay[i].col);
+      sink_words(s, m->colors, 3 * nv);
+    }
+    sink_pad(s, (uint64_t)lay[i].idx);
+    sink_words(s, m->indices, 3 * nt);
+  }
+  sink_pad(s, align16(s->written));
+  sink_finish(s);
+}
+
+/* ---- materials ------------------------------------------------------------- */
+
+/* A Blender material is one iris material with or without vertex colours
+ * multiplied in (vertex colours are a mesh attribute in iris). */
+typedef struct material_variant {
+  int32_t material; /* -1 = iris's default material */
+  bool vertex_colors;
+} material_variant;
+
+static const char *wrap_name(iris_wrap w) {
+  switch (w) {
+    case IRIS_WRAP_CLAMP: return "CLAMP";
+    case IRIS_WRAP_MIRROR: return "MIRROR";
+    default: return "REPEAT";
+  }
+}
+
+static const char *material_type_name(iris_material_type t) {
+  switch (t) {
+    case IRIS_MATERIAL_GLOSSY: return "glossy";
+    case IRIS_MATERIAL_GLASS: return "glass";
+    case IRIS_MATERIAL_GLTF: return "gltf";
+    default: return "diffuse";
+  }
+}
+
+/* Principled BSDF (v1) "Specular" gives a dielectric F0 of 0.08 * Specular;
+ * glTF's is ((ior-1)/(ior+1))^2 * specular * specularColor (KHR_materials_specular,
+ * colour approximated by its maximum). */
+static float principled_specular(const iris_material *m) {
+  float f0 = iris_sqr((m->ior - 1.0f) / (m->ior + 1.0f));
+  float col = fmaxf(m->specular_color[0], fmaxf(m->specular_color[1], m->specular_color[2]));
+  return f0 / 0.08f * m->specular * col;
+}
+
+static void put_material(FILE *fp, const iris_scene *scene, material_variant v) {
+  iris_material def = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  const iris_material *m = v.material >= 0 ? &scene->materials[v.material] : &def;
+  fputs("    dict(name=", fp);
+  put_bytes(fp, v.material >= 0 ? (m->name ? m->name : "material") : "iris-default");
+  fprintf(fp, ", type=\"%s\", color=", material_type_name(m->type));
+  put_vec3(fp, m->color);
+  fprintf(fp, ", color_tex=%d, roughness=", (int)m->color_texture);
+  put_float(fp, m->roughness);
+  fputs(", ior=", fp);
+  put_float(fp, m->ior);
+  fputs(", metallic=", fp);
+  put_float(fp, m->metallic);
+  fprintf(fp, ", mr_tex=%d, principled_specular=", (int)m->metallic_roughness_texture);
+  put_float(fp, principled_specular(m));
+  fputs(", transmission=", fp);
+  put_float(fp, m->transmission);
+  fputs(", emission=", fp);
+  put_vec3(fp, m->emission);
+  fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s),\n",
+          (int)m->emission_texture, m->emission_two_sided ? "True" : "False",
+          v.vertex_colors ? "True" : "False");
+}
+
+/* ---- textures -------------------------------------------------------------- */
+
+static void texture_file_ext(const iris_texture *t, char *out, size_t size) {
+  snprintf(out, size, "%s", strcmp(t->mime, "image/jpeg") == 0 ? "jpg" : "png");
+}
+
+/* In-memory textures become "<stem>.textures/<i>.<ext>" next to the script. */
+static iris_status write_textures(const iris_scene *scene, const char *script_path, iris_error *err) {
+  char dir[1024], stem[256], tdir[1400], path[1600], ext[8];
+  iris_path_dir(script_path, dir, sizeof dir);
+  iris_path_stem(script_path, stem, sizeof stem);
+  snprintf(path, sizeof path, "%s.textures", stem);
+  iris_path_join(dir, path, tdir, sizeof tdir);
+  bool made = false;
+  for (size_t i = 0; i < scene->texture_count; i++) {
+    const iris_texture *t = &scene->textures[i];
+    if (t->path) continue;
+    if (!made) {
+      iris_status st = iris_mkdir_p(tdir, err);
+      if (st != IRIS_OK) return st;
+      made = true;
+    }
+    texture_file_ext(t, ext, sizeof ext);
+    char name[32];
+    snprintf(name, sizeof name, "%zu.%s", i, ext);
+    iris_path_join(tdir, name, path, sizeof path);
+    iris_status st = iris_file_write_atomic(path, t->data, t->data_size, err);
+    if (st != IRIS_OK) return st;
+  }
+  return IRIS_OK;
+}
+
+static void put_texture(FILE *fp, const iris_texture *t, size_t index, const char *stem) {
+  char path[PATH_MAX + 64];
+  if (t->path) {
+    /* Absolute, so the script can be run from anywhere. */
+    char cwd[PATH_MAX];
+    if (t->path[0] != '/' && getcwd(cwd, sizeof cwd))
+      iris_path_join(cwd, t->path, path, sizeof path);
+    else
+      snprintf(path, sizeof path, "%s", t->path);
+    if (!iris_path_exists(path)) iris_warnf("texture '%s' not found (the Blender script refers to it anyway)", path);
+  } else {
+    char ext[8];
+    texture_file_ext(t, ext, sizeof ext);
+    snprintf(path, sizeof path, "%s.textures/%zu.%s", stem, index, ext);
+  }
+  fputs("    dict(path=", fp);
+  put_bytes(fp, path);
+  fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s),\n", wrap_name(t->wrap_s),
+          wrap_name(t->wrap_t), t->nearest ? "True" : "False");
+}
+
+/* ---- lights and camera ----------------------------------------------------- */
+
+static void put_light(FILE *fp, const iris_light *l, size_t index) {
+  static const char *const TYPES[] = {"POINT", "SPOT", "SUN"};
+  char name[32];
+  snprintf(name, sizeof name, "light.%zu", index);
+  /* Cycles 3.4 (measured, docs/export.md): a point or spot light of power P W
+   * has radiant intensity P/(4 pi) W/sr; a sun of strength S gives irradiance
+   * S W/m^2 on a surface facing it. */
+  float strength = l->type == IRIS_LIGHT_DIRECTIONAL ? l->intensity : 4.0f * IRIS_PI * l->intensity;
+  float outer = iris_clampf(l->outer_cone, 1e-4f, 0.5f * IRIS_PI);
+  float inner = iris_clampf(l->inner_cone, 0.0f, outer);
+  if (l->range > 0.0f)
+    iris_warnf("light '%s': range %g ignored (Cycles lights have no range)", l->name ? l->name : name,
+               (double)l->range);
+  fputs("    dict(name=", fp);
+  put_bytes(fp, l->name ? l->name : name);
+  fprintf(fp, ", type=\"%s\", color=", TYPES[l->type <= IRIS_LIGHT_DIRECTIONAL ? l->type : 0]);
+  put_vec3(fp, l->color);
+  fputs(", strength=", fp);
+  put_float(fp, strength);
+  fputs(", position=", fp);
+  put_vec3(fp, l->position);
+  fputs(", direction=", fp);
+  put_vec3(fp, l->direction);
+  fputs(", cos_inner=", fp);
+  put_float(fp, cosf(inner));
+  fputs(", cos_outer=", fp);
+  put_float(fp, cosf(outer));
+  fputs("),\n", fp);
+}
+
+static void put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view) {
+  /* Cycles starts camera rays at clip_start: keep it far below any feature
+   * size. clip_end must reach past everything. */
+  iris_vec3 lo, hi, eye = iris_v3(view->to_world.m[0][3], view->to_world.m[1][3], view->to_world.m[2][3]);
+  float far = 1.0f, diag = 1.0f;
+  if (iris_scene_bounds(scene, &lo, &hi)) {
+    diag = fmaxf(iris_length(iris_sub(hi, lo)), 1e-6f);
+    iris_vec3 c = iris_scale(iris_add(lo, hi), 0.5f);
+    far = iris_length(iris_sub(c, eye)) + diag;
+  }
+  fputs("CAMERA = dict(name=", fp);
+  put_bytes(fp, view->camera >= 0 && scene->cameras[view->camera].name ? scene->cameras[view->camera].name
+                                                                       : "camera");
+  fputs(", yfov=", fp);
+  put_float(fp, view->yfov);
+  fputs(", clip_start=", fp);
+  put_float(fp, fmaxf(1e-6f, 1e-7f * diag));
+  fputs(", clip_end=", fp);
+  put_float(fp, 2.0f * far + 1.0f);
+  fputs(",\n              matrix=", fp);
+  put_matrix(fp, &view->to_world);
+  fputs(")\n", fp);
+}
+
+/* ---- the script ------------------------------------------------------------ */
+
+void iris_blender_sidecar_path(const char *script_path, char *out, size_t size) {
+  char dir[1024], stem[256], name[300];
+  iris_path_dir(script_path, dir, sizeof dir);
+  iris_path_stem(script_path, stem, sizeof stem);
+  snprintf(name, sizeof name, "%s.meshes.bin", stem);
+  iris_path_join(dir, name, out, size);
+}
+
+static bool mesh_has_degenerate(const iris_mesh *m) {
+  for (size_t t = 0; t < m->triangle_count; t++) {
+    const uint32_t *i = m->indices + 3 * t;
+    if (i[0] == i[1] || i[1] == i[2] || i[0] == i[2]) return true;
+  }
+  return false;
+}
+
+static iris_status write_script(FILE *fp, const iris_scene *scene, const char *script_path,
+                                const iris_export_params *params, const iris_export_view *view,
+                                const mesh_layout *lay, uint64_t blob_size, int32_t *mesh_variant,
+                                const material_variant *variants, size_t variant_count) {
+  char stem[256], sidecar[1300];
+  iris_path_stem(script_path, stem, sizeof stem);
+  iris_blender_sidecar_path(script_path, sidecar, sizeof sidecar);
+  char sidecar_name[300];
+  snprintf(sidecar_name, sizeof sidecar_name, "%s.meshes.bin", stem);
+
+  fprintf(fp,
+          "# Blender 3.4 scene written by iris %s from ",
+          IRIS_VERSION_STRING);
+  put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
+  fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
+        "# fair-comparison settings of iris's docs/export.md. Usage:\n"
+        "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
+        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n",
+        fp);
+  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
+    fputs(PRELUDE[i], fp);
+    fputc('\n', fp);
+  }
+
+  fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
+  fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view->width,
+          view->height, view->spp, view->max_depth, (unsigned long long)(view->seed & 0x7fffffffu));
+  if (scene->has_environment) {
+    fputs("WORLD = ", fp);
+    put_vec3(fp, scene->environment);
+    fputc('\n', fp);
+  } else {
+    fputs("WORLD = None\n", fp);
+  }
+
+  fputs("TEXTURES = [\n", fp);
+  for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, &scene->textures[i], i, stem);
+  fputs("]\nMATERIALS = [\n", fp);
+  for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i]);
+  fputs("]\nMESHES = [\n", fp);
+  for (size_t i = 0; i < scene->mesh_count; i++) {
+    const iris_mesh *m = &scene->meshes[i];
+    char name[32];
+    snprintf(name, sizeof name, "mesh.%zu", i);
+    fputs("    dict(name=", fp);
+    put_bytes(fp, m->name ? m->name : name);
+    fprintf(fp,
+            ", nv=%u, nt=%u, pos=%lld, nrm=%lld, uv=%lld, col=%lld, idx=%lld, material=%d, "
+            "validate=%s),\n",
+            m->vertex_count, m->triangle_count, (long long)lay[i].pos, (long long)lay[i].nrm,
+            (long long)lay[i].uv, (long long)lay[i].col, (long long)lay[i].idx, (int)mesh_variant[i],
+            mesh_has_degenerate(m) ? "True" : "False");
+  }
+  fputs("]\nINSTANCES = [\n", fp);
+  for (size_t i = 0; i < scene->instance_count; i++) {
+    fprintf(fp, "    (%u, ", scene->instances[i].mesh);
+    put_matrix(fp, &scene->instances[i].transform);
+    fputs("),\n", fp);
+  }
+  fputs("]\nLIGHTS = [\n", fp);
+  for (size_t i = 0; i < scene->light_count; i++) put_light(fp, &scene->lights[i], i);
+  fputs("]\n", fp);
+  put_camera(fp, scene, view);
+
+  fprintf(fp, "BLOB_SIZE = %llu\n", (unsigned long long)blob_size);
+  if (params->embed_meshes) {
+    fputs("SIDECAR = None\nBLOB = b\"", fp);
+    blob_sink sink = {fp, true, 0, {0}, 0};
+    write_blob(&sink, scene, lay);
+    fputs("\"\n", fp);
+  } else {
+    fputs("SIDECAR = ", fp);
+    put_bytes(fp, sidecar_name);
+    fputs("\nBLOB = None\n", fp);
+  }
+  fputs("\nmain()\n", fp);
+  return IRIS_OK;
+}
+
+iris_status iris_export_blender(const iris_scene *scene, const char *script_path,
+                                const iris_export_params *params, iris_error *err) {
+  const char *file = scene->source_path ? scene->source_path : script_path;
+  iris_status st = iris_scene_validate(scene, file, err);
+  if (st != IRIS_OK) return st;
+  iris_export_view view;
+  st = iris_export_resolve_view(scene, params, file, &view, err);
+  if (st != IRIS_OK) return st;
+
+  size_t nm = scene->mesh_count;
+  mesh_layout *lay = calloc(nm ? nm : 1, sizeof *lay);
+  int32_t *mesh_variant = calloc(nm ? nm : 1, sizeof *mesh_variant);
+  material_variant *variants = calloc(nm ? nm : 1, sizeof *variants);
+  if (!lay || !mesh_variant || !variants) {
+    st = iris_error_set(err, IRIS_ERR_NOMEM, script_path, 0, NULL, "out of memory");
+    goto done;
+  }
+  /* Variants in order of first use, so equal scenes give equal scripts. */
+  size_t variant_count = 0;
+  for (size_t i = 0; i < nm; i++) {
+    material_variant v = {scene->meshes[i].material, scene->meshes[i].colors != NULL};
+    size_t k = 0;
+    while (k < variant_count && !(variants[k].material == v.material && variants[k].vertex_colors == v.vertex_colors)) k++;
+    if (k == variant_count) variants[variant_count++] = v;
+    mesh_variant[i] = (int32_t)k;
+  }
+  uint64_t blob_size = layout_meshes(scene, lay);
+
+  st = write_textures(scene, script_path, err);
+  if (st != IRIS_OK) goto done;
+  if (!params->embed_meshes) {
+    char sidecar[1300];
+    iris_blender_sidecar_path(script_path, sidecar, sizeof sidecar);
+    iris_atomic_file af;
+    st = iris_atomic_open(&af, sidecar, err);
+    if (st != IRIS_OK) goto done;
+    blob_sink sink = {af.fp, false, 0, {0}, 0};
+    write_blob(&sink, scene, lay);
+    if (ferror(af.fp)) {
+      iris_atomic_abort(&af);
+      st = iris_error_set(err, IRIS_ERR_IO, sidecar, 0, NULL, "write failed: %s", strerror(errno));
+      goto done;
+    }
+    st = iris_atomic_commit(&af, err);
+    if (st != IRIS_OK) goto done;
+  }
+
+  iris_atomic_file af;
+  st = iris_atomic_open(&af, script_path, err);
+  if (st != IRIS_OK) goto done;
+  st = write_script(af.fp, scene, script_path, params, &view, lay, blob_size, mesh_variant, variants,
+                    variant_count);
+  if (st == IRIS_OK && ferror(af.fp))
+    st = iris_error_set(err, IRIS_ERR_IO, script_path, 0, NULL, "write failed: %s", strerror(errno));
+  if (st != IRIS_OK)
+    iris_atomic_abort(&af);
+  else
+    st = iris_atomic_commit(&af, err);
+
+done:
+  free(lay);
+  free(mesh_variant);
+  free(variants);
+  return st;
+}

@@ -1,0 +1,30 @@
+/* Blender exporter: writes a Python script for Blender 3.4 that builds the
+ * whole scene from an empty file (meshes, Cycles node materials, lights,
+ * camera, world) and renders it with the fair-comparison Cycles settings
+ * (docs/export.md). Mesh arrays go to a sidecar binary file next to the
+ * script, or are embedded in it (base64) when params->embed_meshes is set. */
+#ifndef IRIS_EXPORTERS_BLENDER_H
+#define IRIS_EXPORTERS_BLENDER_H
+
+#include "exporters/export.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Writes `script_path` (and "<stem>.meshes.bin" / "<stem>.textures/" next to
+ * it), all atomically. The script's usage:
+ *   blender -b --factory-startup --python-exit-code 1 -P SCRIPT -- --output OUT.exr
+ *           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]
+ * and it prints "IRIS_BLENDER build_seconds=.. render_seconds=.. ..." on stdout. */
+iris_status iris_export_blender(const iris_scene *scene, const char *script_path,
+                                const iris_export_params *params, iris_error *err);
+
+/* Path of the sidecar mesh file for a script path ("a/scene.py" -> "a/scene.meshes.bin"). */
+void iris_blender_sidecar_path(const char *script_path, char *out, size_t size);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,116 @@
+/* Export parameters resolved against a scene (exporters/export.h). */
+#include "exporters/export.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+iris_export_params iris_export_params_default(void) {
+  iris_export_params p;
+  memset(&p, 0, sizeof p);
+  p.max_depth = -1;
+  return p;
+}
+
+/* Unit-length columns; false when a column is degenerate or not finite. */
+static bool normalize_camera(const iris_mat4 *in, iris_mat4 *out) {
+  *out = *in;
+  if (!iris_mat4_is_finite(in)) return false;
+  for (int c = 0; c < 3; c++) {
+    iris_vec3 v = iris_v3(in->m[0][c], in->m[1][c], in->m[2][c]);
+    float len = iris_length(v);
+    if (!(len > 1e-12f)) return false;
+    for (int r = 0; r < 3; r++) out->m[r][c] = in->m[r][c] / len;
+  }
+  out->m[3][0] = out->m[3][1] = out->m[3][2] = 0.0f;
+  out->m[3][3] = 1.0f;
+  return true;
+}
+
+iris_status iris_export_resolve_view(const iris_scene *scene, const iris_export_params *params,
+                                     const char *file, iris_export_view *view, iris_error *err) {
+  memset(view, 0, sizeof *view);
+  view->camera = -1;
+  if (params->camera_name && *params->camera_name) {
+    for (size_t i = 0; i < scene->camera_count; i++)
+      if (scene->cameras[i].name && strcmp(scene->cameras[i].name, params->camera_name) == 0) {
+        view->camera = (int32_t)i;
+        break;
+      }
+    if (view->camera < 0)
+      return iris_error_set(err, IRIS_ERR_USAGE, file, 0, NULL, "no camera named '%s' (%zu cameras)",
+                            params->camera_name, scene->camera_count);
+  } else if (scene->camera_count > 0) {
+    view->camera = 0;
+  }
+
+  /* Mirrors renderer/camera.c (iris_pinhole_setup) so that an export frames
+   * exactly what `iris render` frames; tests/exporters checks the two agree. */
+  const iris_camera *cam = view->camera >= 0 ? &scene->cameras[view->camera] : NULL;
+  float aspect = 1.0f;
+  if (cam && cam->aspect > 0.0f)
+    aspect = cam->aspect;
+  else if (scene->render.width > 0 && scene->render.height > 0)
+    aspect = (float)scene->render.width / (float)scene->render.height;
+  int w = params->width, h = params->height;
+  if (w <= 0 && h <= 0 && scene->render.width > 0 && scene->render.height > 0) {
+    w = scene->render.width;
+    h = scene->render.height;
+  }
+  if (w <= 0 && h <= 0) h = IRIS_EXPORT_DEFAULT_HEIGHT;
+  if (w <= 0) w = (int)lroundf((float)h * aspect);
+  if (h <= 0) h = (int)lroundf((float)w / aspect);
+  view->width = w < 1 ? 1 : w;
+  view->height = h < 1 ? 1 : h;
+
+  if (cam) {
+    char element[64];
+    snprintf(element, sizeof element, "cameras[%d]", view->camera);
+    if (!normalize_camera(&cam->to_world, &view->to_world))
+      return iris_error_set(err, IRIS_ERR_INVALID, file, 0, element, "degenerate camera matrix");
+    if (!(cam->yfov > 0.0f && cam->yfov < IRIS_PI))
+      return iris_error_set(err, IRIS_ERR_INVALID, file, 0, element,
+                            "vertical field of view %g is not in (0, pi)", (double)cam->yfov);
+    view->yfov = cam->yfov;
+  } else {
+    /* No camera: frame the bounding sphere from +Z, looking along -Z. */
+    iris_vec3 lo, hi;
+    if (!iris_scene_bounds(scene, &lo, &hi)) {
+      lo = iris_v3(-1, -1, -1);
+      hi = iris_v3(1, 1, 1);
+    }
+    iris_vec3 c = iris_scale(iris_add(lo, hi), 0.5f);
+    float r = 0.5f * iris_length(iris_sub(hi, lo));
+    if (!(r > 0.0f)) r = 1.0f;
+    view->yfov = IRIS_EXPORT_FRAMING_YFOV;
+    float half_y = 0.5f * view->yfov;
+    float half_x = atanf(tanf(half_y) * ((float)view->width / (float)view->height));
+    float dist = r / sinf(fminf(half_y, half_x));
+    view->to_world = iris_mat4_identity();
+    view->to_world.m[0][3] = c.x;
+    view->to_world.m[1][3] = c.y;
+    view->to_world.m[2][3] = c.z + dist;
+  }
+
+  view->spp = params->spp > 0 ? params->spp
+                              : (scene->render.spp > 0 ? scene->render.spp : IRIS_EXPORT_DEFAULT_SPP);
+  view->max_depth = params->max_depth >= 0
+                        ? params->max_depth
+                        : (scene->render.max_depth >= 0 ? scene->render.max_depth : IRIS_EXPORT_DEFAULT_DEPTH);
+  view->seed = params->has_seed ? params->seed : (scene->render.has_seed ? scene->render.seed : 0);
+  return IRIS_OK;
+}
+
+float iris_export_triangle_area(const iris_mesh *m, uint32_t t, const iris_mat4 *x) {
+  const uint32_t *ix = m->indices + 3 * (size_t)t;
+  iris_vec3 a = iris_mat4_point(x, iris_v3_load(m->positions + 3 * (size_t)ix[0]));
+  iris_vec3 b = iris_mat4_point(x, iris_v3_load(m->positions + 3 * (size_t)ix[1]));
+  iris_vec3 c = iris_mat4_point(x, iris_v3_load(m->positions + 3 * (size_t)ix[2]));
+  return 0.5f * iris_length(iris_cross(iris_sub(b, a), iris_sub(c, a)));
+}
+
+bool iris_export_material_emits(const iris_scene *scene, int32_t material) {
+  if (material < 0 || (size_t)material >= scene->material_count) return false;
+  const float *e = scene->materials[material].emission;
+  return e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
+}

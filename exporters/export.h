@@ -1,0 +1,64 @@
+/* What the Blender and POV-Ray exporters share: the export parameters (which
+ * camera, image size, sampling) and their resolution against a scene into one
+ * concrete view, so that both exporters and iris's own render frame the scene
+ * identically. docs/export.md describes every default. */
+#ifndef IRIS_EXPORTERS_EXPORT_H
+#define IRIS_EXPORTERS_EXPORT_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct iris_export_params {
+  const char *camera_name; /* NULL: the scene's first camera (or a framing camera if none) */
+  int width, height;       /* <= 0: scene render settings, else IRIS_EXPORT_DEFAULT_HEIGHT high\n                              and as wide as the camera aspect (as `iris render`) */
+  int spp;                 /* 0: scene render settings, then IRIS_EXPORT_DEFAULT_SPP */
+  int max_depth;           /* -1: scene render settings, then IRIS_EXPORT_DEFAULT_DEPTH */
+  uint64_t seed;
+  bool has_seed;           /* false: scene render settings, then 0 */
+  bool embed_meshes;       /* blender: mesh data inside the script instead of a sidecar file */
+  bool coverage;           /* pov: every object pure white emitter, black background, no lights */
+} iris_export_params;
+
+#define IRIS_EXPORT_DEFAULT_HEIGHT 512
+#define IRIS_EXPORT_DEFAULT_SPP 64
+#define IRIS_EXPORT_DEFAULT_DEPTH 64
+/* Vertical field of view of the framing camera used when a scene has none. */
+#define IRIS_EXPORT_FRAMING_YFOV 0.6981317f /* 40 degrees */
+
+iris_export_params iris_export_params_default(void);
+
+/* The concrete view an export renders: an orthonormal camera-to-world matrix
+ * (scale removed), the vertical field of view and the image size. */
+typedef struct iris_export_view {
+  iris_mat4 to_world; /* camera looks along local -Z, +Y up */
+  float yfov;
+  int width, height;
+  int spp;
+  int max_depth;
+  uint64_t seed;
+  int32_t camera; /* index into scene->cameras, -1 for the framing camera */
+} iris_export_view;
+
+/* Resolves params against the scene exactly as `iris render` does (camera
+ * choice, resolution, automatic framing of camera-less scenes). Fails
+ * (IRIS_ERR_USAGE) when camera_name names no camera and (IRIS_ERR_INVALID)
+ * when the camera is degenerate. `file` names the scene in messages. */
+iris_status iris_export_resolve_view(const iris_scene *scene, const iris_export_params *params,
+                                     const char *file, iris_export_view *view, iris_error *err);
+
+/* World-space area of triangle t of mesh m under transform x. */
+float iris_export_triangle_area(const iris_mesh *m, uint32_t t, const iris_mat4 *x);
+
+/* True when the material emits (any emission component > 0). */
+bool iris_export_material_emits(const iris_scene *scene, int32_t material);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
