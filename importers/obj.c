@@ -134,10 +134,12 @@ static const char *line_end(const char *p, const char *end) {
   return e ? e : end;
 }
 
-/* Strips a trailing comment. */
+/* Strips a trailing comment: a '#' at the start or after white space (so
+ * MSVC's "1.#IND" stays a number, to be rejected as non-finite). */
 static const char *strip_comment(const char *p, const char *e) {
-  const char *h = memchr(p, '#', (size_t)(e - p));
-  return h ? h : e;
+  for (const char *h = p; (h = memchr(h, '#', (size_t)(e - h))) != NULL; h++)
+    if (h == p || iris_np_is_space(h[-1])) return h;
+  return e;
 }
 
 static bool parse_floats(const char **pp, const char *end, float *out, int max, int *count) {
