@@ -19,6 +19,7 @@
 #include <OpenEXR/openexr.h>
 #include <stb_image.h>
 
+#include "core/exr_imf.h"
 #include "core/fileio.h"
 
 /* Limits that keep a corrupt or hostile header from asking for unbounded memory. */
@@ -259,16 +260,26 @@ iris_status iris_exr_write(const char *path, const iris_image *img, const iris_i
 
 /* -------------------------------------------------------- EXR reading */
 
-/* Points the decoder's channels at the float image for a block whose top-left
- * pixel is (x0, y0). */
-static void exr_point_channels(exr_decode_pipeline_t *dec, iris_image *img, int x0, int y0) {
-  const size_t pixel_stride = (size_t)img->channel_count * sizeof(float);
+/* Decoding goes into a buffer with one spare float per pixel (stride C + 1).
+ * OpenEXRCore 3.1 picks hand-written unpackers for 3- and 4-channel half data
+ * written "simply interleaved", and its 4-channel one puts the channels in the
+ * wrong slots (it assumes R,G,B,A order while the file order is A,B,G,R).
+ * With the spare float no special case matches and the generic, per-channel
+ * unpacker runs; the padding is squeezed out afterwards. */
+typedef struct exr_target {
+  float *data; /* width * height * (channel_count + 1) */
+  int width, height, channel_count;
+} exr_target;
+
+/* Points the decoder's channels at the target for a block whose top-left
+ * pixel is (x0, y0). Channels are decoded in header order, which is ours. */
+static void exr_point_channels(exr_decode_pipeline_t *dec, const exr_target *t, int x0, int y0) {
+  const size_t stride = (size_t)t->channel_count + 1;
   for (int k = 0; k < dec->channel_count; k++) {
     exr_coding_channel_info_t *ch = &dec->channels[k];
-    /* Channels are read in header order, which is ours. */
-    ch->decode_to_ptr = (uint8_t *)&img->data[((size_t)y0 * (size_t)img->width + (size_t)x0) * (size_t)img->channel_count + (size_t)k];
-    ch->user_pixel_stride = (int32_t)pixel_stride;
-    ch->user_line_stride = (int32_t)(pixel_stride * (size_t)img->width);
+    ch->decode_to_ptr = (uint8_t *)&t->data[((size_t)y0 * (size_t)t->width + (size_t)x0) * stride + (size_t)k];
+    ch->user_pixel_stride = (int32_t)(stride * sizeof(float));
+    ch->user_line_stride = (int32_t)(stride * sizeof(float) * (size_t)t->width);
     ch->user_bytes_per_element = 4;
     ch->user_data_type = EXR_PIXEL_FLOAT;
   }
@@ -276,7 +287,7 @@ static void exr_point_channels(exr_decode_pipeline_t *dec, iris_image *img, int 
 
 /* Decodes one chunk whose pixels start at (x0, y0) of the image. */
 static exr_result_t exr_decode_chunk(exr_context_t ctx, const exr_chunk_info_t *cinfo,
-                                     exr_decode_pipeline_t *dec, bool *started, iris_image *img,
+                                     exr_decode_pipeline_t *dec, bool *started, const exr_target *img,
                                      int x0, int y0) {
   if (cinfo->width <= 0 || cinfo->height <= 0 || x0 < 0 || y0 < 0 || cinfo->width > img->width - x0 ||
       cinfo->height > img->height - y0)
@@ -297,7 +308,7 @@ static exr_result_t exr_decode_chunk(exr_context_t ctx, const exr_chunk_info_t *
 }
 
 static iris_status exr_read_pixels(exr_context_t ctx, exr_storage_t storage, const char *path,
-                                   const exr_stream *s, iris_image *img, iris_error *err) {
+                                   const exr_stream *s, const exr_target *img, iris_error *err) {
   exr_decode_pipeline_t dec = EXR_DECODE_PIPELINE_INITIALIZER;
   bool started = false;
   exr_result_t rv = EXR_ERR_SUCCESS;
@@ -456,7 +467,26 @@ iris_status iris_exr_read(const char *path, iris_image *img, iris_image_meta **m
     if (err) snprintf(err->file, sizeof err->file, "%s", path);
     goto done;
   }
-  st = exr_read_pixels(ctx, storage, path, &s, img, err);
+  exr_compression_t comp = EXR_COMPRESSION_NONE;
+  exr_get_compression(ctx, 0, &comp);
+  if (comp == EXR_COMPRESSION_DWAA || comp == EXR_COMPRESSION_DWAB) {
+    /* OpenEXRCore 3.1 has no DWA decoder; the C++ library has. */
+    char msg[256] = "";
+    if (iris_exr_imf_read_pixels(path, img->width, img->height, img->channel_count, names, img->data, msg,
+                                 sizeof msg) != 0)
+      st = iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "corrupt EXR pixel data: %s", msg);
+  } else {
+    const size_t pixels = (size_t)img->width * (size_t)img->height, nc = (size_t)img->channel_count;
+    exr_target t = {calloc(pixels * (nc + 1), sizeof(float)), img->width, img->height, img->channel_count};
+    if (!t.data) {
+      st = iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory for EXR pixels");
+    } else {
+      st = exr_read_pixels(ctx, storage, path, &s, &t, err);
+      for (size_t p = 0; p < pixels && st == IRIS_OK; p++)
+        memcpy(&img->data[p * nc], &t.data[p * (nc + 1)], nc * sizeof(float));
+      free(t.data);
+    }
+  }
   if (st == IRIS_OK && meta && meta_count) st = exr_read_meta(ctx, path, meta, meta_count, err);
   if (st != IRIS_OK) iris_image_destroy(img);
 done:
