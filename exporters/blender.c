@@ -7,12 +7,10 @@
 #include "exporters/blender.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "core/fileio.h"
 #include "core/log.h"
@@ -674,51 +672,10 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v) 
 
 /* ---- textures -------------------------------------------------------------- */
 
-static void texture_file_ext(const iris_texture *t, char *out, size_t size) {
-  snprintf(out, size, "%s", strcmp(t->mime, "image/jpeg") == 0 ? "jpg" : "png");
-}
-
-/* In-memory textures become "<stem>.textures/<i>.<ext>" next to the script. */
-static iris_status write_textures(const iris_scene *scene, const char *script_path, iris_error *err) {
-  char dir[1024], stem[256], tdir[1400], path[1600], ext[8];
-  iris_path_dir(script_path, dir, sizeof dir);
-  iris_path_stem(script_path, stem, sizeof stem);
-  snprintf(path, sizeof path, "%s.textures", stem);
-  iris_path_join(dir, path, tdir, sizeof tdir);
-  bool made = false;
-  for (size_t i = 0; i < scene->texture_count; i++) {
-    const iris_texture *t = &scene->textures[i];
-    if (t->path) continue;
-    if (!made) {
-      iris_status st = iris_mkdir_p(tdir, err);
-      if (st != IRIS_OK) return st;
-      made = true;
-    }
-    texture_file_ext(t, ext, sizeof ext);
-    char name[32];
-    snprintf(name, sizeof name, "%zu.%s", i, ext);
-    iris_path_join(tdir, name, path, sizeof path);
-    iris_status st = iris_file_write_atomic(path, t->data, t->data_size, err);
-    if (st != IRIS_OK) return st;
-  }
-  return IRIS_OK;
-}
-
-static void put_texture(FILE *fp, const iris_texture *t, size_t index, const char *stem) {
-  char path[PATH_MAX + 64];
-  if (t->path) {
-    /* Absolute, so the script can be run from anywhere. */
-    char cwd[PATH_MAX];
-    if (t->path[0] != '/' && getcwd(cwd, sizeof cwd))
-      iris_path_join(cwd, t->path, path, sizeof path);
-    else
-      snprintf(path, sizeof path, "%s", t->path);
-    if (!iris_path_exists(path)) iris_warnf("texture '%s' not found (the Blender script refers to it anyway)", path);
-  } else {
-    char ext[8];
-    texture_file_ext(t, ext, sizeof ext);
-    snprintf(path, sizeof path, "%s.textures/%zu.%s", stem, index, ext);
-  }
+static void put_texture(FILE *fp, const iris_scene *scene, size_t index, const char *script_path) {
+  const iris_texture *t = &scene->textures[index];
+  char path[2048];
+  iris_export_texture_file(scene, index, script_path, false, path, sizeof path);
   fputs("    dict(path=", fp);
   put_bytes(fp, path);
   fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s),\n", wrap_name(t->wrap_s),
@@ -835,7 +792,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   }
 
   fputs("TEXTURES = [\n", fp);
-  for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, &scene->textures[i], i, stem);
+  for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, scene, i, script_path);
   fputs("]\nMATERIALS = [\n", fp);
   for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i]);
   fputs("]\nMESHES = [\n", fp);
@@ -906,7 +863,7 @@ iris_status iris_export_blender(const iris_scene *scene, const char *script_path
   }
   uint64_t blob_size = layout_meshes(scene, lay);
 
-  st = write_textures(scene, script_path, err);
+  st = iris_export_write_textures(scene, script_path, err);
   if (st != IRIS_OK) goto done;
   if (!params->embed_meshes) {
     char sidecar[1300];

@@ -3,7 +3,12 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <limits.h>
 #include <string.h>
+#include <unistd.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
 
 iris_export_params iris_export_params_default(void) {
   iris_export_params p;
@@ -113,4 +118,71 @@ bool iris_export_material_emits(const iris_scene *scene, int32_t material) {
   if (material < 0 || (size_t)material >= scene->material_count) return false;
   const float *e = scene->materials[material].emission;
   return e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f;
+}
+
+static const char *texture_ext(const iris_texture *t) {
+  return strcmp(t->mime, "image/jpeg") == 0 ? "jpg" : "png";
+}
+
+/* "<dir>/<stem>.textures" for an exported file. */
+static void textures_dir(const char *out_path, char *out, size_t size) {
+  char dir[1024], stem[256], name[300];
+  iris_path_dir(out_path, dir, sizeof dir);
+  iris_path_stem(out_path, stem, sizeof stem);
+  snprintf(name, sizeof name, "%s.textures", stem);
+  iris_path_join(dir, name, out, size);
+}
+
+/* Absolute form of a path (relative ones are taken from the working folder). */
+static void absolute_path(const char *path, char *out, size_t size) {
+  char cwd[PATH_MAX];
+  if (path[0] != '/' && getcwd(cwd, sizeof cwd))
+    iris_path_join(cwd, path, out, size);
+  else
+    snprintf(out, size, "%s", path);
+}
+
+iris_status iris_export_write_textures(const iris_scene *scene, const char *out_path, iris_error *err) {
+  char tdir[1400], path[1600], name[32];
+  textures_dir(out_path, tdir, sizeof tdir);
+  bool made = false;
+  for (size_t i = 0; i < scene->texture_count; i++) {
+    const iris_texture *t = &scene->textures[i];
+    if (t->path) continue;
+    if (!made) {
+      iris_status st = iris_mkdir_p(tdir, err);
+      if (st != IRIS_OK) return st;
+      made = true;
+    }
+    snprintf(name, sizeof name, "%zu.%s", i, texture_ext(t));
+    iris_path_join(tdir, name, path, sizeof path);
+    iris_status st = iris_file_write_atomic(path, t->data, t->data_size, err);
+    if (st != IRIS_OK) return st;
+  }
+  return IRIS_OK;
+}
+
+bool iris_export_texture_file(const iris_scene *scene, size_t i, const char *out_path, bool absolute,
+                              char *buf, size_t size) {
+  const iris_texture *t = &scene->textures[i];
+  if (t->path) {
+    absolute_path(t->path, buf, size);
+    if (!iris_path_exists(buf)) {
+      iris_warnf("texture '%s' not found (the export refers to it anyway)", buf);
+      return false;
+    }
+    return true;
+  }
+  char stem[256], rel[400], tdir[1400];
+  if (absolute) {
+    textures_dir(out_path, tdir, sizeof tdir);
+    snprintf(rel, sizeof rel, "%zu.%s", i, texture_ext(t));
+    char joined[1800];
+    iris_path_join(tdir, rel, joined, sizeof joined);
+    absolute_path(joined, buf, size);
+  } else {
+    iris_path_stem(out_path, stem, sizeof stem);
+    snprintf(buf, size, "%s.textures/%zu.%s", stem, i, texture_ext(t));
+  }
+  return true;
 }

@@ -58,6 +58,16 @@ float iris_export_triangle_area(const iris_mesh *m, uint32_t t, const iris_mat4 
 /* True when the material emits (any emission component > 0). */
 bool iris_export_material_emits(const iris_scene *scene, int32_t material);
 
+/* In-memory textures (glTF data URIs, GLB buffer views) become files
+ * "<stem>.textures/<i>.png|jpg" next to the exported file `out_path`. */
+iris_status iris_export_write_textures(const iris_scene *scene, const char *out_path, iris_error *err);
+/* The file of texture i as an export refers to it: file textures by their
+ * absolute path, in-memory ones by "<stem>.textures/<i>.<ext>", relative to
+ * the exported file's folder or (absolute = true) made absolute. Returns false
+ * (after a warning) when a file texture does not exist. */
+bool iris_export_texture_file(const iris_scene *scene, size_t i, const char *out_path, bool absolute,
+                              char *buf, size_t size);
+
 #ifdef __cplusplus
 }
 #endif
