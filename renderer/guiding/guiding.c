@@ -24,7 +24,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   iris_guiding_params p;
   memset(&p, 0, sizeof p);
   p.pdf_floor = -1.0f;
-  p.alpha_max = 0.9f;
+  p.alpha_max = 0.5f; /* thesis: 0.9; measured in docs/guiding.md */
   p.cos_min = 0.9f;
   p.splat = IRIS_SPLAT_NEAREST;
   return p;

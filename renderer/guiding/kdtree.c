@@ -51,8 +51,9 @@ static void build_range(build_ctx *c, uint32_t lo, uint32_t hi) {
     float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = lo; i < hi; ++i) {
       for (int k = 0; k < 3; ++k) {
-        mn[k] = fminf(mn[k], c->p[3 * i + k]);
-        mx[k] = fmaxf(mx[k], c->p[3 * i + k]);
+        float v = c->p[3 * i + k]; /* plain compares: fminf is a libm call here */
+        mn[k] = v < mn[k] ? v : mn[k];
+        mx[k] = v > mx[k] ? v : mx[k];
       }
     }
     int ax = 0;
