@@ -369,6 +369,8 @@ int main(int argc, char **argv) {
   const char *shuffled[] = {"var.B", "Z", "albedo.G", "B", "A", "R", "G", "N.x"};
   test_exr_round_trip(1, 1, 1, five, 4);
   test_exr_round_trip(37, 23, 5, five, 4);
+  test_exr_round_trip(13, 11, 4, five, 1); /* RGBA: the layout with special-cased (un)packers */
+  test_exr_round_trip(7, 5, 3, five, 1);
   test_exr_round_trip(64, 17, 8, shuffled, 2); /* 17 rows: a partial 16-line ZIP chunk */
   test_exr_round_trip(301, 2, 4, shuffled, 0);
   test_exr_round_trip(3, 200, 2, shuffled + 6, 1);

@@ -181,19 +181,19 @@ static void test_read_foreign(void) {
   }
 }
 
-static void test_write_for_foreign(void) {
+static void test_write_for_foreign(int nc) {
   const char *names[] = {"R", "G", "B", "A", "var.R"};
   iris_image img;
   iris_error err;
   iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, 29, 18, 5, names, &err), &err);
+  CHECK_OK(iris_image_create(&img, 29, 18, nc, names, &err), &err);
   if (!img.data) return;
   for (int y = 0; y < 18; y++)
     for (int x = 0; x < 29; x++)
-      for (int c = 0; c < 5; c++) img.data[(y * 29 + x) * 5 + c] = (float)(x * 0.5 - y * 0.25 + c * 10) / 7.0f;
+      for (int c = 0; c < nc; c++) img.data[(y * 29 + x) * nc + c] = (float)(x * 0.5 - y * 0.25 + c * 10) / 7.0f;
   iris_image_meta meta = {"iris:renderer", "iris test"};
   char path[700], cmd[1600], line[2048];
-  snprintf(path, sizeof path, "%s/by_iris.exr", dir);
+  snprintf(path, sizeof path, "%s/by_iris_%d.exr", dir, nc);
   CHECK_OK(iris_exr_write(path, &img, &meta, 1, &err), &err);
   dump d;
   if (iris_check_record(read_dump(path, &d) == 0, __FILE__, __LINE__, "oiiotool cannot read iris's EXR")) {
@@ -223,7 +223,7 @@ int main(int argc, char **argv) {
     return 1;
   }
   test_read_foreign();
-  test_write_for_foreign();
+  for (int nc = 3; nc <= 5; nc++) test_write_for_foreign(nc);
   iris_test_rmtree(dir);
   return TEST_SUMMARY();
 }
