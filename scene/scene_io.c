@@ -13,6 +13,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/fileio.h"
 #include "core/log.h"
@@ -368,6 +369,14 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
       st = iris_file_write_atomic(json_path, text, n + 1, err);
       free(text);
     }
+  }
+  /* Mesh files of an earlier, larger scene written under the same name are
+   * removed once the new JSON is in place (never before: a failed write keeps
+   * the old scene whole). */
+  for (size_t i = scene->mesh_count; st == IRIS_OK; i++) {
+    snprintf(file, sizeof file, "%s.meshes/%zu.irmesh", stem, i);
+    iris_path_join(dir, file, path, sizeof path);
+    if (unlink(path) != 0) break;
   }
   cJSON_Delete(root);
   return st;

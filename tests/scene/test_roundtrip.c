@@ -191,6 +191,22 @@ static void test_rich_scene(void) {
     snprintf(pb, sizeof pb, "%s/b/%s", dir, files[i]);
     CHECK(fixture_same_file(pa, pb));
   }
+  /* Rewriting a smaller scene under the same name removes the stale mesh files. */
+  iris_scene *small = iris_scene_create();
+  iris_mesh tri = fixture_triangle("t");
+  iris_scene_add_mesh(small, &tri);
+  char stale[800];
+  snprintf(stale, sizeof stale, "%s/b/scene.meshes/1.irmesh", dir);
+  CHECK(iris_path_exists(stale));
+  char c_json[700];
+  snprintf(c_json, sizeof c_json, "%s/b/scene.json", dir);
+  CHECK_OK(iris_scene_write(small, c_json, &err), &err);
+  CHECK(!iris_path_exists(stale));
+  stale[strlen(stale) - 8] = '0';
+  CHECK(iris_path_exists(stale));
+  iris_scene_destroy(small);
+  CHECK_OK(iris_scene_write(loaded, b_json, &err), &err);
+
   iris_scene *again = NULL;
   CHECK_OK(iris_scene_load(b_json, &again, &err), &err);
   if (again) compare_scenes(s, again);
