@@ -301,6 +301,7 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
     cJSON *a = cJSON_AddArrayToObject(root, "textures");
     for (size_t i = 0; i < scene->texture_count && st == IRIS_OK; i++) {
       const iris_texture *t = &scene->textures[i];
+      file[0] = '\0';
       st = write_texture_file(t, i, dir, dir_abs, stem, scene_name, file, sizeof file, err);
       cJSON *o = cJSON_CreateObject();
       if (t->name) cJSON_AddStringToObject(o, "name", t->name);
