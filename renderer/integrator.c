@@ -174,7 +174,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
         float w = 1.0f;
         if (!prev_delta && nee)
-          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, ray.d)) : 0.0f;
+          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, ray.d)) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
       }
       break;

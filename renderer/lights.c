@@ -27,6 +27,151 @@ static float spot_falloff(const iris_light *l, iris_vec3 travel) {
   return a * a;
 }
 
+/* Groups: consecutive triangle entries of one instance (or all triangles when
+ * there would be too many groups), and one group per other light. */
+static iris_status build_groups(iris_lights *L, iris_error *err) {
+  size_t tri_groups = 0, others = 0;
+  uint32_t prev = UINT32_MAX;
+  for (size_t i = 0; i < L->count; i++) {
+    if (L->entries[i].kind != IRIS_LIGHT_KIND_TRIANGLE) {
+      others++;
+    } else if (L->entries[i].group != prev) {
+      tri_groups++;
+      prev = L->entries[i].group;
+    }
+  }
+  bool merge = tri_groups + others > IRIS_LIGHTS_MAX_GROUPS;
+  if (merge && tri_groups > 0) tri_groups = 1;
+  L->groups = calloc(tri_groups + others, sizeof *L->groups);
+  if (!L->groups) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for light groups");
+  size_t g = 0;
+  prev = UINT32_MAX;
+  for (size_t i = 0; i < L->count; i++) {
+    iris_light_entry *e = &L->entries[i];
+    bool tri = e->kind == IRIS_LIGHT_KIND_TRIANGLE;
+    bool start = !tri || g == 0 || L->groups[g - 1].kind != IRIS_LIGHT_KIND_TRIANGLE ||
+                 (!merge && e->group != prev);
+    if (tri) prev = e->group;
+    if (start) {
+      L->groups[g].first = (uint32_t)i;
+      L->groups[g].kind = e->kind;
+      g++;
+    }
+    iris_light_group *gr = &L->groups[g - 1];
+    gr->count++;
+    gr->power += e->power;
+    e->group = (uint32_t)(g - 1);
+  }
+  L->group_count = g;
+  for (size_t k = 0; k < g; k++) {
+    iris_light_group *gr = &L->groups[k];
+    const iris_light_entry *e0 = &L->entries[gr->first];
+    switch (gr->kind) {
+      case IRIS_LIGHT_KIND_TRIANGLE: {
+        iris_vec3 lo = iris_v3(INFINITY, INFINITY, INFINITY), hi = iris_neg(lo);
+        for (uint32_t i = gr->first; i < gr->first + gr->count; i++) {
+          iris_vec3 v[3];
+          iris_accel_triangle(L->accel, L->entries[i].prim, v);
+          for (int j = 0; j < 3; j++) {
+            lo = iris_v3(fminf(lo.x, v[j].x), fminf(lo.y, v[j].y), fminf(lo.z, v[j].z));
+            hi = iris_v3(fmaxf(hi.x, v[j].x), fmaxf(hi.y, v[j].y), fmaxf(hi.z, v[j].z));
+          }
+        }
+        gr->center = iris_scale(iris_add(lo, hi), 0.5f);
+        gr->radius = 0.5f * iris_length(iris_sub(hi, lo));
+        break;
+      }
+      case IRIS_LIGHT_KIND_POINT:
+      case IRIS_LIGHT_KIND_SPOT:
+        gr->center = iris_v3_load(L->scene->lights[e0->prim].position);
+        gr->radius = 0.0f;
+        break;
+      case IRIS_LIGHT_KIND_DIRECTIONAL:
+        gr->irradiance = luminance(e0->radiance);
+        break;
+      case IRIS_LIGHT_KIND_ENVIRONMENT:
+      default:
+        gr->irradiance = IRIS_PI * luminance(e0->radiance);
+        break;
+    }
+    if (gr->count > 1) {
+      float *w = malloc(sizeof(float) * gr->count);
+      if (!w) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for light groups");
+      for (uint32_t i = 0; i < gr->count; i++) w[i] = L->entries[gr->first + i].power;
+      iris_status st = iris_distrib1d_create(&gr->select, w, gr->count, err);
+      free(w);
+      if (st != IRIS_OK) return st;
+    }
+  }
+  return IRIS_OK;
+}
+
+/* Estimated irradiance of each group at ref (the selection weights); returns the sum. */
+static double group_weights(const iris_lights *L, iris_vec3 ref, float *w) {
+  double sum = 0.0;
+  for (size_t k = 0; k < L->group_count; k++) {
+    const iris_light_group *g = &L->groups[k];
+    float v;
+    if (g->kind == IRIS_LIGHT_KIND_DIRECTIONAL || g->kind == IRIS_LIGHT_KIND_ENVIRONMENT) {
+      v = g->irradiance;
+    } else {
+      iris_vec3 d = iris_sub(g->center, ref);
+      float d2 = fmaxf(iris_dot(d, d), g->radius * g->radius);
+      d2 = fmaxf(d2, 1e-12f);
+      /* triangles: power / (4 pi d^2); point and spot: I / d^2 = power_point / (4 pi d^2) */
+      float phi = g->kind == IRIS_LIGHT_KIND_TRIANGLE ? g->power
+                                                       : 4.0f * IRIS_PI * luminance(L->entries[g->first].radiance);
+      v = phi / (4.0f * IRIS_PI * d2);
+    }
+    w[k] = isfinite(v) && v > 0.0f ? v : 0.0f;
+    sum += w[k];
+  }
+  return sum;
+}
+
+static float entry_pmf_in_group(const iris_lights *L, uint32_t index) {
+  const iris_light_group *g = &L->groups[L->entries[index].group];
+  return g->count > 1 ? iris_distrib1d_pmf(&g->select, index - g->first) : 1.0f;
+}
+
+float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t index) {
+  if (index >= L->count) return 0.0f;
+  float w[IRIS_LIGHTS_MAX_GROUPS + 1];
+  double sum = group_weights(L, ref, w);
+  if (!(sum > 0.0)) return 0.0f;
+  return (float)(w[L->entries[index].group] / sum) * entry_pmf_in_group(L, index);
+}
+
+/* Two-step choice at ref; returns the entry and its probability. */
+static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf) {
+  float w[IRIS_LIGHTS_MAX_GROUPS + 1];
+  double sum = group_weights(L, ref, w);
+  *pmf = 0.0f;
+  if (!(sum > 0.0)) return 0;
+  double target = (double)u * sum, acc = 0.0;
+  size_t k = 0, last = 0;
+  for (; k < L->group_count; k++) {
+    if (w[k] > 0.0f) last = k;
+    if (w[k] > 0.0f && acc + w[k] > target) break;
+    acc += w[k];
+  }
+  if (k == L->group_count) { /* rounding: the last group with weight */
+    k = last;
+    acc = sum - w[k];
+  }
+  const iris_light_group *g = &L->groups[k];
+  float pg = (float)(w[k] / sum);
+  uint32_t index = g->first;
+  float pe = 1.0f;
+  if (g->count > 1) {
+    float ur = (float)((target - acc) / w[k]);
+    ur = iris_clampf(ur, 0.0f, 0x1.fffffep-1f);
+    index = g->first + (uint32_t)iris_distrib1d_sample(&g->select, ur, &pe, NULL);
+  }
+  *pmf = pg * pe;
+  return index;
+}
+
 iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                               const iris_textures *textures, iris_lights *out, iris_error *err) {
   memset(out, 0, sizeof *out);
@@ -67,6 +212,11 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     iris_light_entry *e = &out->entries[n];
     e->kind = IRIS_LIGHT_KIND_TRIANGLE;
     e->prim = t;
+    {
+      iris_interaction c;
+      iris_accel_surface_at(accel, t, 0.0f, 0.0f, &c);
+      e->group = c.instance; /* provisional: the instance, turned into a group below */
+    }
     e->area = area;
     e->two_sided = m->emission_two_sided;
     e->radiance = iris_v3_load(m->emission);
@@ -109,6 +259,10 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     n++;
   }
   out->count = n;
+  if (n > 0 && build_groups(out, err) != IRIS_OK) {
+    iris_lights_destroy(out);
+    return err ? err->status : IRIS_ERR_NOMEM;
+  }
   if (n > 0) {
     float *w = malloc(sizeof(float) * n);
     if (!w) {
@@ -133,6 +287,10 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
 
 void iris_lights_destroy(iris_lights *lights) {
   if (!lights) return;
+  for (size_t k = 0; k < lights->group_count; k++) iris_distrib1d_destroy(&lights->groups[k].select);
+  free(lights->groups);
+  lights->groups = NULL;
+  lights->group_count = 0;
   free(lights->entries);
   free(lights->light_of_prim);
   iris_distrib1d_destroy(&lights->select);
@@ -176,7 +334,7 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
                         float u1, iris_light_sample *s) {
   if (lights->count == 0) return false;
   float pmf;
-  uint32_t i = iris_lights_select(lights, u_select, &pmf);
+  uint32_t i = select_at(lights, ref, u_select, &pmf);
   if (!(pmf > 0.0f)) return false;
   const iris_light_entry *e = &lights->entries[i];
   s->light = i;
@@ -253,10 +411,11 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
   if (i == UINT32_MAX) return 0.0f;
   const iris_light_entry *e = &lights->entries[i];
   iris_vec3 to = iris_sub(si->p, ref);
+  if (!e->two_sided && iris_dot(to, si->ng) >= 0.0f) return 0.0f; /* never sampled from behind */
   float d2 = iris_dot(to, to);
   float cos_l = fabsf(iris_dot(to, si->ng)) / sqrtf(d2);
   if (!(cos_l > 0.0f) || !(d2 > 0.0f)) return 0.0f;
-  return iris_lights_select_pmf(lights, i) * d2 / (cos_l * e->area);
+  return iris_lights_select_pmf_at(lights, ref, i) * d2 / (cos_l * e->area);
 }
 
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {
@@ -265,10 +424,10 @@ iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {
   return lights->entries[lights->environment].radiance;
 }
 
-float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 d) {
+float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d) {
   (void)d;
   if (lights->environment < 0) return 0.0f;
-  return iris_lights_select_pmf(lights, (uint32_t)lights->environment) *
+  return iris_lights_select_pmf_at(lights, ref, (uint32_t)lights->environment) *
          iris_sample_uniform_sphere_pdf();
 }
 

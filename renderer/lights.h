@@ -35,6 +35,7 @@ typedef enum iris_light_kind {
 /* One entry of the light list. */
 typedef struct iris_light_entry {
   iris_light_kind kind;
+  uint32_t group;     /* index into iris_lights.groups */
   uint32_t prim;      /* triangle: global triangle index; punctual: scene light index */
   float power;        /* selection weight: luminance of the emitted power (W) */
   float area;         /* triangle area (0 for the others) */
@@ -43,13 +44,33 @@ typedef struct iris_light_entry {
                          point/spot: radiant intensity (W/sr); directional: irradiance (W/m^2) */
 } iris_light_entry;
 
+/* Lights are chosen for next-event estimation in two steps: a group (the
+ * emissive triangles of one instance, or one punctual/environment light) with
+ * probability proportional to an estimate of the irradiance it gives at the
+ * shading point (power / (4 pi max(d^2, r^2)) for a group of bounding sphere
+ * radius r at distance d; I / d^2 for point and spot lights; E, resp. pi L, for
+ * directional lights and the environment), then an entry of the group in
+ * proportion to power. docs/rendering.md, "Light selection". */
+#define IRIS_LIGHTS_MAX_GROUPS 64
+typedef struct iris_light_group {
+  uint32_t first, count;  /* entries [first, first + count) */
+  iris_light_kind kind;
+  iris_vec3 center;       /* bounding sphere of a triangle group */
+  float radius;
+  float power;            /* sum of the entries' power */
+  float irradiance;       /* directional / environment: the distance-free estimate */
+  iris_distrib1d select;  /* over the group's entries (count > 1) */
+} iris_light_group;
+
 typedef struct iris_lights {
   const iris_scene *scene;
   const iris_accel *accel;
   const iris_textures *textures;
   iris_light_entry *entries;
   size_t count;
-  iris_distrib1d select;  /* over entries, in proportion to power */
+  iris_distrib1d select;  /* over entries, in proportion to power (photon emission) */
+  iris_light_group *groups;
+  size_t group_count;
   uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
   int32_t environment;    /* entry index of the environment, or -1 */
   iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */
@@ -63,11 +84,13 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                               const iris_textures *textures, iris_lights *out, iris_error *err);
 void iris_lights_destroy(iris_lights *lights);
 
-/* Probability with which iris_lights_sample picks entry `index`. */
+/* Probability with which photon emission picks entry `index` (power-proportional). */
 float iris_lights_select_pmf(const iris_lights *lights, uint32_t index);
 /* Picks an entry in proportion to power with one uniform number; returns its
  * index and the pmf (0 when there is no light). */
 uint32_t iris_lights_select(const iris_lights *lights, float u, float *pmf);
+/* Probability with which iris_lights_sample, called at `ref`, picks entry `index`. */
+float iris_lights_select_pmf_at(const iris_lights *lights, iris_vec3 ref, uint32_t index);
 
 /* ---- next-event estimation -------------------------------------------- */
 
@@ -99,9 +122,9 @@ iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction 
 float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
                                const iris_interaction *si);
 /* Environment radiance along direction d (a ray that escaped), and the
- * solid-angle pdf that iris_lights_sample returns d. */
+ * solid-angle pdf that iris_lights_sample, called at `ref`, returns d. */
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
-float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 d);
+float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d);
 
 /* ---- photon emission (guiding preprocess) ----------------------------- */
 

@@ -84,7 +84,13 @@ static void check_value(const char *what, iris_method m, const stats *s, double 
                         double rel_tol) {
   for (int k = 0; k < 3; k++) {
     double err = fabs(s->mean[k] - expect);
-    bool ok = err <= rel_tol * expect && err <= 5.0 * s->sigma[k] + 1e-3 * expect;
+    /* Converged (4 sigma within the tolerance): the tolerance decides, and the
+     * error must also be statistically plausible up to a 0.1% systematic
+     * (shading normals of a tessellated sphere). Not converged within the
+     * sample cap (NEE alone on a sharp glossy lobe): 5 sigma decides. */
+    bool converged = 4.0 * s->sigma[k] <= rel_tol * expect;
+    bool ok = converged ? err <= rel_tol * expect && err <= 5.0 * s->sigma[k] + 1e-3 * expect
+                        : err <= 5.0 * s->sigma[k];
     iris_check_record(ok, __FILE__, __LINE__, "%s (%s) channel %d: mean %.6f, expected %.6f (sigma %.2g)",
                       what, iris_method_name(m), k, s->mean[k], expect, s->sigma[k]);
   }

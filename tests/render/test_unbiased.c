@@ -1,0 +1,118 @@
+/* bsdf, nee and mis estimate the same integral: on the Cornell box and on the
+ * Veach scene their images agree within 3 sigma per image and per 8x8 block
+ * (Mitsuba test_renders.py style z-tests on the variance of each pixel's mean).
+ * The threshold is the Bonferroni-corrected two-sided normal quantile for a
+ * family-wise level of 0.1% over all tests of this file, so a correct renderer
+ * fails with probability < 0.001; "3 sigma" is the per-test level when there
+ * is a single test. */
+#include <stdlib.h>
+
+#include "check.h"
+#include "renderer/render.h"
+#include "scenes/builtin.h"
+
+/* Two-sided normal quantile by bisection on erfc. */
+static double z_for_alpha(double alpha) {
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200; i++) {
+    double mid = 0.5 * (lo + hi);
+    if (erfc(mid / sqrt(2.0)) > alpha)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+static bool render(const iris_scene *s, iris_method m, int w, int h, int spp, uint64_t seed,
+                   iris_render_result *r) {
+  iris_render_params p = iris_render_params_default();
+  p.width = w;
+  p.height = h;
+  p.spp = spp;
+  p.method = m;
+  p.seed = seed;
+  iris_error err;
+  iris_error_clear(&err);
+  if (iris_render(s, &p, r, &err) != IRIS_OK) {
+    fprintf(stderr, "render failed: %s\n", err.message);
+    return false;
+  }
+  return true;
+}
+
+/* Mean of the film's pixel means over [x0, x1) x [y0, y1) and its variance. */
+static void region(const iris_film *f, int x0, int y0, int x1, int y1, double mean[3], double var[3]) {
+  int n = 0;
+  for (int k = 0; k < 3; k++) mean[k] = var[k] = 0.0;
+  for (int y = y0; y < y1; y++)
+    for (int x = x0; x < x1; x++) {
+      iris_vec3 m, v;
+      iris_film_pixel(f, x, y, &m, &v);
+      mean[0] += m.x, mean[1] += m.y, mean[2] += m.z;
+      var[0] += v.x, var[1] += v.y, var[2] += v.z;
+      n++;
+    }
+  for (int k = 0; k < 3; k++) {
+    mean[k] /= n;
+    var[k] /= (double)n * n;
+  }
+}
+
+typedef struct scene_case {
+  const char *name;
+  int w, h, spp;
+} scene_case;
+
+int main(void) {
+  static const scene_case cases[2] = {{"cornell-box", 32, 32, 256}, {"veach-mis", 48, 32, 1024}};
+  static const iris_method methods[3] = {IRIS_METHOD_BSDF, IRIS_METHOD_NEE, IRIS_METHOD_MIS};
+  /* tests: per scene, 3 pairs x 3 channels x (1 image + blocks) */
+  int n_tests = 0;
+  for (int c = 0; c < 2; c++) n_tests += 3 * 3 * (1 + (cases[c].w / 8) * (cases[c].h / 8));
+  double z_max = z_for_alpha(1e-3 / n_tests);
+  printf("%d tests, |z| < %.2f\n", n_tests, z_max);
+  for (int c = 0; c < 2; c++) {
+    iris_scene *s = NULL;
+    iris_error err;
+    if (!CHECK(iris_builtin_create(cases[c].name, &s, &err) == IRIS_OK)) continue;
+    iris_render_result r[3];
+    bool ok[3];
+    for (int m = 0; m < 3; m++)
+      ok[m] = CHECK(render(s, methods[m], cases[c].w, cases[c].h, cases[c].spp, 100 + (uint64_t)m, &r[m]));
+    for (int a = 0; a < 3; a++)
+      for (int b = a + 1; b < 3; b++) {
+        if (!ok[a] || !ok[b]) continue;
+        double worst = 0.0;
+        int bx = cases[c].w / 8, by = cases[c].h / 8;
+        for (int blk = -1; blk < bx * by; blk++) {
+          int x0 = 0, y0 = 0, x1 = cases[c].w, y1 = cases[c].h;
+          if (blk >= 0) {
+            x0 = (blk % bx) * 8, y0 = (blk / bx) * 8;
+            x1 = x0 + 8, y1 = y0 + 8;
+          }
+          double ma[3], va[3], mb[3], vb[3];
+          region(&r[a].film, x0, y0, x1, y1, ma, va);
+          region(&r[b].film, x0, y0, x1, y1, mb, vb);
+          for (int k = 0; k < 3; k++) {
+            double sd = sqrt(va[k] + vb[k]);
+            double z = sd > 0 ? (ma[k] - mb[k]) / sd : (ma[k] == mb[k] ? 0.0 : INFINITY);
+            if (fabs(z) > worst) worst = fabs(z);
+            iris_check_record(fabs(z) <= z_max, __FILE__, __LINE__,
+                              "%s %s vs %s, %s (%d,%d)-(%d,%d) channel %d: %.5f vs %.5f, z = %.2f",
+                              cases[c].name, iris_method_name(methods[a]), iris_method_name(methods[b]),
+                              blk < 0 ? "image" : "block", x0, y0, x1, y1, k, ma[k], mb[k], z);
+          }
+        }
+        printf("%s: %s vs %s: worst |z| = %.2f\n", cases[c].name, iris_method_name(methods[a]),
+               iris_method_name(methods[b]), worst);
+      }
+    for (int m = 0; m < 3; m++) {
+      if (!ok[m]) continue;
+      CHECK_EQ_INT(r[m].stats.nan_count, 0);
+      iris_render_result_destroy(&r[m]);
+    }
+    iris_scene_destroy(s);
+  }
+  return iris_check_summary("render.unbiased");
+}
