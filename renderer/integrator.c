@@ -199,7 +199,11 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     if (!direction_allowed(&sp, ds.wi)) break;
     float cos_i = fabsf(iris_dot(ds.wi, sp.si.ns));
     beta = iris_mul(beta, iris_scale(ds.f, cos_i / ds.pdf));
-    if (!iris_isfinite3(beta) || iris_max3(beta) <= 0.0f) break;
+    if (!iris_isfinite3(beta)) { /* a NaN/Inf from a sampler: count it, keep what is finite */
+      stats->nan_count++;
+      break;
+    }
+    if (iris_max3(beta) <= 0.0f) break;
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;
     prev_p = sp.si.p;
