@@ -182,7 +182,15 @@ typedef struct ctx {
   bool warned_texcoord, warned_alpha, warned_normal_occlusion, warned_spec_tex, warned_trans_tex;
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
   size_t zero_normals;
+  size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
+  int32_t *image_texture;           /* image -> last scene texture made from it */
+  int *image_sampler;               /* ... and that texture's sampler */
 } ctx;
+
+/* Converted mesh data may use 16 bytes per byte of buffer plus this much. */
+#define MESH_BUDGET_SLACK ((size_t)256 << 20)
+/* Instances (nodes x primitives) are not bounded by the file size; cap them. */
+#define MAX_INSTANCES ((size_t)1 << 22)
 
 static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -550,6 +558,19 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   if (mode == MODE_TRIANGLES && ni % 3 != 0)
     return fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
 
+  /* Budget: converted data may exceed the file's buffers only by the expansion of
+   * small types (u8 -> float, strip -> list), unless accessors are reused by many
+   * primitives or are zero-filled; both could otherwise demand unbounded memory. */
+  size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
+  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0)) +
+                (double)ni * 4.0 + (double)nt_max * 12.0;
+  if (need > (double)c->budget_left)
+    return fail(c, IRIS_ERR_NOMEM, el,
+                "mesh data would exceed %zu MiB (%g MiB for this primitive; accessors reused by "
+                "many primitives or without a bufferView?)",
+                c->budget_total >> 20, need / 1048576.0);
+  c->budget_left -= (size_t)need;
+
   iris_mesh *m = &out->mesh;
   m->owned = true;
   m->material = -1;
@@ -764,12 +785,10 @@ static iris_status resolve_texture(ctx *c, int ti, int32_t *out) {
   const iris_gltf_texture *t = &d->textures[ti];
   char el[64];
   /* Textures naming the same image and sampler share one scene texture. */
-  for (int tj = 0; tj < (int)d->texture_count; tj++)
-    if (tj != ti && c->texture_map[tj] >= 0 && d->textures[tj].source == t->source &&
-        d->textures[tj].sampler == t->sampler) {
-      *out = c->texture_map[ti] = c->texture_map[tj];
-      return IRIS_OK;
-    }
+  if (t->source >= 0 && c->image_texture[t->source] >= 0 && c->image_sampler[t->source] == t->sampler) {
+    *out = c->texture_map[ti] = c->image_texture[t->source];
+    return IRIS_OK;
+  }
   if (t->source < 0) {
     iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
     return IRIS_OK;
@@ -843,6 +862,8 @@ static iris_status resolve_texture(ctx *c, int ti, int32_t *out) {
     return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   }
   *out = c->texture_map[ti] = id;
+  c->image_texture[t->source] = id;
+  c->image_sampler[t->source] = t->sampler;
   return IRIS_OK;
 }
 
@@ -1133,6 +1154,8 @@ static iris_status add_instance_prims(ctx *c, int mesh, const dmat4 *world) {
       memset(&cp->mesh, 0, sizeof cp->mesh); /* the scene owns the arrays now */
       cp->scene_mesh = id;
     }
+    if (c->scene->instance_count >= MAX_INSTANCES)
+      return fail(c, IRIS_ERR_NOMEM, NULL, "more than %zu mesh instances", MAX_INSTANCES);
     iris_instance inst;
     inst.mesh = (uint32_t)cp->scene_mesh;
     inst.transform = dmat4_to_float(world);
@@ -1392,6 +1415,8 @@ static void ctx_free(ctx *c) {
   free(c->materials);
   free(c->material_map);
   free(c->texture_map);
+  free(c->image_texture);
+  free(c->image_sampler);
   free(c->parent);
   free(c->world);
 }
@@ -1412,12 +1437,21 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   c.scene = iris_scene_create();
   c.material_map = malloc((doc->material_count ? doc->material_count : 1) * sizeof *c.material_map);
   c.texture_map = malloc((doc->texture_count ? doc->texture_count : 1) * sizeof *c.texture_map);
-  if (!c.scene || !c.material_map || !c.texture_map) {
+  c.image_texture = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_texture);
+  c.image_sampler = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_sampler);
+  if (!c.scene || !c.material_map || !c.texture_map || !c.image_texture || !c.image_sampler) {
     st = fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   for (size_t i = 0; i < doc->material_count; i++) c.material_map[i] = -1;
   for (size_t i = 0; i < doc->texture_count; i++) c.texture_map[i] = -1;
+  for (size_t i = 0; i < doc->image_count; i++) c.image_texture[i] = -1, c.image_sampler[i] = -2;
+  c.budget_total = MESH_BUDGET_SLACK;
+  for (size_t i = 0; i < doc->buffer_count; i++) {
+    size_t add = doc->buffers[i].size > SIZE_MAX / 32 ? SIZE_MAX / 32 : doc->buffers[i].size * 16;
+    c.budget_total = c.budget_total > SIZE_MAX / 2 - add ? SIZE_MAX / 2 : c.budget_total + add;
+  }
+  c.budget_left = c.budget_total;
   /* Validate everything first (even what the scene does not use), then build. */
   if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = validate_textures(&c)) ||
       (st = validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||

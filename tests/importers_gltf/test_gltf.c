@@ -532,6 +532,10 @@ static void check_synthetic(void) {
       {"\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"}],"
        "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}}]}]",
        "multiple of 3"},
+      /* 2^24 - 1 zero-filled vertices from a few bytes of JSON: over the memory budget. */
+      {"\"accessors\":[{\"componentType\":5126,\"count\":16777215,\"type\":\"VEC3\"}],"
+       "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0}},{\"attributes\":{\"POSITION\":0}}]}]",
+       "would exceed"},
   };
   for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
     j = make_gltf(bad[i][0]);
