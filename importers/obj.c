@@ -104,15 +104,13 @@ typedef struct obj_ctx {
 static void note_ignored(char *list, size_t size, const char *key, size_t key_len) {
   char k[48];
   if (key_len >= sizeof k) key_len = sizeof k - 1;
-  memcpy(k, key, key_len);
+  for (size_t i = 0; i < key_len; i++) /* printable for the message, no NUL */
+    k[i] = (key[i] > ' ' && key[i] < 127 && key[i] != ',') ? key[i] : '?';
   k[key_len] = 0;
-  /* already listed? */
-  const char *p = list;
-  size_t kl = strlen(k);
-  while ((p = strstr(p, k)) != NULL) {
+  const size_t kl = key_len;
+  if (kl == 0) return;
+  for (const char *p = list; (p = strstr(p, k)) != NULL; p++) /* already listed? */
     if ((p == list || p[-1] == ' ') && (p[kl] == ',' || p[kl] == 0)) return;
-    p += kl;
-  }
   size_t n = strlen(list);
   if (n + kl + 3 >= size) return;
   if (n) strcat(list, ", ");
