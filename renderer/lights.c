@@ -343,8 +343,18 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
     case IRIS_LIGHT_KIND_TRIANGLE: {
       float b0, b1;
       iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+      const iris_material *m = material_of(lights->scene, iris_accel_triangle_material(lights->accel, e->prim));
       iris_interaction si;
-      iris_accel_surface_at(lights->accel, e->prim, b1, 1.0f - b0 - b1, &si);
+      if (m->emission_texture >= 0) {
+        iris_accel_surface_at(lights->accel, e->prim, b1, 1.0f - b0 - b1, &si);
+      } else { /* position and normal are all an untextured emitter needs */
+        iris_vec3 v[3];
+        iris_accel_triangle(lights->accel, e->prim, v); /* counter-clockwise around the front */
+        iris_vec3 c = iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0]));
+        si.ng = iris_scale(c, 1.0f / iris_length(c));
+        si.p = iris_add(iris_add(iris_scale(v[0], b0), iris_scale(v[1], b1)),
+                        iris_scale(v[2], 1.0f - b0 - b1));
+      }
       iris_vec3 to = iris_sub(si.p, ref);
       float d2 = iris_dot(to, to);
       if (!(d2 > 0.0f)) return false;
@@ -354,12 +364,11 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
       if (!e->two_sided && cos_l <= 0.0f) return false;
       cos_l = fabsf(cos_l);
       if (!(cos_l > 0.0f)) return false;
-      const iris_material *m = material_of(lights->scene, si.material);
       s->wi = wi;
       s->dist = dist;
       s->p = si.p;
       s->n = si.ng;
-      s->L = surface_emission(lights, m, &si);
+      s->L = m->emission_texture >= 0 ? surface_emission(lights, m, &si) : e->radiance;
       s->pdf = pmf * d2 / (cos_l * e->area);
       return isfinite(s->pdf) && s->pdf > 0.0f;
     }
