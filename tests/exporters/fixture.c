@@ -29,9 +29,9 @@ int32_t fixture_add_quad(iris_scene *scene, const char *name, const fixture_quad
   if (q->normals) {
     m.normals = malloc(12 * sizeof(float));
     for (int i = 0; i < 4; i++) {
-      m.normals[3 * i + 0] = 0.0f;
-      m.normals[3 * i + 1] = 0.0f;
-      m.normals[3 * i + 2] = q->facing_down ? -1.0f : 1.0f;
+      m.normals[3 * i + 0] = q->normal ? q->normal[0] : 0.0f;
+      m.normals[3 * i + 1] = q->normal ? q->normal[1] : 0.0f;
+      m.normals[3 * i + 2] = q->normal ? q->normal[2] : (q->facing_down ? -1.0f : 1.0f);
     }
   }
   if (q->uvs) {

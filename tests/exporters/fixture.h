@@ -16,6 +16,7 @@ typedef struct fixture_quad {
   float cx, cy, cz, hx, hy;
   bool facing_down;
   bool normals, uvs;
+  const float *normal; /* with normals: this (unit) shading normal instead of +-z */
   const float *color; /* per-vertex colour or NULL */
   int32_t material;
 } fixture_quad;

@@ -7,7 +7,8 @@
  *    smooth white glass = E (white furnace); GGX glossy in (0.9, 1] x tint x E.
  *  - scenes "light0..2" (no environment, one delta light each, so Cycles is
  *    noise-free): point, spot (glTF falloff) and sun on a Lambert plane against
- *    rho/pi I cos/d^2 and rho/pi E cos; light0 has its mesh data embedded.
+ *    rho/pi I cos/d^2 and rho/pi E cos; light0 has its mesh data embedded and a
+ *    shading normal tilted 16.7 degrees from the geometric one (custom normals).
  * SKIPs (exit 77) when `blender` is not installed. */
 #include <math.h>
 #include <stdio.h>
@@ -226,6 +227,9 @@ static void check_cells(const iris_image *img) {
 /* ---- delta lights: exact expectation --------------------------------------- */
 
 static const float RHO = 0.5f;
+/* The point-light plane's shading normal, tilted away from the geometric +z so
+ * that Blender's custom split normals are exercised. */
+static const float TILT[3] = {0.28734789f, 0.0f, 0.95782629f}; /* normalize(0.3, 0, 1) */
 
 static iris_scene *lights_scene(int which) {
   iris_scene *s = iris_scene_create();
@@ -234,6 +238,7 @@ static iris_scene *lights_scene(int which) {
   dif.color[0] = dif.color[1] = dif.color[2] = RHO;
   fixture_quad q = {0};
   q.hx = q.hy = 1.5f, q.normals = true, q.material = add_material(s, dif, "plane");
+  if (which == 0) q.normal = TILT;
   fixture_add_instance(s, fixture_add_quad(s, "plane", &q), 0, 0, 0);
 
   iris_light l;
@@ -272,7 +277,8 @@ static double analytic(double x, double y, int c, int which) {
   if (which == 0) { /* point */
     double dx = 0.3 - x, dy = -0.2 - y, dz = 1.0, d2 = dx * dx + dy * dy + dz * dz;
     const double col[3] = {1, 0.5, 0.25};
-    sum += 2.0 * col[c] * (dz / sqrt(d2)) / d2;
+    double cos_s = (TILT[0] * dx + TILT[1] * dy + TILT[2] * dz) / sqrt(d2); /* shading normal */
+    sum += 2.0 * col[c] * fmax(cos_s, 0.0) / d2;
   }
   if (which == 1) { /* spot */
     double dx = -0.4 - x, dy = 0.3 - y, dz = 1.5, d2 = dx * dx + dy * dy + dz * dz;
