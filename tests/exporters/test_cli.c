@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "core/fileio.h"
@@ -60,7 +61,14 @@ static void clean(void) {
 
 int main(int argc, char **argv) {
   if (argc < 3) return TEST_SKIP("usage: test_exporters_cli IRIS ASSETS");
-  g_iris = argv[1];
+  /* Commands run inside the temporary folder: make the executable's path absolute. */
+  static char iris_abs[2048];
+  char cwd[1024];
+  if (argv[1][0] != '/' && getcwd(cwd, sizeof cwd))
+    snprintf(iris_abs, sizeof iris_abs, "%s/%s", cwd, argv[1]);
+  else
+    snprintf(iris_abs, sizeof iris_abs, "%s", argv[1]);
+  g_iris = iris_abs;
   g_assets = argv[2];
   if (iris_test_tmpdir(g_dir, sizeof g_dir, "export-cli") != 0) return TEST_SKIP("no temporary folder");
   char args[2048];
