@@ -1,0 +1,29 @@
+# Runs one libFuzzer harness for a short while on a private copy of its seeds.
+# libFuzzer adds new inputs to its first corpus folder, so the seeds (the
+# checked-in corpus and the shared assets, which must never change) are copied
+# into WORK first. Called by the fuzz.<name>.short tests:
+#   cmake -DFUZZER=<exe> -DWORK=<dir> -DSEEDS=<dir;dir> -DSECONDS=20 -P run_fuzz.cmake
+if(NOT FUZZER OR NOT WORK)
+  message(FATAL_ERROR "run_fuzz.cmake needs FUZZER and WORK")
+endif()
+if(NOT SECONDS)
+  set(SECONDS 20)
+endif()
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}/corpus" "${WORK}/artifacts")
+set(i 0)
+foreach(seed IN LISTS SEEDS)
+  if(IS_DIRECTORY "${seed}")
+    # One subfolder per seed folder: file names may repeat between folders.
+    file(COPY "${seed}/" DESTINATION "${WORK}/corpus/seed${i}")
+    math(EXPR i "${i} + 1")
+  endif()
+endforeach()
+execute_process(
+  COMMAND "${FUZZER}" -max_total_time=${SECONDS} -timeout=10 -rss_limit_mb=2048
+          -max_len=1048576 -print_final_stats=1 -artifact_prefix=${WORK}/artifacts/
+          "${WORK}/corpus"
+  RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${FUZZER} failed (${rc}); reproducer in ${WORK}/artifacts/")
+endif()
