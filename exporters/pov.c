@@ -196,11 +196,21 @@ static void put_texture(FILE *fp, const iris_scene *scene, int32_t index, const 
 
 static bool degenerate(const uint32_t *i) { return i[0] == i[1] || i[1] == i[2] || i[0] == i[2]; }
 
+/* Triangles POV-Ray gets (it rejects a mesh2 without any). */
+static size_t usable_triangles(const iris_mesh *m) {
+  size_t nt = 0;
+  for (size_t t = 0; t < m->triangle_count; t++) nt += !degenerate(m->indices + 3 * t);
+  return nt;
+}
+
 static void put_mesh(FILE *fp, const iris_scene *scene, size_t index, const char *pov_path,
                      bool coverage) {
   const iris_mesh *m = &scene->meshes[index];
-  size_t nv = m->vertex_count, nt = 0;
-  for (size_t t = 0; t < m->triangle_count; t++) nt += !degenerate(m->indices + 3 * t);
+  size_t nv = m->vertex_count, nt = usable_triangles(m);
+  if (nt == 0) {
+    fprintf(fp, "// mesh %zu has no non-degenerate triangles: skipped\n", index);
+    return;
+  }
   fprintf(fp, "// mesh %zu: ", index);
   put_comment_name(fp, m->name);
   fprintf(fp, "\n#declare IrisMesh%zu = mesh2 {\n  vertex_vectors { %zu", index, nv);
@@ -410,6 +420,7 @@ static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_
   for (size_t i = 0; i < scene->instance_count; i++) {
     const iris_instance *inst = &scene->instances[i];
     const iris_mesh *m = &scene->meshes[inst->mesh];
+    if (usable_triangles(m) == 0) continue;
     iris_material def = iris_material_default(IRIS_MATERIAL_DIFFUSE);
     const iris_material *mat = m->material >= 0 ? &scene->materials[m->material] : &def;
     fprintf(fp, "object { IrisMesh%u ", inst->mesh);

@@ -175,7 +175,8 @@ static iris_scene *cells_scene(void) {
   fixture_add_instance(s, fixture_add_quad(s, "lambert", &q), 0, 0, 0);
   q.normals = false;
   const float vc[3] = {0.25f, 0.5f, 0.75f};
-  q.cx = 0.0f, q.cy = 0.0f, q.color = vc, q.material = add_material(s, white, "white");
+  int32_t white_index = add_material(s, white, "white");
+  q.cx = 0.0f, q.cy = 0.0f, q.color = vc, q.material = white_index;
   int32_t vcq = fixture_add_quad(s, "vertex-colours", &q);
   fixture_add_instance(s, vcq, cell_x(1), cell_y(1), 0);
   fixture_add_instance(s, vcq, cell_x(3), cell_y(3), 0);
@@ -191,6 +192,17 @@ static iris_scene *cells_scene(void) {
   fixture_add_instance(s, fixture_add_quad(s, "textured", &t), 0, 0, 0);
   q.cx = cell_x(2), q.cy = cell_y(2), q.uvs = true, q.material = add_material(s, gltf, "gltf");
   fixture_add_instance(s, fixture_add_quad(s, "gltf", &q), 0, 0, 0);
+  /* (3,2): a white quad whose mesh also holds a degenerate triangle (Blender
+   * must drop it with mesh.validate() rather than fail). */
+  q.cx = cell_x(3), q.uvs = false, q.material = white_index;
+  int32_t dq = fixture_add_quad(s, "with-degenerate", &q);
+  iris_mesh *dm = &s->meshes[dq];
+  uint32_t *grown = realloc(dm->indices, 9 * sizeof(uint32_t));
+  if (!grown) abort();
+  grown[6] = 0, grown[7] = 0, grown[8] = 1;
+  dm->indices = grown;
+  dm->triangle_count = 3;
+  fixture_add_instance(s, dq, 0, 0, 0);
   return s;
 }
 
@@ -206,6 +218,7 @@ static void check_cells(const iris_image *img) {
     CHECK_NEAR(cell_mean(img, 0, 1, c), dif[c] * ENV[c], rel * dif[c] * ENV[c]);
     CHECK_NEAR(cell_mean(img, 1, 1, c), vc[c] * ENV[c], rel * vc[c] * ENV[c]);
     CHECK_NEAR(cell_mean(img, 3, 3, c), vc[c] * ENV[c], rel * vc[c] * ENV[c]);
+    CHECK_NEAR(cell_mean(img, 3, 2, c), ENV[c], rel * ENV[c]); /* white, degenerate triangle dropped */
     CHECK_NEAR(cell_mean(img, 2, 1, c), ENV[c], rel * ENV[c]);     /* smooth glass furnace */
     double g = cell_mean(img, 3, 1, c) / (gl[c] * ENV[c]);         /* GGX albedo, no Fresnel */
     CHECK(g > 0.9 && g < 1.0 + rel);
