@@ -7,6 +7,8 @@
 
 #include "core/image.h"
 #include "core/parallel.h"
+#include "core/rng.h"
+#include "renderer/merge.h"
 
 #define TILE 8
 /* Aim for passes of about this many paths: short enough to stop quickly on a
@@ -39,7 +41,9 @@ typedef struct pass_ctx {
   const iris_pinhole *cam;
   iris_film *film;
   uint64_t seed;
-  int s0, s1; /* sample indices of this pass */
+  uint64_t s0, s1; /* sample indices of this pass */
+  int x0, y0, x1, y1; /* the window; the film covers it */
+  int frame_width;    /* pixel indices are full-frame indices */
   int tiles_x;
   iris_path_stats *stats; /* one per thread */
 } pass_ctx;
@@ -47,19 +51,19 @@ typedef struct pass_ctx {
 static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
   pass_ctx *c = (pass_ctx *)vctx;
   iris_path_stats *st = &c->stats[thread];
-  const int w = c->film->width, h = c->film->height;
   for (uint64_t t = begin; t < end; t++) {
-    int tx = (int)(t % (uint64_t)c->tiles_x) * TILE, ty = (int)(t / (uint64_t)c->tiles_x) * TILE;
-    for (int y = ty; y < ty + TILE && y < h; y++)
-      for (int x = tx; x < tx + TILE && x < w; x++) {
-        uint64_t pixel = (uint64_t)y * (uint64_t)w + (uint64_t)x;
-        for (int s = c->s0; s < c->s1; s++) {
-          iris_sampler rng = iris_sampler_start(c->seed, pixel, (uint64_t)s);
+    int tx = c->x0 + (int)(t % (uint64_t)c->tiles_x) * TILE;
+    int ty = c->y0 + (int)(t / (uint64_t)c->tiles_x) * TILE;
+    for (int y = ty; y < ty + TILE && y < c->y1; y++)
+      for (int x = tx; x < tx + TILE && x < c->x1; x++) {
+        uint64_t pixel = (uint64_t)y * (uint64_t)c->frame_width + (uint64_t)x;
+        for (uint64_t s = c->s0; s < c->s1; s++) {
+          iris_sampler rng = iris_sampler_start(c->seed, pixel, s);
           float fx = (float)x + iris_sampler_next(&rng);
           float fy = (float)y + iris_sampler_next(&rng);
           iris_ray ray = iris_pinhole_ray(c->cam, fx, fy);
           iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, st);
-          iris_film_add(c->film, x, y, L);
+          iris_film_add(c->film, x - c->x0, y - c->y0, L);
         }
       }
   }
@@ -78,6 +82,30 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   double t0 = iris_time_now();
   iris_status st = iris_pinhole_setup(scene, p.camera_name, p.width, p.height, &res->camera, err);
   if (st != IRIS_OK) return st;
+  iris_pixel_bounds b = p.bounds;
+  if (b.x0 == 0 && b.y0 == 0 && b.x1 == 0 && b.y1 == 0) {
+    b.x1 = res->camera.width;
+    b.y1 = res->camera.height;
+  }
+  if (b.x0 < 0 || b.y0 < 0 || b.x0 >= b.x1 || b.y0 >= b.y1 || b.x1 > res->camera.width ||
+      b.y1 > res->camera.height)
+    return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
+                          "pixel bounds %d,%d,%d,%d are empty or outside the %dx%d frame", b.x0,
+                          b.y0, b.x1, b.y1, res->camera.width, res->camera.height);
+  if (p.sample_offset > (1ull << 52))
+    return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL, "sample offset %llu is too large",
+                          (unsigned long long)p.sample_offset);
+  res->bounds = b;
+  res->sample_offset = p.sample_offset;
+  res->max_depth = p.max_depth;
+  res->scene_hash = iris_merge_scene_hash(scene);
+  {
+    /* everything besides the scene, seed and method that changes the image */
+    uint64_t h = iris_hash4((uint64_t)res->camera.width, (uint64_t)res->camera.height,
+                            (uint64_t)p.max_depth, (uint64_t)p.rr_depth);
+    for (const char *c = res->camera.name; *c; c++) h = iris_mix64(h ^ (unsigned char)*c);
+    res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
+  }
   iris_accel *accel = NULL;
   iris_textures textures;
   iris_lights lights;
@@ -100,7 +128,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
                            p.guide_options};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
-  if (st == IRIS_OK) st = iris_film_create(&res->film, res->camera.width, res->camera.height, err);
+  if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
   if (st == IRIS_OK) {
     stats = calloc((size_t)p.threads, sizeof *stats);
     if (!stats) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
@@ -112,10 +140,21 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   res->setup_seconds = t1 - t0;
 
   if (st == IRIS_OK) {
-    const uint64_t pixels = (uint64_t)res->camera.width * (uint64_t)res->camera.height;
-    pass_ctx c = {&it, &res->camera, &res->film, p.seed, 0, 0, 0, stats};
-    c.tiles_x = (res->camera.width + TILE - 1) / TILE;
-    int tiles_y = (res->camera.height + TILE - 1) / TILE;
+    const uint64_t pixels = (uint64_t)res->film.width * (uint64_t)res->film.height;
+    pass_ctx c;
+    memset(&c, 0, sizeof c);
+    c.it = &it;
+    c.cam = &res->camera;
+    c.film = &res->film;
+    c.seed = p.seed;
+    c.x0 = b.x0;
+    c.y0 = b.y0;
+    c.x1 = b.x1;
+    c.y1 = b.y1;
+    c.frame_width = res->camera.width;
+    c.stats = stats;
+    c.tiles_x = (res->film.width + TILE - 1) / TILE;
+    int tiles_y = (res->film.height + TILE - 1) / TILE;
     uint64_t tiles = (uint64_t)c.tiles_x * (uint64_t)tiles_y;
     int pass_spp = (int)((PASS_PATHS + pixels - 1) / pixels);
     if (pass_spp < 1) pass_spp = 1;
@@ -143,8 +182,8 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
         if (done >= target) break;
         if (n > target - done) n = target - done;
       }
-      c.s0 = done;
-      c.s1 = done + n;
+      c.s0 = p.sample_offset + (uint64_t)done;
+      c.s1 = c.s0 + (uint64_t)n;
       double tp = iris_time_now();
       uint64_t grain = tiles / (uint64_t)(8 * p.threads) + 1;
       if (grain > 4) grain = 4;
@@ -188,7 +227,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   iris_image img;
   iris_status st = iris_film_to_image(&r->film, variance, &img, err);
   if (st != IRIS_OK) return st;
-  iris_image_meta meta[12];
+  iris_image_meta meta[20];
   size_t n = 0;
 #define META(k, ...) \
   do { \
@@ -206,6 +245,12 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("camera", "%s", r->camera.name);
   META("threads", "%d", r->threads);
   META("nan_count", "%llu", (unsigned long long)r->stats.nan_count);
+  META("max_depth", "%d", r->max_depth);
+  META("sample_offset", "%llu", (unsigned long long)r->sample_offset);
+  META("window", "%d,%d,%d,%d", r->bounds.x0, r->bounds.y0, r->bounds.x1, r->bounds.y1);
+  META("full_size", "%d,%d", r->camera.width, r->camera.height);
+  META("scene_hash", "%016llx", (unsigned long long)r->scene_hash);
+  META("config_hash", "%016llx", (unsigned long long)r->config_hash);
 #undef META
   st = iris_exr_write(path, &img, meta, n, err);
   iris_image_destroy(&img);

@@ -42,6 +42,11 @@ typedef struct iris_guide_provider {
   void (*destroy)(void *state);
 } iris_guide_provider;
 
+/* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
+typedef struct iris_pixel_bounds {
+  int x0, y0, x1, y1;
+} iris_pixel_bounds;
+
 typedef struct iris_render_params {
   int width, height;        /* <= 0: derive (camera.h) */
   int spp;                  /* samples per pixel (used when time_budget <= 0); 0: scene or 64 */
@@ -59,6 +64,13 @@ typedef struct iris_render_params {
   void *progress_ctx;
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
+  /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..
+   * sample_offset + spp - 1 of the pixels in `bounds` only. Pixels keep their
+   * full-frame index for the sampler, so a part equals the same samples and
+   * pixels of the whole render bit for bit. Defaults: 0 and the whole frame. */
+  uint64_t sample_offset;
+  iris_pixel_bounds bounds;         /* all 0: the whole frame */
+  uint64_t config_hash;             /* options iris_render cannot see (the guide's), for iris:config_hash */
 } iris_render_params;
 
 /* Defaults: everything unset (taken from the scene, else 64 spp, mis, max
@@ -79,6 +91,11 @@ typedef struct iris_render_result {
   double setup_seconds;  /* accel, textures, lights, guide */
   iris_path_stats stats;
   bool interrupted;
+  uint64_t sample_offset;   /* first sample index */
+  iris_pixel_bounds bounds; /* window rendered: the film covers it; camera.width/height is the frame */
+  int max_depth;
+  uint64_t scene_hash;      /* iris_merge_scene_hash */
+  uint64_t config_hash;     /* frame size, camera, depths and params.config_hash */
 } iris_render_result;
 
 iris_status iris_render(const iris_scene *scene, const iris_render_params *params,
@@ -86,7 +103,8 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
 void iris_render_result_destroy(iris_render_result *result);
 
 /* EXR with R, G, B (+ var.R/G/B when `variance`) and iris:version, scene,
- * method, spp, seed, render_seconds, interrupted, ... metadata. */
+ * method, spp, seed, render_seconds, interrupted, ... metadata, and what
+ * iris merge needs: sample_offset, window, full_size, scene_hash, config_hash. */
 iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
                                   const char *scene_name, bool variance, iris_error *err);
 iris_status iris_render_write_png(const iris_render_result *r, const char *path, float exposure,

@@ -10,6 +10,7 @@
 
 #include "core/fileio.h"
 #include "core/log.h"
+#include "core/rng.h"
 #include "importers/import.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
@@ -37,6 +38,10 @@ static void print_help(void) {
       "      --method M      bsdf | nee | mis (default) | guided | guided-nee\n"
       "      --max-depth B   bounces as Cycles counts them, 0 = direct light (default 64)\n"
       "      --threads N     worker threads (default: all cores); same image for any N\n"
+      "Partitioned renders (merge the parts with iris merge; docs/distributed.md):\n"
+      "      --sample-offset K   render sample indices K .. K+spp-1 (default 0)\n"
+      "      --pixel-bounds x0,y0,x1,y1   render only this window of the frame\n"
+      "                      (half-open; the output image is the window)\n"
       "Camera:\n"
       "      --camera NAME   scene camera to use (default: the first; none: auto-framed)\n"
       "      --width W, --height H   film size (default: the scene's, else from the\n"
@@ -77,6 +82,41 @@ static bool ends_with(const char *s, const char *suffix) {
   char ext[16];
   iris_path_ext(s, ext, sizeof ext);
   return strcmp(ext, suffix + 1) == 0;
+}
+
+/* "x0,y0,x1,y1": four integers, a non-empty window; the frame check is
+ * iris_render's, which knows the frame size. */
+static bool parse_bounds(const char *text, iris_pixel_bounds *b) {
+  long v[4];
+  const char *q = text;
+  for (int i = 0; i < 4; i++) {
+    char *end = NULL;
+    if (*q < '0' || *q > '9') return false;
+    v[i] = strtol(q, &end, 10);
+    if (end == q || v[i] > 65536) return false;
+    q = end;
+    if (i < 3 && *q++ != ',') return false;
+  }
+  if (*q || v[0] >= v[2] || v[1] >= v[3]) return false;
+  b->x0 = (int)v[0];
+  b->y0 = (int)v[1];
+  b->x1 = (int)v[2];
+  b->y1 = (int)v[3];
+  return true;
+}
+
+/* Folds the guiding options into iris:config_hash, so parts rendered with
+ * different caches refuse to merge. */
+static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
+  uint64_t h = 0x6a1d1e5ULL;
+  double v[] = {(double)gp->photons, (double)gp->caches, gp->cache_res, gp->cache_k,
+                gp->pdf_floor, gp->alpha_max, gp->cos_min, (double)gp->splat, gp->force};
+  for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
+    uint64_t bits;
+    memcpy(&bits, &v[i], sizeof bits);
+    h = iris_mix64(h ^ (bits + 0x9e3779b97f4a7c15ULL));
+  }
+  return h;
 }
 
 static bool output_dir_ok(const char *path) {
@@ -196,6 +236,16 @@ int iris_cmd_render(int argc, char **argv) {
         return iris_cli_usage_error(CMD, "unknown splat mode '%s' (nearest, bilinear)", val);
     } else if (strcmp(a, "--force-guiding") == 0) {
       gp.force = true;
+    } else if (strcmp(a, "--sample-offset") == 0) {
+      NEED_VALUE();
+      if (!iris_cli_parse_u64(CMD, a, val, &p.sample_offset)) return IRIS_EXIT_USAGE;
+      if (p.sample_offset > (1ull << 40))
+        return iris_cli_usage_error(CMD, "invalid value '%s' for %s (at most 2^40)", val, a);
+    } else if (strcmp(a, "--pixel-bounds") == 0) {
+      NEED_VALUE();
+      if (!parse_bounds(val, &p.bounds))
+        return iris_cli_usage_error(CMD, "invalid value '%s' for %s (x0,y0,x1,y1 with "
+                                         "0 <= x0 < x1 and 0 <= y0 < y1)", val, a);
     } else if (strcmp(a, "--camera") == 0) {
       NEED_VALUE();
       camera = val;
@@ -229,6 +279,7 @@ int iris_cmd_render(int argc, char **argv) {
   if (iris_method_uses_guiding(p.method)) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &gp;
+    p.config_hash = guiding_params_hash(&gp);
   }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
@@ -261,7 +312,8 @@ int iris_cmd_render(int argc, char **argv) {
     iris_error cerr;
     iris_error_clear(&cerr);
     if (iris_pinhole_setup(scene, camera, p.width, p.height, &cam, &cerr) == IRIS_OK)
-      ps.pixels = (uint64_t)cam.width * (uint64_t)cam.height;
+      ps.pixels = p.bounds.x1 > 0 ? (uint64_t)(p.bounds.x1 - p.bounds.x0) * (uint64_t)(p.bounds.y1 - p.bounds.y0)
+                                  : (uint64_t)cam.width * (uint64_t)cam.height;
   }
   struct sigaction sa, old_int, old_term;
   memset(&sa, 0, sizeof sa);
@@ -297,6 +349,10 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_AddStringToObject(o, "camera", res.camera.name);
     cJSON_AddStringToObject(o, "method", iris_method_name(res.method));
     cJSON_AddNumberToObject(o, "spp", res.spp);
+    cJSON_AddNumberToObject(o, "sample_offset", (double)res.sample_offset);
+    cJSON *win = cJSON_AddArrayToObject(o, "pixel_bounds");
+    int wb[4] = {res.bounds.x0, res.bounds.y0, res.bounds.x1, res.bounds.y1};
+    for (int k = 0; k < 4; k++) cJSON_AddItemToArray(win, cJSON_CreateNumber(wb[k]));
     cJSON_AddNumberToObject(o, "seed", (double)res.seed);
     cJSON_AddNumberToObject(o, "threads", res.threads);
     cJSON_AddNumberToObject(o, "max_depth", p.max_depth < 0 ? (scene->render.max_depth >= 0 ? scene->render.max_depth : IRIS_DEFAULT_MAX_DEPTH) : p.max_depth);
