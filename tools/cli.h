@@ -40,5 +40,6 @@ int iris_cmd_import(int argc, char **argv);
 int iris_cmd_info(int argc, char **argv);
 int iris_cmd_render(int argc, char **argv);
 int iris_cmd_export(int argc, char **argv);
+int iris_cmd_merge(int argc, char **argv);
 
 #endif

@@ -10,6 +10,7 @@ static const iris_command COMMANDS[] = {
     {"info", "describe a scene or importable file", iris_cmd_info},
     {"render", "render a scene (or any importable file) to EXR/PNG", iris_cmd_render},
     {"export", "export a scene to Blender (Python) or POV-Ray (SDL)", iris_cmd_export},
+    {"merge", "merge the EXRs of a partitioned render (sample ranges, windows)", iris_cmd_merge},
 };
 static const size_t COMMAND_COUNT = sizeof COMMANDS / sizeof COMMANDS[0];
 
