@@ -256,14 +256,14 @@ static iris_scene *lights_scene(int which) {
 
   iris_light l;
   memset(&l, 0, sizeof l);
-  l.name = iris_strdup("point");
+  l.name = which == 0 ? iris_strdup("point") : NULL;
   l.type = IRIS_LIGHT_POINT;
   l.color[0] = 1.0f, l.color[1] = 0.5f, l.color[2] = 0.25f;
   l.intensity = 2.0f;
   l.position[0] = 0.3f, l.position[1] = -0.2f, l.position[2] = 1.0f;
   if (which == 0) iris_scene_add_light(s, &l);
   memset(&l, 0, sizeof l);
-  l.name = iris_strdup("spot");
+  l.name = which == 1 ? iris_strdup("spot") : NULL;
   l.type = IRIS_LIGHT_SPOT;
   l.color[0] = 0.2f, l.color[1] = 0.6f, l.color[2] = 1.0f;
   l.intensity = 5.0f;
@@ -273,7 +273,7 @@ static iris_scene *lights_scene(int which) {
   l.outer_cone = 35.0f * IRIS_PI / 180.0f;
   if (which == 1) iris_scene_add_light(s, &l);
   memset(&l, 0, sizeof l);
-  l.name = iris_strdup("sun");
+  l.name = which == 2 ? iris_strdup("sun") : NULL;
   l.type = IRIS_LIGHT_DIRECTIONAL;
   l.color[0] = l.color[1] = l.color[2] = 1.0f;
   l.intensity = 0.7f;
