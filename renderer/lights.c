@@ -136,6 +136,7 @@ static float entry_pmf_in_group(const iris_lights *L, uint32_t index) {
 
 float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t index) {
   if (index >= L->count) return 0.0f;
+  if (L->group_count == 1) return entry_pmf_in_group(L, index);
   float w[IRIS_LIGHTS_MAX_GROUPS + 1];
   double sum = group_weights(L, ref, w);
   if (!(sum > 0.0)) return 0.0f;
@@ -144,6 +145,14 @@ float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t in
 
 /* Two-step choice at ref; returns the entry and its probability. */
 static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf) {
+  if (L->group_count == 1) {
+    const iris_light_group *g = &L->groups[0];
+    if (g->count == 1) {
+      *pmf = 1.0f;
+      return 0;
+    }
+    return (uint32_t)iris_distrib1d_sample(&g->select, u, pmf, NULL);
+  }
   float w[IRIS_LIGHTS_MAX_GROUPS + 1];
   double sum = group_weights(L, ref, w);
   *pmf = 0.0f;
@@ -221,6 +230,11 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     e->two_sided = m->emission_two_sided;
     e->radiance = iris_v3_load(m->emission);
     e->power = luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
+    e->v0 = v[0];
+    e->e1 = iris_sub(v[1], v[0]);
+    e->e2 = iris_sub(v[2], v[0]);
+    e->ng = iris_normalize(iris_cross(e->e1, e->e2));
+    e->textured = m->emission_texture >= 0;
     out->light_of_prim[t] = (uint32_t)n;
     n++;
   }
@@ -343,17 +357,12 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
     case IRIS_LIGHT_KIND_TRIANGLE: {
       float b0, b1;
       iris_sample_uniform_triangle(u0, u1, &b0, &b1);
-      const iris_material *m = material_of(lights->scene, iris_accel_triangle_material(lights->accel, e->prim));
       iris_interaction si;
-      if (m->emission_texture >= 0) {
+      if (e->textured) {
         iris_accel_surface_at(lights->accel, e->prim, b1, 1.0f - b0 - b1, &si);
       } else { /* position and normal are all an untextured emitter needs */
-        iris_vec3 v[3];
-        iris_accel_triangle(lights->accel, e->prim, v); /* counter-clockwise around the front */
-        iris_vec3 c = iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0]));
-        si.ng = iris_scale(c, 1.0f / iris_length(c));
-        si.p = iris_add(iris_add(iris_scale(v[0], b0), iris_scale(v[1], b1)),
-                        iris_scale(v[2], 1.0f - b0 - b1));
+        si.ng = e->ng;
+        si.p = iris_add(e->v0, iris_add(iris_scale(e->e1, b1), iris_scale(e->e2, 1.0f - b0 - b1)));
       }
       iris_vec3 to = iris_sub(si.p, ref);
       float d2 = iris_dot(to, to);
@@ -368,7 +377,8 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
       s->dist = dist;
       s->p = si.p;
       s->n = si.ng;
-      s->L = m->emission_texture >= 0 ? surface_emission(lights, m, &si) : e->radiance;
+      s->L = e->textured ? surface_emission(lights, material_of(lights->scene, si.material), &si)
+                         : e->radiance;
       s->pdf = pmf * d2 / (cos_l * e->area);
       return isfinite(s->pdf) && s->pdf > 0.0f;
     }

@@ -42,6 +42,9 @@ typedef struct iris_light_entry {
   bool two_sided;     /* triangle emits from both faces */
   iris_vec3 radiance; /* triangle: emission factor (untextured); environment: radiance;
                          point/spot: radiant intensity (W/sr); directional: irradiance (W/m^2) */
+  iris_vec3 v0, e1, e2; /* triangle: world vertex 0 and edges (counter-clockwise, front) */
+  iris_vec3 ng;         /* triangle: unit front normal */
+  bool textured;        /* triangle: the emission has a texture */
 } iris_light_entry;
 
 /* Lights are chosen for next-event estimation in two steps: a group (the
