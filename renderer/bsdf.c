@@ -291,7 +291,10 @@ static iris_vec3 gltf_spec_tint(const iris_bsdf *b, const gltf_setup *g, float c
   return iris_add(diel, metal);
 }
 
-/* (1 - w max(F_r(c))): what the dielectric layer leaves for diffuse/transmission. */
+/* (1 - w max(F_r(c))): what the dielectric layer leaves for diffuse and
+ * transmission. Appendix B evaluates it at V.H; iris evaluates it at N.V
+ * (c = wo.z), because the V.H form reflects more than it receives at grazing
+ * angles (white furnace 1.33 at 87 degrees, roughness 0.05; docs/materials.md). */
 static float gltf_base_weight(const gltf_setup *g, float c) {
   return fmaxf(0.0f, 1.0f - g->weight * iris_max3(schlick3(g->f0, c)));
 }
@@ -304,7 +307,7 @@ static iris_vec3 gltf_eval_local(const iris_bsdf *b, const gltf_setup *g, iris_v
     iris_vec3 m = iris_normalize(iris_add(wo, wi));
     float c = iris_dot(wo, m);
     float opaque = (1.0f - g->metallic) * (1.0f - iris_clampf(b->transmission, 0.0f, 1.0f));
-    iris_vec3 f = iris_scale(base, opaque * gltf_base_weight(g, c) * IRIS_INV_PI);
+    iris_vec3 f = iris_scale(base, opaque * gltf_base_weight(g, wo.z) * IRIS_INV_PI);
     if (!g->smooth) {
       float spec = ggx_reflect_f(g->alpha, wo, wi, true);
       f = iris_add(f, iris_scale(gltf_spec_tint(b, g, c), spec));
@@ -312,11 +315,8 @@ static iris_vec3 gltf_eval_local(const iris_bsdf *b, const gltf_setup *g, iris_v
     return f;
   }
   if (g->smooth || !(g->transmission > 0.0f)) return zero3;
-  iris_vec3 m;
-  float denom;
-  if (!refract_half(wo, wi, g->eta, &m, &denom)) return zero3;
   float btdf = ggx_refract_f(g->alpha, g->eta, wo, wi, true);
-  return iris_scale(base, g->transmission * gltf_base_weight(g, iris_dot(wo, m)) * btdf);
+  return iris_scale(base, g->transmission * gltf_base_weight(g, wo.z) * btdf);
 }
 
 static float gltf_pdf_local(const gltf_setup *g, iris_vec3 wo, iris_vec3 wi) {

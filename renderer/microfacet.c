@@ -5,9 +5,13 @@
 
 float iris_ggx_d(float alpha, iris_vec3 m) {
   if (m.z <= 0.0f) return 0.0f;
+  /* 1 + (a^2 - 1) cos^2 written as sin^2 + a^2 cos^2 with sin^2 from the
+   * tangential components: no cancellation near the peak of a sharp lobe. */
+  float s2 = m.x * m.x + m.y * m.y, c2 = m.z * m.z;
+  float len2 = s2 + c2;
   float a2 = alpha * alpha;
-  float c2 = m.z * m.z;
-  float t = c2 * (a2 - 1.0f) + 1.0f; /* >= min(a2, 1) > 0 */
+  float t = (s2 + a2 * c2) / len2;
+  if (!(t > 0.0f)) return 0.0f;
   return a2 / (IRIS_PI * t * t);
 }
 
