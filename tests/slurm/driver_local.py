@@ -1,0 +1,72 @@
+#!/usr/bin/python3
+"""slurm.driver_local: tools/slurm/iris-slurm without a cluster. `render
+--dry-run` with 3x2 tiles x 2 sample partitions writes the array and merge job
+scripts; running them here (SLURM_ARRAY_TASK_ID = 0..11, then the merge) must
+give the single-process render. Also: the driver's usage errors exit 2.
+
+usage: driver_local.py WORKDIR IRIS IRIS_SLURM EXR_CLOSE
+"""
+import os
+import shutil
+import subprocess
+import sys
+
+
+def main():
+    workdir, iris, driver, exr_close = (os.path.abspath(p) for p in sys.argv[1:5])
+    shutil.rmtree(workdir, ignore_errors=True)
+    os.makedirs(workdir)
+    failures = []
+
+    def check(cond, what):
+        print(("ok: " if cond else "FAILED: ") + what, flush=True)
+        if not cond:
+            failures.append(what)
+
+    scene = ["cornell-box", "--seed", "5", "--max-depth", "3"]
+    merged = os.path.join(workdir, "merged.exr")
+    job = os.path.join(workdir, "job")
+    r = subprocess.run([driver, "render", "--dry-run", "--workdir", job, "--iris", iris,
+                        "-o", merged, "--spp", "6", "--parts", "2", "--tiles", "3x2",
+                        "--width", "29", "--height", "17", "--"] + scene,
+                       capture_output=True, text=True)
+    print(r.stdout + r.stderr)
+    check(r.returncode == 0 and "would run: sbatch" in r.stdout, "dry run writes scripts")
+    env = dict(os.environ)
+    for t in range(12):
+        env["SLURM_ARRAY_TASK_ID"] = str(t)
+        r = subprocess.run(["sh", os.path.join(job, "render-array.sh")], env=env,
+                           capture_output=True, text=True)
+        check(r.returncode == 0, f"array task {t}: {r.stderr.strip()}")
+    env["SLURM_ARRAY_TASK_ID"] = "12"
+    r = subprocess.run(["sh", os.path.join(job, "render-array.sh")], env=env,
+                       capture_output=True, text=True)
+    check(r.returncode == 2, "a task id beyond the array is refused")
+    r = subprocess.run(["sh", os.path.join(job, "render-final.sh")], capture_output=True, text=True)
+    print(r.stdout + r.stderr)
+    check(r.returncode == 0 and "12 parts (6 windows)" in r.stderr, "merge job merges 12 parts")
+    single = os.path.join(workdir, "single.exr")
+    subprocess.run([iris, "render"] + scene + ["--spp", "6", "--width", "29", "--height", "17",
+                   "--variance", "--quiet", "-o", single], check=True)
+    r = subprocess.run([exr_close, merged, single], capture_output=True, text=True)
+    print(r.stdout + r.stderr)
+    check(r.returncode == 0, "tiles x partitions merge to the single render")
+
+    def usage(args, needle):
+        r = subprocess.run([driver] + args, capture_output=True, text=True)
+        check(r.returncode == 2 and needle in r.stderr, f"iris-slurm {' '.join(args)} -> {needle}")
+
+    base = ["render", "--dry-run", "--workdir", job, "--iris", iris, "-o", merged]
+    usage(base + ["--spp", "4", "--tiles", "2x2", "--"] + scene, "needs --width and --height")
+    usage(base + ["--spp", "4", "--parts", "5", "--"] + scene, "parts <= --spp")
+    usage(base + ["--spp", "4", "--", "cornell-box", "--time", "3"], "--time")
+    usage(base + ["--spp", "4", "--", "cornell-box", "--sample-offset=3"], "--sample-offset")
+    usage(["sweep", "--dry-run", "--workdir", job, "--template", "echo {x}"], "no --set gives it")
+    print(f"{len(failures)} failed")
+    if not failures:
+        shutil.rmtree(workdir, ignore_errors=True)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
