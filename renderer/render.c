@@ -159,6 +159,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     int pass_spp = (int)((PASS_PATHS + pixels - 1) / pixels);
     if (pass_spp < 1) pass_spp = 1;
     const bool timed = p.time_budget > 0.0;
+    const double budget = p.time_budget - (p.budget_includes_setup ? res->setup_seconds : 0.0);
     const int target = timed ? 0 : p.spp;
     int done = 0;
     double sec_per_spp = 0.0;
@@ -171,7 +172,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
       double elapsed = iris_time_now() - t1;
       if (timed) {
         if (done > 0) {
-          double left = p.time_budget - elapsed;
+          double left = budget - elapsed;
           int fit = sec_per_spp > 0.0 ? (int)(left / sec_per_spp) : n;
           if (fit < 1) break; /* the next whole pass would overrun the budget */
           if (fit < n) n = fit;
@@ -193,9 +194,9 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
       sec_per_spp = dt / n;
       double now = iris_time_now() - t1;
       if (p.progress) {
-        int total = timed ? done + (int)((p.time_budget - now) / (sec_per_spp > 0 ? sec_per_spp : 1)) : target;
+        int total = timed ? done + (int)((budget - now) / (sec_per_spp > 0 ? sec_per_spp : 1)) : target;
         if (total < done) total = done;
-        double eta = timed ? (p.time_budget - now > 0 ? p.time_budget - now : 0)
+        double eta = timed ? (budget - now > 0 ? budget - now : 0)
                            : (target - done) * sec_per_spp;
         p.progress(p.progress_ctx, done, total, now, eta);
       }

@@ -71,6 +71,9 @@ typedef struct iris_render_params {
   uint64_t sample_offset;
   iris_pixel_bounds bounds;         /* all 0: the whole frame */
   uint64_t config_hash;             /* options iris_render cannot see (the guide's), for iris:config_hash */
+  /* time_budget covers setup (accel, textures, lights, guide) too: wall-clock
+   * budgets for iris bench. At least one pass always runs. Default false. */
+  bool budget_includes_setup;
 } iris_render_params;
 
 /* Defaults: everything unset (taken from the scene, else 64 spp, mis, max
