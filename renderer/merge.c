@@ -451,8 +451,9 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
     }
   }
 
-  /* Metadata: the first part's, with the merged sample range, window and
-   * totals; per-process keys (threads) are dropped. */
+  /* Metadata: the first part's iris:* keys (not the EXR's own, such as type
+   * and name, which the writer sets), with the merged sample range, window
+   * and totals; per-process keys (threads) are dropped. */
   static const char *const replaced[] = {"iris:spp",          "iris:sample_offset", "iris:window",
                                          "iris:full_size",    "iris:render_seconds",
                                          "iris:nan_count",    "iris:threads",
@@ -465,7 +466,7 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
   }
   size_t k = 0;
   for (size_t i = 0; i < m->meta_count; i++) {
-    bool skip = false;
+    bool skip = strncmp(m->meta[i].key, "iris:", 5) != 0;
     for (size_t r = 0; r < nrep; r++) skip = skip || strcmp(m->meta[i].key, replaced[r]) == 0;
     if (!skip) meta[k++] = m->meta[i];
   }
