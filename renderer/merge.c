@@ -192,6 +192,9 @@ iris_status iris_merge_part_info_parse(const iris_image *img, const iris_image_m
                             "'%s' is not W,H", full);
     out->full_width = (int)v[0];
     out->full_height = (int)v[1];
+    if ((uint64_t)v[0] * (uint64_t)v[1] > (1ull << 28)) /* iris_film_create's limit */
+      return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:full_size",
+                            "frame %s is larger than any iris film", full);
   } else {
     out->full_width = img->width;
     out->full_height = img->height;

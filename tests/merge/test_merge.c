@@ -145,6 +145,51 @@ static void test_synthetic(int order) {
   iris_merge_destroy(&m);
 }
 
+/* Parts whose metadata is missing or inconsistent are refused before any
+ * accumulation. */
+static void expect_bad_meta(const char *key, const char *value, const char *needle) {
+  static const char *const names[3] = {"R", "G", "B"};
+  iris_image img;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_image_create(&img, 4, 3, 3, names, &err), &err);
+  iris_image_meta meta[6];
+  set_meta(&meta[0], "iris:method", "mis");
+  set_meta(&meta[1], "iris:seed", "1");
+  set_meta(&meta[2], "iris:spp", "4");
+  set_meta(&meta[3], "iris:scene_hash", "ab");
+  set_meta(&meta[4], "iris:window", "0,0,4,3");
+  set_meta(&meta[5], "iris:full_size", "4,3");
+  size_t n = 6;
+  for (size_t i = 0; i < n; i++)
+    if (strcmp(meta[i].key, key) == 0) {
+      if (value)
+        set_meta(&meta[i], key, value);
+      else
+        meta[i] = meta[--n];
+    }
+  iris_merge m;
+  iris_merge_init(&m);
+  iris_status st = iris_merge_add(&m, "bad.exr", &img, meta, n, &err);
+  iris_check_record(st == IRIS_ERR_INVALID && strstr(err.message, needle) != NULL, __FILE__,
+                    __LINE__, "%s=%s: status %s, message '%s' (want '%s')", key,
+                    value ? value : "(absent)", iris_status_name(st), err.message, needle);
+  iris_merge_destroy(&m);
+  iris_image_destroy(&img);
+}
+
+static void test_bad_metadata(void) {
+  expect_bad_meta("iris:scene_hash", NULL, "no iris:scene_hash");
+  expect_bad_meta("iris:spp", NULL, "not an iris render");
+  expect_bad_meta("iris:spp", "0", "not a sample count");
+  expect_bad_meta("iris:spp", "4x", "not a sample count");
+  expect_bad_meta("iris:window", "0,0,5,3", "outside the 4x3 frame");
+  expect_bad_meta("iris:window", "0,0,2,3", "image is 4x3 but its window");
+  expect_bad_meta("iris:window", "0,0,4", "not x0,y0,x1,y1");
+  expect_bad_meta("iris:full_size", "65536,65536", "larger than any iris film");
+  expect_bad_meta("iris:full_size", "-4,3", "not W,H");
+}
+
 /* ---- real renders ---------------------------------------------------------- */
 
 typedef struct job {
@@ -424,6 +469,7 @@ int main(void) {
   if (iris_test_tmpdir(g_dir, sizeof g_dir, "merge") != 0) return TEST_SKIP("no temp dir");
   test_synthetic(0);
   test_synthetic(1);
+  test_bad_metadata();
   iris_scene *cornell = NULL;
   iris_error err;
   iris_error_clear(&err);
