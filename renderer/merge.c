@@ -352,8 +352,7 @@ typedef struct window_run {
   int64_t begin, end;
 } window_run;
 
-static iris_status check_coverage(iris_merge *m, size_t *window_count, int64_t *begin,
-                                  int64_t *end, iris_error *err) {
+static iris_status check_coverage(iris_merge *m, int64_t *begin, int64_t *end, iris_error *err) {
   qsort(m->parts, m->part_count, sizeof *m->parts, cmp_parts);
   window_run *runs = calloc(m->part_count, sizeof *runs);
   if (!runs) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
@@ -420,7 +419,7 @@ static iris_status check_coverage(iris_merge *m, size_t *window_count, int64_t *
                         m->width, m->height);
   }
   if (st == IRIS_OK) {
-    *window_count = nr;
+    m->window_count = nr;
     *begin = runs[0].begin;
     *end = runs[0].end;
   }
@@ -435,9 +434,8 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
   *meta_count_out = 0;
   if (m->part_count == 0)
     return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL, "no parts to merge");
-  size_t windows = 0;
   int64_t begin = 0, end = 0;
-  iris_status st = check_coverage(m, &windows, &begin, &end, err);
+  iris_status st = check_coverage(m, &begin, &end, err);
   if (st != IRIS_OK) return st;
   static const char *const names[6] = {"R", "G", "B", "var.R", "var.G", "var.B"};
   const bool var = m->all_variance;
@@ -490,7 +488,6 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
 #undef META
   *meta_out = meta;
   *meta_count_out = k;
-  (void)windows;
   return IRIS_OK;
 }
 
@@ -526,10 +523,7 @@ iris_status iris_merge_files(const char *const *paths, size_t count, const char 
         if (strcmp(meta[i].key, "iris:sample_offset") == 0)
           summary->sample_offset = strtoll(meta[i].value, NULL, 10);
       }
-      size_t w = 0;
-      for (size_t i = 0; i < m.part_count; i++)
-        if (i == 0 || !same_window(&m.parts[i].info, &m.parts[i - 1].info)) w++;
-      summary->windows = w;
+      summary->windows = m.window_count;
     }
     st = iris_exr_write(out_path, &out, meta, mc, err);
   }

@@ -58,6 +58,7 @@ typedef struct iris_merge_part {
 typedef struct iris_merge {
   iris_merge_part *parts;
   size_t part_count, part_capacity;
+  size_t window_count;   /* distinct windows (set by iris_merge_finish) */
   iris_image_meta *meta; /* the first part's metadata */
   size_t meta_count;
   double render_seconds; /* sum over parts */
