@@ -81,7 +81,7 @@ int main(void) {
   for (int i = 0; i < 3; i++) {
     ctx c = {accel, &lights, refs[i]};
     chi2_domain dom = {CHI2_SPHERE, 64, 128, 1234 + (uint64_t)i};
-    chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 1000000, 0.01, 3);
+    chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 500000, 0.01, 3);
     iris_check_record(r.passed, __FILE__, __LINE__, "light sampling at ref %d: %s", i, r.message);
     printf("ref %d: p = %.3g, pdf integral %.4f, lost %zu\n", i, r.p_value, r.pdf_integral, r.lost);
   }
