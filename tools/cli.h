@@ -41,5 +41,8 @@ int iris_cmd_info(int argc, char **argv);
 int iris_cmd_render(int argc, char **argv);
 int iris_cmd_export(int argc, char **argv);
 int iris_cmd_merge(int argc, char **argv);
+int iris_cmd_validate(int argc, char **argv);
+int iris_cmd_bench(int argc, char **argv);
+int iris_cmd_report(int argc, char **argv);
 
 #endif

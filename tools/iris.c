@@ -11,6 +11,9 @@ static const iris_command COMMANDS[] = {
     {"render", "render a scene (or any importable file) to EXR/PNG", iris_cmd_render},
     {"export", "export a scene to Blender (Python) or POV-Ray (SDL)", iris_cmd_export},
     {"merge", "merge the EXRs of a partitioned render (sample ranges, windows)", iris_cmd_merge},
+    {"validate", "compare iris with Blender Cycles (stored reference or Blender)", iris_cmd_validate},
+    {"bench", "speed against accuracy: relMSE vs time per method, charts, tables", iris_cmd_bench},
+    {"report", "self-contained HTML page from bench and validate outputs", iris_cmd_report},
 };
 static const size_t COMMAND_COUNT = sizeof COMMANDS / sizeof COMMANDS[0];
 

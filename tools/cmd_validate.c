@@ -1,0 +1,283 @@
+/* `iris validate INPUT --out DIR`: renders INPUT with iris and compares it with
+ * Cycles (a stored or given reference EXR, or Blender run here), and
+ * `iris validate --refresh` regenerates the stored references. The library
+ * does the work (validate/validate.h); docs/cli.md ("validate") lists the flags. */
+#include <getopt.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
+#include "validate/validate.h"
+#include "tools/cli.h"
+
+static const char *const CMD = "validate";
+
+static void print_help(void) {
+  printf(
+      "Usage: iris validate INPUT --out DIR [--reference REF.exr | --blender] [options]\n"
+      "       iris validate --refresh [SCENE...] [--blender-spp N] [--threads T] [--seed S]\n"
+      "\n"
+      "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene:\n"
+      "cornell-box, veach-mis, door, ...) with iris and compares it with Blender Cycles:\n"
+      "per-channel mean energy, energy per 8x8 block, relMSE, MAPE, block and per-pixel\n"
+      "z-tests using iris's variance, NaN/Inf counts. Writes DIR/report.html,\n"
+      "DIR/summary.json, DIR/<method>.exr and PNGs.\n"
+      "\n"
+      "Reference (one of; default for cornell-box, veach-mis and door: the stored one):\n"
+      "      --reference REF.exr   a Cycles (or other) EXR; iris renders at its size\n"
+      "      --blender             export the scene, run Blender here (--blender-spp)\n"
+      "      --blender-spp N       Cycles samples per pixel (default %d; --refresh: per scene)\n"
+      "Rendering:\n"
+      "      --method M            bsdf | nee | mis | guided | guided-nee; repeat or give a\n"
+      "                            comma list to validate several (default mis)\n"
+      "      --spp N               iris samples per pixel (default %d)\n"
+      "      --seed N              seed of iris and Cycles (default 0)\n"
+      "      --threads N           threads of iris and Cycles (default: all cores)\n"
+      "      --width W --height H  image size (must match a given reference)\n"
+      "      --max-depth B         bounces as Cycles counts them (default: scene's, else 64)\n"
+      "      --camera NAME         scene camera to use\n"
+      "Checks:\n"
+      "      --tolerance T         allowed relative mean-energy difference (default 0.01)\n"
+      "      --alpha A             family-wise significance of the z-tests (default 0.01)\n"
+      "      --strict-pixels       fail on the per-pixel z-test too (default: reported; the\n"
+      "                            8x8 block z-test always decides)\n"
+      "Refresh:\n"
+      "      --refresh             regenerate validate/references/<scene>.exr + .json with\n"
+      "                            Blender (all reference scenes, or the ones named)\n"
+      "      --references DIR      where stored references live (default: the source tree's\n"
+      "                            validate/references)\n"
+      "Other:\n"
+      "      --out DIR             output folder (created if missing)\n"
+      "      --blender-exe FILE    Blender executable (default $IRIS_BLENDER, else blender)\n"
+      "  -q, --quiet               no progress messages\n"
+      "  -h, --help                show this help\n"
+      "\n"
+      "Exit status: 0 all methods pass, 1 a check failed (energy beyond the tolerance, a\n"
+      "z-test, NaN/Inf in iris's image) or Blender failed, 2 bad usage or bad input:\n"
+      "missing/unreadable/non-finite reference, different image sizes.\n",
+      IRIS_VALIDATE_DEFAULT_BLENDER_SPP, IRIS_VALIDATE_DEFAULT_SPP);
+}
+
+static volatile sig_atomic_t g_stop = 0;
+static void on_signal(int sig) { g_stop = sig; }
+
+static const char *default_references_dir(void) {
+#ifdef IRIS_SOURCE_DIR
+  return IRIS_SOURCE_DIR "/validate/references";
+#else
+  return "validate/references";
+#endif
+}
+
+static bool add_methods(iris_validate_params *p, const char *list) {
+  char buf[256];
+  snprintf(buf, sizeof buf, "%s", list);
+  for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+    iris_method m;
+    if (!iris_method_parse(tok, &m)) {
+      iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", tok);
+      return false;
+    }
+    for (int i = 0; i < p->method_count; i++)
+      if (p->methods[i] == m) {
+        iris_cli_usage_error(CMD, "method '%s' given twice", tok);
+        return false;
+      }
+    p->methods[p->method_count++] = m;
+  }
+  return true;
+}
+
+static bool is_reference_scene(const char *name) {
+  for (const char *const *s = iris_validate_reference_scenes(); *s; s++)
+    if (strcmp(*s, name) == 0) return true;
+  return false;
+}
+
+int iris_cmd_validate(int argc, char **argv) {
+  enum {
+    OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
+    OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
+    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT
+  };
+  static const struct option longopts[] = {
+      {"method", required_argument, NULL, OPT_METHOD},
+      {"spp", required_argument, NULL, OPT_SPP},
+      {"reference", required_argument, NULL, OPT_REFERENCE},
+      {"blender", no_argument, NULL, OPT_BLENDER},
+      {"tolerance", required_argument, NULL, OPT_TOLERANCE},
+      {"blender-spp", required_argument, NULL, OPT_BLENDER_SPP},
+      {"threads", required_argument, NULL, OPT_THREADS},
+      {"seed", required_argument, NULL, OPT_SEED},
+      {"width", required_argument, NULL, OPT_WIDTH},
+      {"height", required_argument, NULL, OPT_HEIGHT},
+      {"out", required_argument, NULL, OPT_OUT},
+      {"refresh", no_argument, NULL, OPT_REFRESH},
+      {"references", required_argument, NULL, OPT_REFERENCES},
+      {"max-depth", required_argument, NULL, OPT_DEPTH},
+      {"camera", required_argument, NULL, OPT_CAMERA},
+      {"alpha", required_argument, NULL, OPT_ALPHA},
+      {"blender-exe", required_argument, NULL, OPT_BLENDER_EXE},
+      {"strict-pixels", no_argument, NULL, OPT_STRICT},
+      {"quiet", no_argument, NULL, 'q'},
+      {"help", no_argument, NULL, 'h'},
+      {NULL, 0, NULL, 0}};
+  iris_validate_params p = iris_validate_params_default();
+  bool blender = false, refresh = false, have_blender_spp = false;
+  const char *references = NULL;
+  long v;
+  double d;
+  opterr = 0;
+  optind = 1;
+  int c;
+  while ((c = getopt_long(argc, argv, ":qh", longopts, NULL)) != -1) {
+    switch (c) {
+      case OPT_METHOD:
+        if (!add_methods(&p, optarg)) return IRIS_EXIT_USAGE;
+        break;
+      case OPT_SPP:
+        if (!iris_cli_parse_int(CMD, "--spp", optarg, 1, 1 << 24, &v)) return IRIS_EXIT_USAGE;
+        p.spp = (int)v;
+        break;
+      case OPT_REFERENCE:
+        if (p.reference_path)
+          return iris_cli_usage_error(CMD, "--reference given twice ('%s' and '%s')", p.reference_path, optarg);
+        p.reference_path = optarg;
+        break;
+      case OPT_BLENDER: blender = true; break;
+      case OPT_TOLERANCE:
+        if (!iris_cli_parse_float(CMD, "--tolerance", optarg, 0.0, 10.0, &d)) return IRIS_EXIT_USAGE;
+        p.tolerance = d;
+        break;
+      case OPT_ALPHA:
+        if (!iris_cli_parse_float(CMD, "--alpha", optarg, 1e-12, 0.5, &d)) return IRIS_EXIT_USAGE;
+        p.alpha = d;
+        break;
+      case OPT_BLENDER_SPP:
+        if (!iris_cli_parse_int(CMD, "--blender-spp", optarg, 1, 1 << 20, &v)) return IRIS_EXIT_USAGE;
+        p.blender_spp = (int)v;
+        have_blender_spp = true;
+        break;
+      case OPT_THREADS:
+        if (!iris_cli_parse_int(CMD, "--threads", optarg, 1, 4096, &v)) return IRIS_EXIT_USAGE;
+        p.threads = (int)v;
+        break;
+      case OPT_SEED:
+        /* Cycles' seed is a non-negative 32-bit int; both renderers get the same. */
+        if (!iris_cli_parse_int(CMD, "--seed", optarg, 0, 2147483647L, &v)) return IRIS_EXIT_USAGE;
+        p.seed = (uint64_t)v;
+        break;
+      case OPT_WIDTH:
+        if (!iris_cli_parse_int(CMD, "--width", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
+        p.width = (int)v;
+        break;
+      case OPT_HEIGHT:
+        if (!iris_cli_parse_int(CMD, "--height", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
+        p.height = (int)v;
+        break;
+      case OPT_DEPTH:
+        if (!iris_cli_parse_int(CMD, "--max-depth", optarg, 0, 1024, &v)) return IRIS_EXIT_USAGE;
+        p.max_depth = (int)v;
+        break;
+      case OPT_OUT:
+        if (p.out_dir) return iris_cli_usage_error(CMD, "--out given twice ('%s' and '%s')", p.out_dir, optarg);
+        p.out_dir = optarg;
+        break;
+      case OPT_CAMERA:
+        if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
+        p.camera_name = optarg;
+        break;
+      case OPT_REFRESH: refresh = true; break;
+      case OPT_REFERENCES: references = optarg; break;
+      case OPT_BLENDER_EXE: p.blender = optarg; break;
+      case OPT_STRICT: p.pixel_test_gates = true; break;
+      case 'q': p.quiet = true; break;
+      case 'h': print_help(); return IRIS_EXIT_OK;
+      case ':': return iris_cli_usage_error(CMD, "option '%s' needs a value", argv[optind - 1]);
+      default:
+        if (optopt) return iris_cli_usage_error(CMD, "unknown option '-%c'", optopt);
+        return iris_cli_usage_error(CMD, "unknown option '%s'", argv[optind - 1]);
+    }
+  }
+  if (p.quiet) iris_log_set_level(IRIS_LOG_QUIET);
+  if (!references) references = default_references_dir();
+
+  iris_error err;
+  iris_error_clear(&err);
+  if (refresh) {
+    /* Everything checked before the (long) Blender runs. */
+    if (p.reference_path || blender || p.out_dir || p.method_count || p.width > 0 || p.height > 0)
+      return iris_cli_usage_error(CMD, "--refresh takes only scene names, --blender-spp, --threads, "
+                                       "--seed, --references and --blender-exe");
+    for (int i = optind; i < argc; i++)
+      if (!is_reference_scene(argv[i]))
+        return iris_cli_usage_error(CMD, "'%s' has no stored reference (cornell-box, veach-mis, door)", argv[i]);
+    const char *const *all = iris_validate_reference_scenes();
+    int count = argc - optind;
+    for (int i = 0; count == 0 ? all[i] != NULL : i < count; i++) {
+      iris_refresh_params rp = {count ? argv[optind + i] : all[i], references,
+                                have_blender_spp ? p.blender_spp : 0, p.seed, p.threads, p.blender,
+                                p.quiet};
+      if (iris_validate_refresh(&rp, &err) != IRIS_OK) return iris_cli_report(&err);
+    }
+    return IRIS_EXIT_OK;
+  }
+
+  if (argc - optind == 0) return iris_cli_usage_error(CMD, "no input");
+  if (argc - optind > 1)
+    return iris_cli_usage_error(CMD, "one input only (got '%s' and '%s')", argv[optind], argv[optind + 1]);
+  p.input = argv[optind];
+  if (!p.out_dir) return iris_cli_usage_error(CMD, "missing --out DIR");
+  if (blender && p.reference_path) return iris_cli_usage_error(CMD, "--reference and --blender exclude each other");
+  if (have_blender_spp && !blender) return iris_cli_usage_error(CMD, "--blender-spp needs --blender (or --refresh)");
+  if ((p.width > 0) != (p.height > 0)) return iris_cli_usage_error(CMD, "give both --width and --height");
+  char stored[1200];
+  if (blender) {
+    p.source = IRIS_REFERENCE_BLENDER;
+  } else {
+    p.source = IRIS_REFERENCE_FILE;
+    if (!p.reference_path) {
+      if (!is_reference_scene(p.input) || iris_path_exists(p.input))
+        return iris_cli_usage_error(CMD, "'%s' has no stored reference: give --reference REF.exr or --blender", p.input);
+      snprintf(stored, sizeof stored, "%s/%s.exr", references, p.input);
+      p.reference_path = stored;
+    }
+  }
+
+  struct sigaction sa, old_int, old_term;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sa.sa_flags = SA_RESETHAND;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &old_int);
+  sigaction(SIGTERM, &sa, &old_term);
+  p.cancel = &g_stop;
+  iris_validate_result res;
+  iris_status st = iris_validate_run(&p, &res, &err);
+  sigaction(SIGINT, &old_int, NULL);
+  sigaction(SIGTERM, &old_term, NULL);
+  if (st == IRIS_ERR_INTERRUPTED) return g_stop == SIGTERM ? 143 : 130;
+  if (st != IRIS_OK) {
+    /* A reference that cannot be read or used is bad input (2); Blender
+     * failing is a failure of the run (1). */
+    return iris_cli_report(&err);
+  }
+  if (!p.quiet) {
+    for (int k = 0; k < res.method_count; k++) {
+      const iris_validate_method *m = &res.methods[k];
+      iris_infof("validate: %s %s: energy ratio %.5f (R %.5f G %.5f B %.5f) %s, max block dev %+.2f%%, "
+                 "block z %.2f/%.2f, pixel z %.2f/%.2f, |z|>3 %llu/%.0f allowed, z-test %s, relMSE %.4g -> %s",
+                 res.scene, iris_method_name(m->method), m->energy_ratio, m->channel_ratio[0],
+                 m->channel_ratio[1], m->channel_ratio[2], m->energy_passed ? "ok" : "OFF",
+                 100.0 * m->blocks.signed_max_rel_dev, m->blocks.max_abs_z, m->blocks.z_crit,
+                 m->pixels.max_abs_z, m->pixels.z_crit, (unsigned long long)m->pixels.over_count,
+                 m->pixels.allowed_over, m->z_passed ? "ok" : "FAILED", m->relmse,
+                 m->passed ? "pass" : "FAIL");
+    }
+    iris_infof("validate: report in %s/report.html", p.out_dir);
+  }
+  return res.passed ? IRIS_EXIT_OK : IRIS_EXIT_FAILURE;
+}

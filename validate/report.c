@@ -1,0 +1,299 @@
+/* Report outputs of `iris validate` (validate/report.h). */
+#include "validate/report.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
+
+#include "core/fileio.h"
+#include "validate/metrics.h"
+
+float iris_report_exposure(const double ref_mean[3]) {
+  double e = (ref_mean[0] + ref_mean[1] + ref_mean[2]) / 3.0;
+  if (!(e > 0.0)) return 0.0f;
+  double ev = log2(0.18 / e);
+  return (float)(ev < -10 ? -10 : ev > 10 ? 10 : ev);
+}
+
+void iris_report_png_name(const char *method, const char *kind, char *buf, size_t size) {
+  if (kind && kind[0])
+    snprintf(buf, size, "%s-%s.png", method, kind);
+  else
+    snprintf(buf, size, "%s.png", method);
+}
+
+void iris_report_relative_difference(const iris_image *test, const iris_image *ref, float *out) {
+  size_t n = (size_t)ref->width * (size_t)ref->height;
+  for (size_t i = 0; i < n; i++) {
+    const float *t = test->data + i * (size_t)test->channel_count;
+    const float *r = ref->data + i * (size_t)ref->channel_count;
+    double et = (double)t[0] + t[1] + t[2], er = (double)r[0] + r[1] + r[2];
+    out[i] = (float)((et - er) / (er + 3.0 * IRIS_METRIC_EPS));
+  }
+}
+
+iris_status iris_report_write_false_colour(const char *path, const float *values, int width,
+                                           int height, float range, iris_error *err) {
+  static const char *const names[3] = {"R", "G", "B"};
+  iris_image img;
+  iris_status st = iris_image_create(&img, width, height, 3, names, err);
+  if (st != IRIS_OK) return st;
+  size_t n = (size_t)width * (size_t)height;
+  for (size_t i = 0; i < n; i++) {
+    float v = values[i];
+    float t = isfinite(v) ? v / range : (v > 0 ? 1.0f : -1.0f);
+    if (isnan(v)) t = 0.0f;
+    t = t < -1 ? -1 : t > 1 ? 1 : t;
+    /* white at 0, towards red (iris brighter) or blue (iris darker); the PNG
+     * writer applies the sRGB curve, so hand it linear values */
+    float a = fabsf(t);
+    float rgb[3];
+    if (t >= 0) {
+      rgb[0] = 1.0f; rgb[1] = 1.0f - 0.85f * a; rgb[2] = 1.0f - 0.85f * a;
+    } else {
+      rgb[0] = 1.0f - 0.85f * a; rgb[1] = 1.0f - 0.6f * a; rgb[2] = 1.0f;
+    }
+    if (isnan(v)) { rgb[0] = 0.0f; rgb[1] = 1.0f; rgb[2] = 0.0f; } /* NaN: green */
+    for (int c = 0; c < 3; c++) img.data[3 * i + (size_t)c] = iris_srgb_to_linear(rgb[c]);
+  }
+  st = iris_png_write(path, &img, 0, 0.0f, err);
+  iris_image_destroy(&img);
+  return st;
+}
+
+/* ---- summary.json ---------------------------------------------------- */
+
+static cJSON *triple(const double v[3]) {
+  cJSON *a = cJSON_CreateArray();
+  for (int c = 0; c < 3; c++) cJSON_AddItemToArray(a, cJSON_CreateNumber(isfinite(v[c]) ? v[c] : -1));
+  return a;
+}
+
+/* JSON has no Inf: non-finite numbers are written as null. */
+static void add_num(cJSON *o, const char *k, double v) {
+  if (isfinite(v))
+    cJSON_AddNumberToObject(o, k, v);
+  else
+    cJSON_AddNullToObject(o, k);
+}
+
+iris_status iris_report_write_summary(const char *path, const iris_validate_params *params,
+                                      const iris_validate_result *res, iris_error *err) {
+  cJSON *o = cJSON_CreateObject();
+  cJSON_AddStringToObject(o, "scene", res->scene);
+  cJSON_AddNumberToObject(o, "width", res->width);
+  cJSON_AddNumberToObject(o, "height", res->height);
+  cJSON_AddNumberToObject(o, "max_depth", res->max_depth);
+  cJSON_AddNumberToObject(o, "seed", (double)params->seed);
+  add_num(o, "tolerance", params->tolerance);
+  add_num(o, "alpha", params->alpha);
+  cJSON_AddBoolToObject(o, "pixel_test_gates", params->pixel_test_gates);
+  cJSON_AddBoolToObject(o, "passed", res->passed);
+  cJSON *r = cJSON_AddObjectToObject(o, "reference");
+  cJSON_AddStringToObject(r, "path", res->reference.path);
+  cJSON_AddStringToObject(r, "description", res->reference.description);
+  cJSON_AddStringToObject(r, "source", params->source == IRIS_REFERENCE_BLENDER ? "blender" : "file");
+  cJSON_AddNumberToObject(r, "spp", res->reference.spp);
+  cJSON_AddItemToObject(r, "mean", triple(res->reference.mean));
+  cJSON_AddNumberToObject(r, "nan_count", (double)res->reference.nan_count);
+  cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
+  cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
+  add_num(r, "seconds", res->reference.seconds);
+  cJSON *ms = cJSON_AddArrayToObject(o, "methods");
+  for (int k = 0; k < res->method_count; k++) {
+    const iris_validate_method *m = &res->methods[k];
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddStringToObject(j, "method", iris_method_name(m->method));
+    cJSON_AddNumberToObject(j, "spp", m->spp);
+    add_num(j, "seconds", m->seconds);
+    cJSON_AddItemToObject(j, "mean", triple(m->mean));
+    cJSON_AddItemToObject(j, "channel_ratio", triple(m->channel_ratio));
+    add_num(j, "energy_ratio", m->energy_ratio);
+    cJSON_AddNumberToObject(j, "nan_count", (double)m->nan_count);
+    cJSON_AddNumberToObject(j, "inf_count", (double)m->inf_count);
+    cJSON_AddNumberToObject(j, "dropped_nonfinite_samples", (double)m->dropped_samples);
+    add_num(j, "relmse", m->relmse);
+    add_num(j, "mape", m->mape);
+    cJSON_AddStringToObject(j, "reference_variance", m->ref_variance);
+    cJSON *b = cJSON_AddObjectToObject(j, "blocks");
+    cJSON_AddNumberToObject(b, "block", m->blocks.block);
+    cJSON_AddNumberToObject(b, "tiles", (double)m->blocks.tiles_x * m->blocks.tiles_y);
+    cJSON_AddNumberToObject(b, "compared", m->blocks.compared);
+    add_num(b, "max_rel_dev", m->blocks.signed_max_rel_dev);
+    cJSON *at = cJSON_AddArrayToObject(b, "max_at_pixel");
+    cJSON_AddItemToArray(at, cJSON_CreateNumber(m->blocks.max_tile_x * m->blocks.block));
+    cJSON_AddItemToArray(at, cJSON_CreateNumber(m->blocks.max_tile_y * m->blocks.block));
+    add_num(b, "rms_rel_dev", m->blocks.rms_rel_dev);
+    cJSON_AddNumberToObject(b, "z_tests", (double)m->blocks.z_tests);
+    add_num(b, "max_abs_z", m->blocks.max_abs_z);
+    add_num(b, "z_crit", m->blocks.z_crit);
+    cJSON_AddNumberToObject(b, "z_over", (double)m->blocks.z_over);
+    cJSON_AddNumberToObject(b, "zero_variance_mismatches", (double)m->blocks.z_degenerate_fail);
+    cJSON_AddBoolToObject(b, "passed", m->blocks.passed);
+    cJSON *z = cJSON_AddObjectToObject(j, "pixels");
+    cJSON_AddNumberToObject(z, "tests", (double)m->pixels.tests);
+    add_num(z, "max_abs_z", m->pixels.max_abs_z);
+    cJSON *zat = cJSON_AddArrayToObject(z, "max_at");
+    cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_x));
+    cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_y));
+    cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_c));
+    add_num(z, "z_crit", m->pixels.z_crit);
+    cJSON_AddNumberToObject(z, "over_crit", (double)m->pixels.over_crit);
+    add_num(z, "count_threshold", m->pixels.count_threshold);
+    cJSON_AddNumberToObject(z, "over_count", (double)m->pixels.over_count);
+    add_num(z, "expected_over", m->pixels.expected_over);
+    add_num(z, "allowed_over", m->pixels.allowed_over);
+    cJSON_AddNumberToObject(z, "zero_variance", (double)m->pixels.degenerate);
+    cJSON_AddNumberToObject(z, "zero_variance_mismatches", (double)m->pixels.degenerate_fail);
+    cJSON_AddBoolToObject(z, "bonferroni_passed", m->pixels.bonferroni_passed);
+    cJSON_AddBoolToObject(z, "count_passed", m->pixels.count_passed);
+    cJSON_AddBoolToObject(z, "passed", m->pixels.passed);
+    cJSON_AddBoolToObject(j, "energy_passed", m->energy_passed);
+    cJSON_AddBoolToObject(j, "z_passed", m->z_passed);
+    cJSON_AddBoolToObject(j, "passed", m->passed);
+    cJSON_AddItemToArray(ms, j);
+  }
+  char *text = cJSON_Print(o);
+  cJSON_Delete(o);
+  if (!text) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
+  size_t len = strlen(text);
+  text[len] = '\n';
+  iris_status st = iris_file_write_atomic(path, text, len + 1, err);
+  free(text);
+  return st;
+}
+
+/* ---- report.html ------------------------------------------------------- */
+
+static const char B64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+/* Writes the PNG `name` of `dir` as a data URI (falls back to the relative name). */
+static void put_image(FILE *fp, const char *dir, const char *name, const char *alt) {
+  char path[1300];
+  iris_path_join(dir, name, path, sizeof path);
+  char *data = NULL;
+  size_t size = 0;
+  fprintf(fp, "<img alt=\"%s\" title=\"%s\" src=\"", alt, alt);
+  if (iris_file_read(path, 256u << 20, &data, &size, NULL) == IRIS_OK) {
+    fputs("data:image/png;base64,", fp);
+    const unsigned char *d = (const unsigned char *)data;
+    for (size_t i = 0; i < size; i += 3) {
+      unsigned v = (unsigned)d[i] << 16 | (i + 1 < size ? (unsigned)d[i + 1] << 8 : 0) |
+                   (i + 2 < size ? d[i + 2] : 0);
+      fputc(B64[v >> 18 & 63], fp);
+      fputc(B64[v >> 12 & 63], fp);
+      fputc(i + 1 < size ? B64[v >> 6 & 63] : '=', fp);
+      fputc(i + 2 < size ? B64[v & 63] : '=', fp);
+    }
+    free(data);
+  } else {
+    fputs(name, fp);
+  }
+  fputs("\">", fp);
+}
+
+static void html_escape(FILE *fp, const char *s) {
+  for (; *s; s++) {
+    if (*s == '<') fputs("&lt;", fp);
+    else if (*s == '>') fputs("&gt;", fp);
+    else if (*s == '&') fputs("&amp;", fp);
+    else if (*s == '"') fputs("&quot;", fp);
+    else fputc(*s, fp);
+  }
+}
+
+static const char *verdict(bool ok) { return ok ? "<b class=ok>pass</b>" : "<b class=bad>FAIL</b>"; }
+
+iris_status iris_report_write_html(const char *dir, const iris_validate_params *params,
+                                   const iris_validate_result *res, iris_error *err) {
+  char path[1300];
+  iris_path_join(dir, "report.html", path, sizeof path);
+  iris_atomic_file f;
+  iris_status st = iris_atomic_open(&f, path, err);
+  if (st != IRIS_OK) return st;
+  FILE *fp = f.fp;
+  fprintf(fp, "<!DOCTYPE html>\n<html lang=en><head><meta charset=utf-8><title>iris validate: ");
+  html_escape(fp, res->scene);
+  fprintf(fp, "</title>\n<style>body{font-family:sans-serif;margin:1.5em;max-width:1400px}"
+              "table{border-collapse:collapse;margin:0.8em 0}td,th{border:1px solid #bbb;padding:3px 8px;"
+              "text-align:right}th{background:#eee}td.l{text-align:left}.ok{color:#080}.bad{color:#c00}"
+              "figure{display:inline-block;margin:0 8px 8px 0}figcaption{font-size:90%%}"
+              "img{image-rendering:pixelated;border:1px solid #888}</style></head><body>\n");
+  fprintf(fp, "<h1>iris validate: ");
+  html_escape(fp, res->scene);
+  fprintf(fp, " &mdash; %s</h1>\n", verdict(res->passed));
+  fprintf(fp, "<p>%dx%d pixels, %d bounces (Cycles' count), energy tolerance %.3g%%, z-test "
+              "family-wise &alpha; = %g. Reference: ", res->width, res->height, res->max_depth,
+          100.0 * params->tolerance, params->alpha);
+  html_escape(fp, res->reference.description);
+  fprintf(fp, " (<code>");
+  html_escape(fp, res->reference.path);
+  fprintf(fp, "</code>), mean RGB %.6g %.6g %.6g, %llu NaN, %llu Inf.</p>\n", res->reference.mean[0],
+          res->reference.mean[1], res->reference.mean[2], (unsigned long long)res->reference.nan_count,
+          (unsigned long long)res->reference.inf_count);
+
+  fprintf(fp, "<h2>Summary</h2><table><tr><th>method</th><th>spp</th><th>seconds</th>"
+              "<th>ratio R</th><th>ratio G</th><th>ratio B</th><th>energy ratio</th><th>energy</th>"
+              "<th>relMSE</th><th>MAPE</th><th>max block dev</th><th>block |z| max / crit</th>"
+              "<th>pixel |z| max / crit</th><th>|z|&gt;3 count / allowed</th><th>NaN/Inf</th>"
+              "<th>z-test</th><th>result</th></tr>\n");
+  for (int k = 0; k < res->method_count; k++) {
+    const iris_validate_method *m = &res->methods[k];
+    fprintf(fp, "<tr><td class=l>%s</td><td>%d</td><td>%.2f</td><td>%.5f</td><td>%.5f</td><td>%.5f</td>"
+                "<td>%.5f</td><td>%s</td><td>%.4g</td><td>%.4g</td><td>%+.2f%%</td><td>%.2f / %.2f</td>"
+                "<td>%.2f / %.2f</td><td>%llu / %.0f</td><td>%llu</td><td>%s</td><td>%s</td></tr>\n",
+            iris_method_name(m->method), m->spp, m->seconds, m->channel_ratio[0], m->channel_ratio[1],
+            m->channel_ratio[2], m->energy_ratio, verdict(m->energy_passed), m->relmse, m->mape,
+            100.0 * m->blocks.signed_max_rel_dev, m->blocks.max_abs_z, m->blocks.z_crit,
+            m->pixels.max_abs_z, m->pixels.z_crit, (unsigned long long)m->pixels.over_count,
+            m->pixels.allowed_over, (unsigned long long)(m->nan_count + m->inf_count),
+            verdict(m->z_passed), verdict(m->passed));
+  }
+  fprintf(fp, "</table>\n<p>Energy: per-channel mean of iris over the reference; pass when every "
+              "channel and the sum are within the tolerance. Blocks: %dx%d tiles, the largest "
+              "relative deviation of tile energy (tiles above %g of the mean tile energy) and a "
+              "per-tile, per-channel z-test with Bonferroni correction. Pixels: per-pixel z with "
+              "Bonferroni (no |z| above crit) and a count test (number of |z|&gt;3 within its "
+              "binomial expectation). Formulas: docs/validation.md.</p>\n",
+          IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK_FLOOR);
+
+  for (int k = 0; k < res->method_count; k++) {
+    const iris_validate_method *m = &res->methods[k];
+    const char *name = iris_method_name(m->method);
+    char file[128], alt[160];
+    fprintf(fp, "<h2>%s</h2><p>Reference variance in the z-tests: ", name);
+    html_escape(fp, m->ref_variance);
+    fprintf(fp, ". Largest pixel |z| %.2f at (%d, %d) channel %c; %llu zero-variance values, %llu of "
+                "them differing. Block z: %llu tests, %llu over %.2f.</p>\n",
+            m->pixels.max_abs_z, m->pixels.max_x, m->pixels.max_y, "RGB"[m->pixels.max_c],
+            (unsigned long long)m->pixels.degenerate, (unsigned long long)m->pixels.degenerate_fail,
+            (unsigned long long)m->blocks.z_tests, (unsigned long long)m->blocks.z_over, m->blocks.z_crit);
+    fprintf(fp, "<figure>");
+    iris_report_png_name(name, "", file, sizeof file);
+    snprintf(alt, sizeof alt, "iris %s", name);
+    put_image(fp, dir, file, alt);
+    fprintf(fp, "<figcaption>iris, %s, %d spp</figcaption></figure>\n<figure>", name, m->spp);
+    put_image(fp, dir, "cycles.png", "Cycles reference");
+    fprintf(fp, "<figcaption>Cycles reference</figcaption></figure>\n<figure>");
+    iris_report_png_name(name, "diff", file, sizeof file);
+    snprintf(alt, sizeof alt, "relative difference %s", name);
+    put_image(fp, dir, file, alt);
+    fprintf(fp, "<figcaption>(E<sub>iris</sub> &minus; E<sub>ref</sub>) / (E<sub>ref</sub> + 0.03): "
+                "blue &minus;0.5 &hellip; white 0 &hellip; red +0.5</figcaption></figure>\n<figure>");
+    iris_report_png_name(name, "z", file, sizeof file);
+    snprintf(alt, sizeof alt, "z-score %s", name);
+    put_image(fp, dir, file, alt);
+    fprintf(fp, "<figcaption>per-pixel z (largest channel): blue &minus;5 &hellip; red +5</figcaption>"
+                "</figure>\n");
+  }
+  fprintf(fp, "<p>Written by <code>iris validate</code> (iris %s). Machine-readable: "
+              "<code>summary.json</code>.</p></body></html>\n", IRIS_VERSION_STRING);
+  if (ferror(fp)) {
+    iris_atomic_abort(&f);
+    return iris_error_set(err, IRIS_ERR_IO, path, 0, NULL, "write failed");
+  }
+  return iris_atomic_commit(&f, err);
+}
