@@ -162,6 +162,7 @@ bool iris_accel_intersect(const iris_accel *a, const iris_ray *ray, iris_hit *hi
   hit->u = rh.hit.u;
   hit->v = rh.hit.v;
   hit->prim = a->instances[rh.hit.geomID].first_prim + rh.hit.primID;
+  hit->instance = rh.hit.geomID;
   return true;
 }
 
@@ -255,7 +256,7 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
 
 void iris_accel_interaction(const iris_accel *a, iris_vec3 d, const iris_hit *hit,
                             iris_interaction *si) {
-  size_t inst = instance_of(a, hit->prim);
+  size_t inst = hit->instance; /* from iris_accel_intersect: no search */
   fill_interaction(a, inst, hit->prim - a->instances[inst].first_prim, hit->u, hit->v, si);
   si->front = iris_dot(d, si->ng) < 0.0f;
 }
@@ -264,44 +265,6 @@ void iris_accel_surface_at(const iris_accel *a, uint32_t prim, float b1, float b
                            iris_interaction *si) {
   size_t inst = instance_of(a, prim);
   fill_interaction(a, inst, prim - a->instances[inst].first_prim, b1, b2, si);
-}
-
-static float offset_component(float p, float n) {
-  const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
-  if (fabsf(p) < origin) return p + float_scale * n;
-  int32_t of = (int32_t)(int_scale * n);
-  int32_t bits;
-  memcpy(&bits, &p, sizeof bits);
-  bits += p < 0.0f ? -of : of;
-  float r;
-  memcpy(&r, &bits, sizeof r);
-  return r;
-}
-
-iris_vec3 iris_offset_origin(iris_vec3 p, iris_vec3 ng, iris_vec3 w) {
-  iris_vec3 n = iris_dot(w, ng) < 0.0f ? iris_neg(ng) : ng;
-  return iris_v3(offset_component(p.x, n.x), offset_component(p.y, n.y),
-                 offset_component(p.z, n.z));
-}
-
-iris_ray iris_spawn_ray(const iris_interaction *si, iris_vec3 w) {
-  iris_ray r;
-  r.o = iris_offset_origin(si->p, si->ng, w);
-  r.d = w;
-  r.tmin = 0.0f;
-  r.tmax = INFINITY;
-  return r;
-}
-
-iris_ray iris_spawn_ray_to(iris_vec3 p, iris_vec3 ng, iris_vec3 target, iris_vec3 target_ng) {
-  iris_vec3 o = iris_offset_origin(p, ng, iris_sub(target, p));
-  iris_vec3 t = iris_offset_origin(target, target_ng, iris_sub(p, target));
-  iris_ray r;
-  r.o = o;
-  r.d = iris_sub(t, o);
-  r.tmin = 0.0f;
-  r.tmax = 1.0f - 1e-5f;
-  return r;
 }
 
 uint32_t iris_accel_triangle_count(const iris_accel *a) { return a->triangle_count; }

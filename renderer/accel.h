@@ -25,11 +25,12 @@ typedef struct iris_ray {
   float tmax;
 } iris_ray;
 
-/* A hit: distance, barycentrics of vertices 1 and 2, and the global triangle
- * index (over all instances, in instance order). */
+/* A hit: distance, barycentrics of vertices 1 and 2, the global triangle
+ * index (over all instances, in instance order) and the scene instance. */
 typedef struct iris_hit {
   float t, u, v;
   uint32_t prim;
+  uint32_t instance;
 } iris_hit;
 
 /* What the renderer needs to know about a surface point. */
@@ -57,7 +58,8 @@ bool iris_accel_intersect(const iris_accel *accel, const iris_ray *ray, iris_hit
 /* Any hit in (tmin, tmax). */
 bool iris_accel_occluded(const iris_accel *accel, const iris_ray *ray);
 
-/* The surface interaction of a hit; `d` is the direction of the ray that hit. */
+/* The surface interaction of a hit made by iris_accel_intersect; `d` is the
+ * direction of the ray that hit. */
 void iris_accel_interaction(const iris_accel *accel, iris_vec3 d, const iris_hit *hit,
                             iris_interaction *si);
 /* The interaction at barycentrics (b1, b2) of triangle `prim`, as seen from
@@ -67,13 +69,48 @@ void iris_accel_surface_at(const iris_accel *accel, uint32_t prim, float b1, flo
 
 /* Ray origin that cannot re-hit the surface of `p`: p pushed a few ulps along
  * the geometric normal towards the side `w` leaves on (Waechter & Binder,
- * Ray Tracing Gems ch. 6), so the error is relative to the magnitude of p. */
-iris_vec3 iris_offset_origin(iris_vec3 p, iris_vec3 ng, iris_vec3 w);
+ * Ray Tracing Gems ch. 6), so the error is relative to the magnitude of p.
+ * These three are inline: they run for every ray, and returning a ray through
+ * memory from another translation unit cost a store-forwarding stall each. */
+static inline float iris_offset_component_(float p, float n) {
+  const float origin = 1.0f / 32.0f, float_scale = 1.0f / 65536.0f, int_scale = 256.0f;
+  if (fabsf(p) < origin) return p + float_scale * n;
+  int32_t of = (int32_t)(int_scale * n);
+  union {
+    float f;
+    int32_t i;
+  } bits;
+  bits.f = p;
+  bits.i += p < 0.0f ? -of : of;
+  return bits.f;
+}
+static inline iris_vec3 iris_offset_origin(iris_vec3 p, iris_vec3 ng, iris_vec3 w) {
+  iris_vec3 n = iris_dot(w, ng) < 0.0f ? iris_neg(ng) : ng;
+  return iris_v3(iris_offset_component_(p.x, n.x), iris_offset_component_(p.y, n.y),
+                 iris_offset_component_(p.z, n.z));
+}
 /* Ray from a surface point leaving along w (unit). */
-iris_ray iris_spawn_ray(const iris_interaction *si, iris_vec3 w);
+static inline iris_ray iris_spawn_ray(const iris_interaction *si, iris_vec3 w) {
+  iris_ray r;
+  r.o = iris_offset_origin(si->p, si->ng, w);
+  r.d = w;
+  r.tmin = 0.0f;
+  r.tmax = INFINITY;
+  return r;
+}
 /* Shadow ray between two surface points, each offset along its normal
  * towards the other; the ray ends at t = 1 just before the target. */
-iris_ray iris_spawn_ray_to(iris_vec3 p, iris_vec3 ng, iris_vec3 target, iris_vec3 target_ng);
+static inline iris_ray iris_spawn_ray_to(iris_vec3 p, iris_vec3 ng, iris_vec3 target,
+                                         iris_vec3 target_ng) {
+  iris_vec3 o = iris_offset_origin(p, ng, iris_sub(target, p));
+  iris_vec3 t = iris_offset_origin(target, target_ng, iris_sub(p, target));
+  iris_ray r;
+  r.o = o;
+  r.d = iris_sub(t, o);
+  r.tmin = 0.0f;
+  r.tmax = 1.0f - 1e-5f;
+  return r;
+}
 
 /* Scene facts the lights and the camera need. */
 uint32_t iris_accel_triangle_count(const iris_accel *accel);

@@ -79,12 +79,14 @@ static iris_status build_groups(iris_lights *L, iris_error *err) {
         }
         gr->center = iris_scale(iris_add(lo, hi), 0.5f);
         gr->radius = 0.5f * iris_length(iris_sub(hi, lo));
+        gr->phi = gr->power;
         break;
       }
       case IRIS_LIGHT_KIND_POINT:
       case IRIS_LIGHT_KIND_SPOT:
         gr->center = iris_v3_load(L->scene->lights[e0->prim].position);
         gr->radius = 0.0f;
+        gr->phi = 4.0f * IRIS_PI * luminance(e0->radiance);
         break;
       case IRIS_LIGHT_KIND_DIRECTIONAL:
         gr->irradiance = luminance(e0->radiance);
@@ -119,9 +121,7 @@ static double group_weights(const iris_lights *L, iris_vec3 ref, float *w) {
       float d2 = fmaxf(iris_dot(d, d), g->radius * g->radius);
       d2 = fmaxf(d2, 1e-12f);
       /* triangles: power / (4 pi d^2); point and spot: I / d^2 = power_point / (4 pi d^2) */
-      float phi = g->kind == IRIS_LIGHT_KIND_TRIANGLE ? g->power
-                                                       : 4.0f * IRIS_PI * luminance(L->entries[g->first].radiance);
-      v = phi / (4.0f * IRIS_PI * d2);
+      v = g->phi / (4.0f * IRIS_PI * d2);
     }
     w[k] = isfinite(v) && v > 0.0f ? v : 0.0f;
     sum += w[k];
@@ -134,13 +134,24 @@ static float entry_pmf_in_group(const iris_lights *L, uint32_t index) {
   return g->count > 1 ? iris_distrib1d_pmf(&g->select, index - g->first) : 1.0f;
 }
 
-float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t index) {
-  if (index >= L->count) return 0.0f;
-  if (L->group_count == 1) return entry_pmf_in_group(L, index);
+/* Selection probability at ref of an entry of group `group` whose probability
+ * within the group is pe. */
+static float select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t group, float pe) {
+  if (L->group_count == 1) return pe;
   float w[IRIS_LIGHTS_MAX_GROUPS + 1];
   double sum = group_weights(L, ref, w);
   if (!(sum > 0.0)) return 0.0f;
-  return (float)(w[L->entries[index].group] / sum) * entry_pmf_in_group(L, index);
+  return (float)(w[group] / sum) * pe;
+}
+
+float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t index) {
+  if (index >= L->count) return 0.0f;
+  return select_pmf_at(L, ref, L->entries[index].group, entry_pmf_in_group(L, index));
+}
+
+/* Probability of entry i within its group. */
+static float pmf_in_group(const iris_lights *L, uint32_t i) {
+  return i < L->tri_count ? L->tris[i].pmf_in_group : entry_pmf_in_group(L, i);
 }
 
 /* Two-step choice at ref; returns the entry and its probability. */
@@ -151,7 +162,9 @@ static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *p
       *pmf = 1.0f;
       return 0;
     }
-    return (uint32_t)iris_distrib1d_sample(&g->select, u, pmf, NULL);
+    uint32_t i = (uint32_t)iris_distrib1d_sample(&g->select, u, NULL, NULL);
+    *pmf = pmf_in_group(L, i);
+    return i;
   }
   float w[IRIS_LIGHTS_MAX_GROUPS + 1];
   double sum = group_weights(L, ref, w);
@@ -175,7 +188,8 @@ static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *p
   if (g->count > 1) {
     float ur = (float)((target - acc) / w[k]);
     ur = iris_clampf(ur, 0.0f, 0x1.fffffep-1f);
-    index = g->first + (uint32_t)iris_distrib1d_sample(&g->select, ur, &pe, NULL);
+    index = g->first + (uint32_t)iris_distrib1d_sample(&g->select, ur, NULL, NULL);
+    pe = pmf_in_group(L, index);
   }
   *pmf = pg * pe;
   return index;
@@ -277,6 +291,30 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     iris_lights_destroy(out);
     return err ? err->status : IRIS_ERR_NOMEM;
   }
+  size_t tris = 0;
+  while (tris < n && out->entries[tris].kind == IRIS_LIGHT_KIND_TRIANGLE) tris++;
+  if (tris > 0) {
+    out->tris = aligned_alloc(64, tris * sizeof *out->tris);
+    if (!out->tris) {
+      iris_lights_destroy(out);
+      return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+    }
+    for (size_t i = 0; i < tris; i++) {
+      const iris_light_entry *e = &out->entries[i];
+      iris_light_tri *t = &out->tris[i];
+      memset(t, 0, sizeof *t);
+      iris_v3_store(e->v0, t->v0);
+      iris_v3_store(e->e1, t->e1);
+      iris_v3_store(e->e2, t->e2);
+      iris_v3_store(e->ng, t->ng);
+      t->area = e->area;
+      t->pmf_in_group = entry_pmf_in_group(out, (uint32_t)i);
+      t->material = iris_accel_triangle_material(accel, e->prim);
+      t->flags = (e->two_sided ? IRIS_LIGHT_TRI_TWO_SIDED : 0u) |
+                 (e->textured ? IRIS_LIGHT_TRI_TEXTURED : 0u) | (e->group << 8);
+    }
+    out->tri_count = tris;
+  }
   if (n > 0) {
     float *w = malloc(sizeof(float) * n);
     if (!w) {
@@ -306,6 +344,9 @@ void iris_lights_destroy(iris_lights *lights) {
   lights->groups = NULL;
   lights->group_count = 0;
   free(lights->entries);
+  free(lights->tris);
+  lights->tris = NULL;
+  lights->tri_count = 0;
   free(lights->light_of_prim);
   iris_distrib1d_destroy(&lights->select);
   lights->entries = NULL;
@@ -350,38 +391,44 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
   float pmf;
   uint32_t i = select_at(lights, ref, u_select, &pmf);
   if (!(pmf > 0.0f)) return false;
-  const iris_light_entry *e = &lights->entries[i];
   s->light = i;
+  if (i < lights->tri_count) { /* a triangle: only its cache line is read */
+    const iris_light_tri *t = &lights->tris[i];
+    s->delta = false;
+    float b0, b1;
+    iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+    iris_interaction si;
+    if (t->flags & IRIS_LIGHT_TRI_TEXTURED) {
+      iris_accel_surface_at(lights->accel, lights->entries[i].prim, b1, 1.0f - b0 - b1, &si);
+    } else { /* position and normal are all an untextured emitter needs */
+      si.ng = iris_v3_load(t->ng);
+      si.p = iris_add(iris_v3_load(t->v0), iris_add(iris_scale(iris_v3_load(t->e1), b1),
+                                                    iris_scale(iris_v3_load(t->e2), 1.0f - b0 - b1)));
+    }
+    iris_vec3 to = iris_sub(si.p, ref);
+    float d2 = iris_dot(to, to);
+    if (!(d2 > 0.0f)) return false;
+    float dist = sqrtf(d2);
+    iris_vec3 wi = iris_scale(to, 1.0f / dist);
+    float cos_l = -iris_dot(wi, si.ng);
+    if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && cos_l <= 0.0f) return false;
+    cos_l = fabsf(cos_l);
+    if (!(cos_l > 0.0f)) return false;
+    s->wi = wi;
+    s->dist = dist;
+    s->p = si.p;
+    s->n = si.ng;
+    const iris_material *m = material_of(lights->scene, t->material);
+    s->L = (t->flags & IRIS_LIGHT_TRI_TEXTURED) ? surface_emission(lights, m, &si)
+                                                : iris_v3_load(m->emission);
+    s->pdf = pmf * d2 / (cos_l * t->area);
+    return isfinite(s->pdf) && s->pdf > 0.0f;
+  }
+  const iris_light_entry *e = &lights->entries[i];
   s->delta = e->kind != IRIS_LIGHT_KIND_TRIANGLE && e->kind != IRIS_LIGHT_KIND_ENVIRONMENT;
   switch (e->kind) {
-    case IRIS_LIGHT_KIND_TRIANGLE: {
-      float b0, b1;
-      iris_sample_uniform_triangle(u0, u1, &b0, &b1);
-      iris_interaction si;
-      if (e->textured) {
-        iris_accel_surface_at(lights->accel, e->prim, b1, 1.0f - b0 - b1, &si);
-      } else { /* position and normal are all an untextured emitter needs */
-        si.ng = e->ng;
-        si.p = iris_add(e->v0, iris_add(iris_scale(e->e1, b1), iris_scale(e->e2, 1.0f - b0 - b1)));
-      }
-      iris_vec3 to = iris_sub(si.p, ref);
-      float d2 = iris_dot(to, to);
-      if (!(d2 > 0.0f)) return false;
-      float dist = sqrtf(d2);
-      iris_vec3 wi = iris_scale(to, 1.0f / dist);
-      float cos_l = -iris_dot(wi, si.ng);
-      if (!e->two_sided && cos_l <= 0.0f) return false;
-      cos_l = fabsf(cos_l);
-      if (!(cos_l > 0.0f)) return false;
-      s->wi = wi;
-      s->dist = dist;
-      s->p = si.p;
-      s->n = si.ng;
-      s->L = e->textured ? surface_emission(lights, material_of(lights->scene, si.material), &si)
-                         : e->radiance;
-      s->pdf = pmf * d2 / (cos_l * e->area);
-      return isfinite(s->pdf) && s->pdf > 0.0f;
-    }
+    case IRIS_LIGHT_KIND_TRIANGLE: /* all triangles are in tris */
+      return false;
     case IRIS_LIGHT_KIND_POINT:
     case IRIS_LIGHT_KIND_SPOT: {
       const iris_light *l = &lights->scene->lights[e->prim];
@@ -427,14 +474,15 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
                                const iris_interaction *si) {
   if (si->prim >= iris_accel_triangle_count(lights->accel)) return 0.0f;
   uint32_t i = lights->light_of_prim[si->prim];
-  if (i == UINT32_MAX) return 0.0f;
-  const iris_light_entry *e = &lights->entries[i];
+  if (i >= lights->tri_count) return 0.0f;
+  const iris_light_tri *t = &lights->tris[i];
   iris_vec3 to = iris_sub(si->p, ref);
-  if (!e->two_sided && iris_dot(to, si->ng) >= 0.0f) return 0.0f; /* never sampled from behind */
+  if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && iris_dot(to, si->ng) >= 0.0f)
+    return 0.0f; /* never sampled from behind */
   float d2 = iris_dot(to, to);
   float cos_l = fabsf(iris_dot(to, si->ng)) / sqrtf(d2);
   if (!(cos_l > 0.0f) || !(d2 > 0.0f)) return 0.0f;
-  return iris_lights_select_pmf_at(lights, ref, i) * d2 / (cos_l * e->area);
+  return select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group) * d2 / (cos_l * t->area);
 }
 
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {

@@ -61,9 +61,24 @@ typedef struct iris_light_group {
   iris_vec3 center;       /* bounding sphere of a triangle group */
   float radius;
   float power;            /* sum of the entries' power */
+  float phi;              /* triangles: power; point/spot: 4 pi luminance(I) (weight numerator) */
   float irradiance;       /* directional / environment: the distance-free estimate */
   iris_distrib1d select;  /* over the group's entries (count > 1) */
 } iris_light_group;
+
+/* What next-event estimation reads of a triangle entry, packed into one
+ * 64-byte cache line (the entries themselves are larger and, for emitters of
+ * thousands of triangles, mostly out of cache). */
+typedef struct iris_light_tri {
+  float v0[3], e1[3], e2[3]; /* world vertex 0 and edges (counter-clockwise, front) */
+  float ng[3];               /* unit front normal */
+  float area;
+  float pmf_in_group;        /* probability of the entry within its group */
+  int32_t material;          /* its emission is the untextured radiance */
+  uint32_t flags;            /* IRIS_LIGHT_TRI_* | group << 8 */
+} iris_light_tri;
+#define IRIS_LIGHT_TRI_TWO_SIDED 1u
+#define IRIS_LIGHT_TRI_TEXTURED 2u
 
 typedef struct iris_lights {
   const iris_scene *scene;
@@ -71,6 +86,8 @@ typedef struct iris_lights {
   const iris_textures *textures;
   iris_light_entry *entries;
   size_t count;
+  iris_light_tri *tris;   /* entries [0, tri_count) are the triangles (64-byte aligned) */
+  size_t tri_count;
   iris_distrib1d select;  /* over entries, in proportion to power (photon emission) */
   iris_light_group *groups;
   size_t group_count;

@@ -104,6 +104,24 @@ iris_status iris_distrib1d_create(iris_distrib1d *d, const float *weights, size_
   size_t last = count;
   while (last > 1 && sum > 0.0 && d->func[last - 1] == 0.0f) --last;
   for (size_t i = last; i <= count; ++i) d->cdf[i] = 1.0f;
+  /* Guide table: guide[j] = largest i < count with cdf[i] <= j / m. Tables
+   * of up to 8 entries are searched directly. */
+  if (count > 8 && count <= ((size_t)1 << 31)) {
+    size_t m = count;
+    d->guide = malloc(m * sizeof(uint32_t));
+    if (!d->guide) {
+      iris_distrib1d_destroy(d);
+      return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL,
+                            "out of memory for a distribution of %zu entries", count);
+    }
+    d->guide_count = m;
+    size_t i = 0;
+    for (size_t j = 0; j < m; ++j) {
+      float lo = (float)((double)j / (double)m);
+      while (i + 1 < count && d->cdf[i + 1] <= lo) ++i;
+      d->guide[j] = (uint32_t)i;
+    }
+  }
   return IRIS_OK;
 }
 
@@ -111,6 +129,7 @@ void iris_distrib1d_destroy(iris_distrib1d *d) {
   if (!d) return;
   free(d->cdf);
   free(d->func);
+  free(d->guide);
   memset(d, 0, sizeof(*d));
 }
 
@@ -121,15 +140,27 @@ float iris_distrib1d_pmf(const iris_distrib1d *d, size_t index) {
 }
 
 size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float *u_remapped) {
-  /* Largest i with cdf[i] <= u, skipping zero-probability entries. */
-  size_t lo = 0, hi = d->count; /* invariant: cdf[lo] <= u < cdf[hi] (cdf[count] = 1 > u) */
-  while (hi - lo > 1) {
-    size_t mid = lo + (hi - lo) / 2;
-    if (d->cdf[mid] <= u) lo = mid;
-    else hi = mid;
+  /* Largest i < count with cdf[i] <= u (cdf is non-decreasing, cdf[count] = 1 > u),
+   * which skips zero-probability entries. */
+  size_t lo;
+  if (d->guide) {
+    float fu = u * (float)d->guide_count;
+    size_t j = fu > 0.0f ? (size_t)fu : 0;
+    if (j >= d->guide_count) j = d->guide_count - 1;
+    lo = d->guide[j];
+    /* the guide entry is exact up to the rounding of u * m: walk to the answer */
+    while (lo > 0 && d->cdf[lo] > u) --lo;
+    while (lo + 1 < d->count && d->cdf[lo + 1] <= u) ++lo;
+  } else {
+    size_t hi = d->count; /* invariant: cdf[lo] <= u < cdf[hi] */
+    lo = 0;
+    while (hi - lo > 1) {
+      size_t mid = lo + (hi - lo) / 2;
+      if (d->cdf[mid] <= u) lo = mid;
+      else hi = mid;
+    }
   }
-  float p = iris_distrib1d_pmf(d, lo);
-  if (pmf) *pmf = p;
+  if (pmf) *pmf = iris_distrib1d_pmf(d, lo);
   if (u_remapped) {
     float width = d->cdf[lo + 1] - d->cdf[lo];
     float r = width > 0.0f ? (u - d->cdf[lo]) / width : 0.0f;

@@ -7,6 +7,7 @@
 #define IRIS_RENDERER_SAMPLING_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "core/error.h"
 #include "core/math.h"
@@ -45,12 +46,18 @@ float iris_sample_uniform_cone_pdf(float cos_theta, float cos_max);
 void iris_sample_uniform_triangle(float u0, float u1, float *b0, float *b1);
 
 /* Discrete distribution over n weights (a tabulated CDF). Negative and
- * non-finite weights count as 0; if all are 0 the choice is uniform. */
+ * non-finite weights count as 0; if all are 0 the choice is uniform.
+ * Sampling inverts the CDF through a guide table (Chen & Asau 1974): bucket
+ * floor(u * guide_count) starts the search at the last entry whose CDF is at
+ * most the bucket's lower end, so a sample costs O(1) expected steps instead
+ * of a binary search, and returns exactly what the binary search would. */
 typedef struct iris_distrib1d {
-  float *cdf;   /* n + 1 entries, cdf[0] = 0, cdf[n] = 1 (owned) */
-  float *func;  /* n weights as given, sanitised (owned) */
+  float *cdf;      /* n + 1 entries, cdf[0] = 0, cdf[n] = 1 (owned) */
+  float *func;     /* n weights as given, sanitised (owned) */
   size_t count;
-  double total; /* sum of weights, 0 when the fallback to uniform is used */
+  double total;    /* sum of weights, 0 when the fallback to uniform is used */
+  uint32_t *guide; /* guide_count entries (owned; NULL for small tables) */
+  size_t guide_count;
 } iris_distrib1d;
 
 iris_status iris_distrib1d_create(iris_distrib1d *d, const float *weights, size_t count,
