@@ -58,10 +58,9 @@ static long grid_cell(const grid *g, const double dir[3]) {
 
 /* ---- adaptive Gauss-Legendre over a (z, phi) rectangle --------------------- */
 
-static const double gl_x[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
-                               0.8611363115940526};
-static const double gl_w[4] = {0.3478548451374538, 0.6521451548625461, 0.6521451548625461,
-                               0.3478548451374538};
+/* 3-point Gauss-Legendre per axis: exact for polynomials of degree 5. */
+static const double gl_x[3] = {-0.7745966692414834, 0.0, 0.7745966692414834};
+static const double gl_w[3] = {0.5555555555555556, 0.8888888888888888, 0.5555555555555556};
 
 /* Cells are bounded in z = cos(theta) but integrated in theta (d(omega) =
  * sin(theta) dtheta dphi), which resolves lobes centred on the poles. */
@@ -69,10 +68,10 @@ static double rect_gauss(chi2_pdf_fn fn, void *ctx, double t0, double t1, double
   double tc = 0.5 * (t0 + t1), th = 0.5 * (t1 - t0);
   double pc = 0.5 * (p0 + p1), ph = 0.5 * (p1 - p0);
   double sum = 0.0;
-  for (int i = 0; i < 4; ++i) {
+  for (int i = 0; i < 3; ++i) {
     double t = tc + th * gl_x[i];
     double st = sin(t), z = cos(t);
-    for (int j = 0; j < 4; ++j) {
+    for (int j = 0; j < 3; ++j) {
       double phi = pc + ph * gl_x[j];
       double dir[3] = {st * cos(phi), st * sin(phi), z};
       double v = fn(ctx, dir);
