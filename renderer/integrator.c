@@ -108,6 +108,10 @@ float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi) {
   return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
 }
 
+void iris_integrator_prepare_direction(const iris_integrator *it, iris_shading_point *sp) {
+  if (iris_method_uses_guiding(it->method) && it->guide.prepare) it->guide.prepare(it->guide.ctx, sp);
+}
+
 bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shading_point *sp,
                                       iris_sampler *rng, iris_direction_sample *out) {
   if (iris_method_uses_guiding(it->method) && it->guide.sample)
@@ -192,6 +196,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
 
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
+    iris_integrator_prepare_direction(it, &sp);
     if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, rng, mis, stats)));
 
     iris_direction_sample ds;

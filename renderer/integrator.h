@@ -42,6 +42,15 @@ bool iris_method_parse(const char *name, iris_method *out);
 bool iris_method_uses_nee(iris_method method);
 bool iris_method_uses_guiding(iris_method method);
 
+/* Per-vertex scratch of a direction sampler: written once per shading point
+ * by iris_direction_sampler.prepare, read by its sample and pdf at that
+ * vertex (guiding keeps the caches it picked for the point here, so the
+ * cache search runs once per bounce, not once per sample/pdf call). */
+#define IRIS_GUIDE_VERTEX_BYTES 64
+typedef struct iris_guide_vertex {
+  _Alignas(16) unsigned char bytes[IRIS_GUIDE_VERTEX_BYTES];
+} iris_guide_vertex;
+
 /* A shading point: the interaction, its shading frame (z = shading normal,
  * turned towards wo for non-transmissive BSDFs), the BSDF, wo in both frames. */
 typedef struct iris_shading_point {
@@ -53,6 +62,7 @@ typedef struct iris_shading_point {
   uint32_t lobes;     /* iris_bsdf_lobes */
   bool delta;         /* iris_bsdf_is_delta */
   int depth;          /* bounces so far (0 at the first hit from the camera) */
+  iris_guide_vertex guide; /* direction sampler's per-vertex state (after prepare) */
 } iris_shading_point;
 
 /* A direction chosen by the path's direction sampler. */
@@ -69,12 +79,17 @@ typedef struct iris_direction_sample {
 /* Pluggable direction sampler (the guiding module provides one). `sample`
  * must fill out->f with the BSDF value and out->pdf with the density of the
  * whole strategy; `pdf` returns that same density for any world direction
- * (0 for directions only a delta lobe reaches). Both must be thread-safe. */
+ * (0 for directions only a delta lobe reaches). All must be thread-safe.
+ * `prepare` (optional, may be NULL) runs once per shading point, after
+ * shading and before any sample/pdf call at that point, and may fill
+ * sp->guide; it must not draw random numbers (so the sample stream does not
+ * depend on it). */
 typedef struct iris_direction_sampler {
   void *ctx;
   bool (*sample)(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
                  iris_direction_sample *out);
   float (*pdf)(void *ctx, const iris_shading_point *sp, iris_vec3 wi);
+  void (*prepare)(void *ctx, iris_shading_point *sp);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */
@@ -109,6 +124,10 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
 /* Fills the shading point for a hit (material, textures, vertex colour, frame). */
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp);
+
+/* Runs the guide's prepare for a shaded point (guided methods with a guide
+ * that has one; otherwise nothing). Call before sample_direction/direction_pdf. */
+void iris_integrator_prepare_direction(const iris_integrator *it, iris_shading_point *sp);
 
 /* THE direction choice of a path: the BSDF's sampling routine, or the guide for
  * guided methods. False ends the path. */

@@ -4,7 +4,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *const NAMES[] = {"cornell-box", "veach-mis", "furnace-diffuse",
+#include "scenes/door.h"
+
+static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "furnace-diffuse",
                                     "furnace-glossy", "inside-sphere", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
@@ -303,6 +305,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = build_cornell(s);
   else if (strcmp(name, "veach-mis") == 0)
     st = build_veach(s);
+  else if (strcmp(name, "door") == 0)
+    st = iris_door_scene_build(s);
   else if (strcmp(name, "furnace-diffuse") == 0)
     st = build_furnace(s, IRIS_MATERIAL_DIFFUSE);
   else if (strcmp(name, "furnace-glossy") == 0)

@@ -1,6 +1,8 @@
 /* Built-in scenes generated in code, with the published numbers (docs/rendering.md,
  * "Built-in scenes"): `cornell-box` (Bitterli's Cornell box) and `veach-mis`
- * (Veach's four-light multiple-importance-sampling scene). Also small analytic
+ * (Veach's four-light multiple-importance-sampling scene), `door` (two rooms
+ * joined by a narrow door, lit from the room the camera cannot see: the
+ * guiding benchmark, scenes/door.h). Also small analytic
  * scenes for tests: `furnace-diffuse`, `furnace-glossy` (albedo-1 spheres under
  * a uniform sky of radiance 1) and `inside-sphere` (a sphere of radiance 1 seen
  * from inside). */

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/guiding/inspect.h"
 #include "renderer/guiding/photons.h"
 
 #define CAMERA_SAMPLE_INDEX 0x63616d6361636865ULL /* streams apart from pixels and photons */
@@ -18,7 +19,7 @@
 /* Photons whose surface normal differs more than this from the cache's (the
  * other side of a thin wall, the neighbouring wall in a corner) are not
  * splatted: their directions describe another surface's hemisphere. */
-#define PHOTON_NORMAL_COS 0.5f
+#define PHOTON_NORMAL_COS IRIS_GUIDING_PHOTON_NORMAL_COS
 
 iris_guiding_params iris_guiding_params_default(void) {
   iris_guiding_params p;
@@ -26,7 +27,8 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.pdf_floor = -1.0f;
   p.alpha_max = 0.5f; /* thesis: 0.9; measured in docs/guiding.md */
   p.cos_min = 0.9f;
-  p.splat = IRIS_SPLAT_NEAREST;
+  p.splat = IRIS_SPLAT_BILINEAR; /* thesis: nearest; measured in docs/guiding.md */
+  p.direct_photons = -1;
   return p;
 }
 
@@ -90,6 +92,23 @@ typedef struct fill_ctx {
   float **d2;       /* per thread, k */
 } fill_ctx;
 
+/* The photons a cache can use: on a surface facing like the cache's (not the
+ * other side of a thin wall, not the neighbouring wall of a corner) and, for
+ * hemisphere caches, arriving from above. The k nearest are searched among
+ * these only, so a cache next to a brightly lit thin wall still gets k. */
+typedef struct photon_filter {
+  const iris_photon *photons;
+  iris_vec3 n;
+  bool sphere;
+} photon_filter;
+
+static bool photon_usable(void *ctx, uint32_t id) {
+  const photon_filter *f = ctx;
+  const iris_photon *ph = &f->photons[id];
+  if (iris_dot(ph->n, f->n) < PHOTON_NORMAL_COS) return false;
+  return f->sphere || iris_dot(ph->wi, f->n) > 0.0f;
+}
+
 static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   fill_ctx *c = ctx;
   iris_guiding *g = c->g;
@@ -100,7 +119,8 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     iris_cache *cache = &g->caches[i];
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
-    uint32_t n = iris_kdtree_knn(c->photon_tree, cache->p, c->k, INFINITY, ids, d2);
+    photon_filter f = {c->photons->photons, cache->frame.n, cache->sphere != 0};
+    uint32_t n = iris_kdtree_knn_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
     uint32_t used = 0;
     for (uint32_t j = 0; j < n; ++j) {
       const iris_photon *ph = &c->photons->photons[ids[j]];
@@ -126,7 +146,7 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
   int64_t cam = p->caches / 2 > 0 ? p->caches / 2 : 1;
   int st = (int)lrint(sqrt((double)pixels / (double)cam));
   *stride = st < 1 ? 1 : st;
-  if (p->cache_res <= 0) p->cache_res = 16;
+  if (p->cache_res <= 0) p->cache_res = 8; /* 16 (thesis-like) is noisier at k = 200: docs/guiding.md */
   if (p->cache_k <= 0) p->cache_k = 200;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
@@ -140,6 +160,33 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
   }
   if (!(p->alpha_max >= 0.0f)) p->alpha_max = 0.0f;
   if (p->alpha_max > 0.9999f) p->alpha_max = 0.9999f; /* BSDF sampling must keep some probability */
+}
+
+static int compare_float(const void *a, const void *b) {
+  float x = *(const float *)a, y = *(const float *)b;
+  return (x > y) - (x < y);
+}
+
+/* Search radius of Algorithm 1: caches are local estimates, so a point whose
+ * 5 nearest caches are far away (a surface no camera ray or photon cache
+ * reached) is better served by BSDF sampling, and bounding the search keeps
+ * its cost flat there. Radius = 3x the 90th percentile, over the caches, of
+ * the distance to their 5th nearest other cache. */
+static float pick_radius2(const iris_guiding *g) {
+  size_t n = g->cache_count;
+  if (n <= IRIS_GUIDING_PICK_K) return INFINITY;
+  float *d = malloc(sizeof(float) * n);
+  if (!d) return INFINITY;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t ids[IRIS_GUIDING_PICK_K + 1];
+    float d2[IRIS_GUIDING_PICK_K + 1];
+    uint32_t m = iris_kdtree_knn(&g->tree, g->caches[i].p, IRIS_GUIDING_PICK_K + 1, INFINITY, ids, d2);
+    d[i] = m ? d2[m - 1] : 0.0f;
+  }
+  qsort(d, n, sizeof(float), compare_float);
+  float r2 = 9.0f * d[(size_t)(0.9 * (double)(n - 1))];
+  free(d);
+  return r2 > 0.0f ? r2 : INFINITY;
 }
 
 static void skip(iris_guiding *g, const char *why) {
@@ -224,6 +271,16 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   memset(&ptree, 0, sizeof ptree);
   if (!g->pdf || !g->cdf || floats > UINT32_MAX)
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
+  /* With light sampling the direct light needs no guide: photons straight
+   * from a light leave the photon tree, so every cache's k photons describe
+   * the indirect light (measured in docs/guiding.md). */
+  const bool direct = p->direct_photons > 0 || (p->direct_photons < 0 && !p->use_nee);
+  if (!direct) {
+    size_t n = 0;
+    for (size_t i = 0; i < photons.count; ++i)
+      if (photons.photons[i].bounce > 0) photons.photons[n++] = photons.photons[i];
+    photons.count = n;
+  }
   if (st == IRIS_OK)
     st = iris_kdtree_build(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count, err);
   /* Fill in parallel with per-thread scratch. */
@@ -255,29 +312,34 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     free(fc.ids);
     free(fc.d2);
   }
+  if (st == IRIS_OK) {
+    /* Keep the caches that received photons; their tables stay where they are. */
+    size_t kept = 0;
+    for (size_t i = 0; i < total; ++i) {
+      if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
+      else g->stats.empty_caches++;
+    }
+    g->cache_count = kept;
+    for (size_t i = 0; i < kept; ++i) g->stats.camera_caches += g->caches[i].from_camera;
+    g->stats.caches = kept;
+    if (kept == 0 && !p->force) {
+      skip(g, "no cache received photons");
+    } else {
+      st = iris_kdtree_build(&g->tree, &g->caches[0].p, sizeof(iris_cache), (uint32_t)kept, err);
+      if (st == IRIS_OK) g->pick_radius2 = pick_radius2(g);
+      g->stats.memory_bytes = sizeof(iris_cache) * kept + 2 * sizeof(float) * floats +
+                              (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
+                              sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count);
+    }
+  }
+  g->stats.cache_seconds = iris_time_now() - t1;
+  /* Inspection outputs need the photons (counts in the dumps): before freeing them. */
+  if (st == IRIS_OK && !g->stats.skipped && p->dump_dir)
+    st = iris_guiding_dump_caches(g, s, &photons, &ptree, p->dump_dir, err);
+  if (st == IRIS_OK && !g->stats.skipped && p->marks) st = iris_guiding_mark_caches(g, s, p->marks, err);
   iris_kdtree_destroy(&ptree);
   iris_photons_destroy(&photons); /* thesis 4.2.4: photons are not needed any more */
-  if (st != IRIS_OK) return st;
-  /* Keep the caches that received photons; their tables stay where they are. */
-  size_t kept = 0;
-  for (size_t i = 0; i < total; ++i) {
-    if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
-    else g->stats.empty_caches++;
-  }
-  g->cache_count = kept;
-  for (size_t i = 0; i < kept; ++i) g->stats.camera_caches += g->caches[i].from_camera;
-  g->stats.caches = kept;
-  if (kept == 0 && !p->force) {
-    skip(g, "no cache received photons");
-    return IRIS_OK;
-  }
-  st = iris_kdtree_build(&g->tree, &g->caches[0].p, sizeof(iris_cache), (uint32_t)kept, err);
-  if (st != IRIS_OK) return st;
-  g->stats.memory_bytes = sizeof(iris_cache) * kept + 2 * sizeof(float) * floats +
-                          (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
-                          sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count);
-  g->stats.cache_seconds = iris_time_now() - t1;
-  return IRIS_OK;
+  return st;
 }
 
 iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
@@ -331,7 +393,7 @@ int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t 
   if (g->cache_count == 0) return 0;
   uint32_t near[IRIS_GUIDING_PICK_K];
   float d2[IRIS_GUIDING_PICK_K], cosv[IRIS_GUIDING_PICK_K];
-  uint32_t m = iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, INFINITY, near, d2);
+  uint32_t m = iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
   float best = -2.0f;
   for (uint32_t i = 0; i < m; ++i) {
     cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);
@@ -360,14 +422,61 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
   return fminf(r, g->params.alpha_max);
 }
 
+/* Per-vertex state (in iris_shading_point.guide): alpha and the tied caches
+ * of Algorithm 1, picked once per bounce by guided_prepare. Caches with the
+ * same frame and map layout (coplanar caches: the usual tie) map a direction
+ * to the same texel, so pdf evaluation computes that texel once per group. */
+typedef struct guide_vertex {
+  float alpha;                          /* cache-sampling probability; 0: BSDF only */
+  int32_t m;                            /* tied caches */
+  uint32_t ids[IRIS_GUIDING_PICK_K];
+  uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
+} guide_vertex;
+_Static_assert(sizeof(guide_vertex) <= IRIS_GUIDE_VERTEX_BYTES, "guide_vertex too large");
+
+static void guided_prepare(void *ctx, iris_shading_point *sp) {
+  const iris_guiding *g = ctx;
+  guide_vertex *v = (guide_vertex *)sp->guide.bytes;
+  v->alpha = iris_guiding_alpha(g, sp);
+  v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
+  if (v->m == 0) v->alpha = 0.0f;
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *ci = &g->caches[v->ids[i]];
+    v->same_as[i] = (uint8_t)i;
+    for (int j = 0; j < i; ++j) {
+      const iris_cache *cj = &g->caches[v->ids[j]];
+      if (cj->sphere == ci->sphere && memcmp(&cj->frame, &ci->frame, sizeof ci->frame) == 0) {
+        v->same_as[i] = (uint8_t)j;
+        break;
+      }
+    }
+  }
+}
+
+/* Cache-sampling density of the vertex's tied caches (their average). */
+static float vertex_cache_pdf(const iris_guiding *g, const guide_vertex *v, iris_vec3 wi) {
+  int32_t texel[IRIS_GUIDING_PICK_K] = {-1, -1, -1, -1, -1};
+  float sum = 0.0f;
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *c = &g->caches[v->ids[i]];
+    if (v->same_as[i] == i) {
+      const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+      texel[i] = iris_octmap_dir_to_texel(map, iris_frame_to_local(&c->frame, wi));
+    } else {
+      texel[i] = texel[v->same_as[i]];
+    }
+    if (texel[i] >= 0) sum += g->pdf[c->table + (uint32_t)texel[i]];
+  }
+  return v->m > 0 ? sum / (float)v->m : 0.0f;
+}
+
 static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
                           iris_direction_sample *out) {
   const iris_guiding *g = ctx;
-  float alpha = iris_guiding_alpha(g, sp);
-  uint32_t ids[IRIS_GUIDING_PICK_K];
-  int m = alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, ids) : 0;
+  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
+  const float alpha = v->alpha;
   /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
-  if (m == 0) return iris_integrator_sample_bsdf(sp, rng, out);
+  if (!(alpha > 0.0f)) return iris_integrator_sample_bsdf(sp, rng, out);
   float u = iris_sampler_next(rng);
   if (u >= alpha) {
     if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;
@@ -375,14 +484,15 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
       out->pdf *= 1.0f - alpha;
       return true;
     }
-    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guiding_cache_pdf(g, ids, m, out->wi);
+    out->pdf = (1.0f - alpha) * out->pdf + alpha * vertex_cache_pdf(g, v, out->wi);
     return out->pdf > 0.0f;
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
   float uc = iris_sampler_next(rng), u0 = iris_sampler_next(rng), u1 = iris_sampler_next(rng),
         u2 = iris_sampler_next(rng);
+  int m = v->m;
   int j = (int)(uc * (float)m);
-  const iris_cache *c = &g->caches[ids[j < m ? j : m - 1]];
+  const iris_cache *c = &g->caches[v->ids[j < m ? j : m - 1]];
   const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
   float pdf_one;
   iris_vec3 wl = iris_cache_sample(map, g->pdf + c->table, g->cdf + c->table, u0, u1, u2, &pdf_one);
@@ -390,8 +500,8 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
   out->wi = wi;
   out->f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wi_local);
-  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) +
-             alpha * iris_guiding_cache_pdf(g, ids, m, wi);
+  out->pdf = (1.0f - alpha) * iris_bsdf_pdf(&sp->bsdf, sp->wo_local, wi_local) +
+             alpha * vertex_cache_pdf(g, v, wi);
   out->delta = false;
   bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
   out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
@@ -401,12 +511,10 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
 
 static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
   const iris_guiding *g = ctx;
-  float alpha = iris_guiding_alpha(g, sp);
-  uint32_t ids[IRIS_GUIDING_PICK_K];
-  int m = alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, ids) : 0;
+  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
   float pb = iris_integrator_bsdf_pdf(sp, wi);
-  if (m == 0) return pb;
-  return (1.0f - alpha) * pb + alpha * iris_guiding_cache_pdf(g, ids, m, wi);
+  if (!(v->alpha > 0.0f)) return pb;
+  return (1.0f - v->alpha) * pb + v->alpha * vertex_cache_pdf(g, v, wi);
 }
 
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
@@ -416,6 +524,7 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.ctx = g;
   s.sample = guided_sample;
   s.pdf = guided_pdf;
+  s.prepare = guided_prepare;
   return s;
 }
 

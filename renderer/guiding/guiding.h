@@ -23,6 +23,15 @@ extern "C" {
 #endif
 
 #define IRIS_GUIDING_PICK_K 5 /* Algorithm 1: the 5 nearest caches */
+/* Photons whose normal has a smaller cosine with the cache's are not splatted. */
+#define IRIS_GUIDING_PHOTON_NORMAL_COS 0.5f
+
+/* Where caches lie on the film (`iris render --aov caches`). */
+typedef struct iris_guiding_marks {
+  int width, height;
+  uint8_t *kind; /* [width * height]: 0 none, 1 cache from a camera ray, 2 cache from a photon */
+} iris_guiding_marks;
+void iris_guiding_marks_destroy(iris_guiding_marks *m);
 
 /* Every parameter has a flag in `iris render`; <= 0 (or < 0 for the floor)
  * means "choose from the scene" (docs/guiding.md, "Budget"). */
@@ -37,6 +46,11 @@ typedef struct iris_guiding_params {
   iris_splat_mode splat;/* nearest (thesis) or bilinear */
   bool force;           /* build caches even where the budget would skip guiding */
   bool use_nee;         /* the render also samples lights (guided-nee): skip if lit only directly */
+  int direct_photons;   /* splat photons straight from a light: -1 auto (not with NEE), 0 no, 1 yes */
+  /* Inspection (outputs of the build, NULL = off): */
+  const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
+                                 serving a 4 x 3 grid of pixels (docs/guiding.md) */
+  iris_guiding_marks *marks;  /* --aov caches: filled with the visible cache positions */
 } iris_guiding_params;
 
 iris_guiding_params iris_guiding_params_default(void);
@@ -69,6 +83,7 @@ typedef struct iris_guiding {
   size_t cache_count;
   float *pdf, *cdf;    /* all tables, pdf over solid angle and CDF per texel */
   iris_kdtree tree;    /* over caches[i].p */
+  float pick_radius2;  /* Algorithm 1 ignores caches farther than this (squared) */
   iris_guiding_stats stats;
 } iris_guiding;
 

@@ -3,6 +3,7 @@
 #include "renderer/guiding/kdtree.h"
 
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -102,6 +103,8 @@ typedef struct knn_heap {
   uint32_t *ids;
   float *d2;
   float max_d2;
+  bool (*accept)(void *ctx, uint32_t id); /* NULL: every point */
+  void *ctx;
 } knn_heap;
 
 /* Max-heap order on (d2, id): the root is the worst kept neighbour. */
@@ -129,6 +132,8 @@ static void sift_down(knn_heap *h, uint32_t i) {
 }
 static void heap_offer(knn_heap *h, uint32_t id, float d2) {
   if (d2 > h->max_d2) return;
+  if (h->n == h->k && (d2 > h->d2[0] || (d2 == h->d2[0] && id > h->ids[0]))) return;
+  if (h->accept && !h->accept(h->ctx, id)) return;
   if (h->n < h->k) {
     uint32_t i = h->n++;
     h->ids[i] = id;
@@ -173,10 +178,88 @@ static void search(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q
   }
 }
 
+/* Small k (cache picking, Algorithm 1, runs once per path vertex): the k best
+ * kept sorted by insertion, (d2, id) order as in the heap version. */
+#define SMALL_K 8
+typedef struct small_set {
+  uint32_t k, n;
+  float bound; /* d2 of the worst kept when full, else max_d2 */
+  float d2[SMALL_K];
+  uint32_t ids[SMALL_K];
+} small_set;
+
+static void small_offer(small_set *s, uint32_t id, float d2) {
+  uint32_t i;
+  if (s->n < s->k) {
+    i = s->n++;
+  } else {
+    i = s->k - 1; /* full: replace the worst kept, if this one ranks better */
+    if (d2 > s->d2[i] || (d2 == s->d2[i] && id > s->ids[i])) return;
+  }
+  while (i > 0 && (s->d2[i - 1] > d2 || (s->d2[i - 1] == d2 && s->ids[i - 1] > id))) {
+    s->d2[i] = s->d2[i - 1];
+    s->ids[i] = s->ids[i - 1];
+    --i;
+  }
+  s->d2[i] = d2;
+  s->ids[i] = id;
+  if (s->n == s->k) s->bound = s->d2[s->k - 1];
+}
+
+static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q[3],
+                         small_set *s) {
+  while (hi > lo) {
+    if (hi - lo <= 8) { /* small ranges: a linear scan beats descending further */
+      for (uint32_t i = lo; i < hi; ++i) {
+        const float *p = &t->points[3 * (size_t)i];
+        float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+        float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 <= s->bound) small_offer(s, t->ids[i], d2);
+      }
+      return;
+    }
+    uint32_t m = lo + (hi - lo) / 2;
+    const float *p = &t->points[3 * (size_t)m];
+    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+    float d2 = dx * dx + dy * dy + dz * dz;
+    if (d2 <= s->bound) small_offer(s, t->ids[m], d2);
+    int ax = t->axis[m];
+    float diff = q[ax] - p[ax];
+    if (diff < 0.0f) {
+      search_small(t, lo, m, q, s);
+      if (!(diff * diff <= s->bound)) return;
+      lo = m + 1;
+    } else {
+      search_small(t, m + 1, hi, q, s);
+      if (!(diff * diff <= s->bound)) return;
+      hi = m;
+    }
+  }
+}
+
 uint32_t iris_kdtree_knn(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                          uint32_t *ids, float *d2) {
+  return iris_kdtree_knn_if(tree, q, k, max_d2, NULL, NULL, ids, d2);
+}
+
+uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
+                            bool (*accept)(void *ctx, uint32_t id), void *ctx, uint32_t *ids,
+                            float *d2) {
   if (k == 0 || tree->count == 0) return 0;
-  knn_heap h = {k, 0, ids, d2, max_d2};
+  if (k <= SMALL_K && !accept) {
+    small_set s;
+    s.k = k;
+    s.n = 0;
+    s.bound = max_d2;
+    float qq[3] = {q.x, q.y, q.z};
+    search_small(tree, 0, tree->count, qq, &s);
+    for (uint32_t i = 0; i < s.n; ++i) {
+      ids[i] = s.ids[i];
+      d2[i] = s.d2[i];
+    }
+    return s.n;
+  }
+  knn_heap h = {k, 0, ids, d2, max_d2, accept, ctx};
   float qq[3] = {q.x, q.y, q.z};
   search(tree, 0, tree->count, qq, &h);
   /* Heap sort in place: ascending (d2, id). */

@@ -5,6 +5,7 @@
 #ifndef IRIS_RENDERER_GUIDING_KDTREE_H
 #define IRIS_RENDERER_GUIDING_KDTREE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -32,6 +33,12 @@ void iris_kdtree_destroy(iris_kdtree *tree);
  * none), written to ids/d2 sorted by (distance, index); returns how many. */
 uint32_t iris_kdtree_knn(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                          uint32_t *ids, float *d2);
+
+/* The same among the points for which accept(ctx, id) is true (photons a
+ * cache can use); accept is called only for points that would be kept. */
+uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
+                            bool (*accept)(void *ctx, uint32_t id), void *ctx, uint32_t *ids,
+                            float *d2);
 
 #ifdef __cplusplus
 }

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
 
 #include "check.h"
 #include "chi2.h"
@@ -35,7 +36,7 @@ static iris_vec3 uniform_sphere(float u0, float u1) {
   return iris_v3(r * cosf(phi), r * sinf(phi), z);
 }
 
-#define N_TESTS 11
+#define N_TESTS 7
 
 static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
   cache_ctx c;
@@ -55,10 +56,12 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
   }
   CHECK(iris_cache_build_tables(&c.map, hist, 2e-4f, c.pdf, c.cdf));
   chi2_domain dom = {sphere ? CHI2_SPHERE : CHI2_HEMISPHERE, 0, 0, 1234 + (uint64_t)pattern};
-  chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 300000, 0.01, N_TESTS);
+  clock_t t0 = clock();
+  chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 200000, 0.01, N_TESTS);
   iris_check_record(r.passed, __FILE__, __LINE__, "res %d sphere %d pattern %d splat %d: %s", res, sphere,
                     pattern, mode, r.message);
   CHECK_NEAR(r.pdf_integral, 1.0, 2e-3);
+  printf("res %d sphere %d pattern %d splat %d: %.1f s\n", res, sphere, pattern, mode, (double)(clock() - t0) / CLOCKS_PER_SEC);
   free(hist);
   free(c.pdf);
   free(c.cdf);
@@ -66,12 +69,14 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
 }
 
 int main(void) {
-  for (int s = 0; s < 2; ++s)
-    for (int pattern = 0; pattern < 3; ++pattern) run(8, s, pattern, IRIS_SPLAT_NEAREST);
-  run(16, false, 0, IRIS_SPLAT_BILINEAR);
-  run(12, true, 1, IRIS_SPLAT_BILINEAR);
+  /* Every map kind, fill pattern and splat mode appears at least once; the
+   * default layout (res 8, bilinear) on both map kinds. */
+  run(8, false, 0, IRIS_SPLAT_NEAREST);
+  run(8, true, 2, IRIS_SPLAT_NEAREST);
+  run(8, false, 1, IRIS_SPLAT_BILINEAR);
+  run(8, true, 0, IRIS_SPLAT_BILINEAR);
+  run(16, false, 2, IRIS_SPLAT_BILINEAR);
   run(5, false, 0, IRIS_SPLAT_BILINEAR); /* odd resolution: texel split by both diagonals */
-  run(5, true, 2, IRIS_SPLAT_NEAREST);
-  run(3, true, 0, IRIS_SPLAT_BILINEAR);
+  run(3, true, 1, IRIS_SPLAT_NEAREST);
   return TEST_SUMMARY();
 }
