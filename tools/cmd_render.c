@@ -1,6 +1,7 @@
 /* `iris render INPUT -o OUT.exr`: fills iris_render_params from the flags,
  * loads the input (an iris scene, an importable file or a built-in scene name),
  * renders and writes EXR/PNG. docs/cli.md ("render") lists every flag. */
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -9,6 +10,7 @@
 #include <cjson/cJSON.h>
 
 #include "core/fileio.h"
+#include "core/image.h"
 #include "core/log.h"
 #include "core/rng.h"
 #include "importers/import.h"
@@ -24,7 +26,7 @@ static void print_help(void) {
       "Usage: iris render INPUT [-o OUT.exr] [--png OUT.png] [options]\n"
       "\n"
       "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene:\n"
-      "cornell-box, veach-mis, furnace-diffuse, furnace-glossy, inside-sphere).\n"
+      "cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, inside-sphere).\n"
       "\n"
       "Output:\n"
       "  -o, --output FILE   OpenEXR output (float RGB + metadata)\n"
@@ -42,6 +44,18 @@ static void print_help(void) {
       "      --sample-offset K   render sample indices K .. K+spp-1 (default 0)\n"
       "      --pixel-bounds x0,y0,x1,y1   render only this window of the frame\n"
       "                      (half-open; the output image is the window)\n"
+      "Guiding (--method guided | guided-nee; docs/guiding.md; unset = from the scene):\n"
+      "      --photons N     photon paths        --caches N      caches\n"
+      "      --cache-res R   map texels per side --cache-k K     photons per cache\n"
+      "      --pdf-floor F   texel probability floor (default 0.0002)\n"
+      "      --alpha-max A   cap on the cache-sampling probability (default 0.5)\n"
+      "      --cos-min C     cache normal agreement needed (default 0.9)\n"
+      "      --splat nearest|bilinear   photon splatting (default bilinear)\n"
+      "      --force-guiding build caches even where guiding would be skipped\n"
+      "      --dump-caches DIR   write pdf and photon-count PNGs of the caches that\n"
+      "                      serve a 4x3 grid of pixels (DIR/caches.txt lists them)\n"
+      "      --aov caches    also write OUT-caches.png: the image with cache positions\n"
+      "                      marked (green: from camera rays, red: from photons)\n"
       "Camera:\n"
       "      --camera NAME   scene camera to use (default: the first; none: auto-framed)\n"
       "      --width W, --height H   film size (default: the scene's, else from the\n"
@@ -125,9 +139,47 @@ static bool output_dir_ok(const char *path) {
   return iris_path_exists(dir);
 }
 
+/* --aov caches: the image (as the PNG) with every visible cache marked,
+ * written to OUT-caches.png next to the main output. */
+static iris_status write_cache_marks(const iris_render_result *res, const iris_guiding_marks *marks,
+                                     const char *out, float exposure, iris_error *err) {
+  if (!marks->kind) {
+    iris_warnf("--aov caches: guiding was skipped, no caches to mark");
+    return IRIS_OK;
+  }
+  if (marks->width != res->film.width || marks->height != res->film.height) {
+    iris_warnf("--aov caches: the film is a window of the frame; marks not written");
+    return IRIS_OK;
+  }
+  char path[1200];
+  size_t n = strlen(out);
+  const char *dot = strrchr(out, '.');
+  size_t base = dot ? (size_t)(dot - out) : n;
+  snprintf(path, sizeof path, "%.*s-caches.png", (int)base, out);
+  iris_image img;
+  iris_status st = iris_film_to_image(&res->film, false, &img, err);
+  if (st != IRIS_OK) return st;
+  float unexpose = powf(2.0f, -exposure); /* marks stay pure green/red after the PNG's exposure */
+  for (int y = 0; y < img.height; y++)
+    for (int x = 0; x < img.width; x++) {
+      uint8_t k = marks->kind[(size_t)y * (size_t)img.width + (size_t)x];
+      if (!k) continue;
+      float *px = &img.data[((size_t)y * (size_t)img.width + (size_t)x) * (size_t)img.channel_count];
+      px[0] = k == 2 ? unexpose : 0.0f;
+      px[1] = k == 1 ? unexpose : 0.0f;
+      px[2] = 0.0f;
+    }
+  st = iris_png_write(path, &img, 0, exposure, err);
+  iris_image_destroy(&img);
+  if (st == IRIS_OK) iris_infof("cache marks: %s", path);
+  return st;
+}
+
 int iris_cmd_render(int argc, char **argv) {
   iris_render_params p = iris_render_params_default();
   iris_guiding_params gp = iris_guiding_params_default();
+  iris_guiding_marks marks = {0, 0, NULL};
+  bool aov_caches = false;
   const char *input = NULL, *out_exr = NULL, *out_png = NULL, *camera = NULL;
   bool variance = false, quiet = false, json = false, have_spp = false, have_seed = false;
   double exposure = 0.0;
@@ -236,6 +288,13 @@ int iris_cmd_render(int argc, char **argv) {
         return iris_cli_usage_error(CMD, "unknown splat mode '%s' (nearest, bilinear)", val);
     } else if (strcmp(a, "--force-guiding") == 0) {
       gp.force = true;
+    } else if (strcmp(a, "--dump-caches") == 0) {
+      NEED_VALUE();
+      gp.dump_dir = val;
+    } else if (strcmp(a, "--aov") == 0) {
+      NEED_VALUE();
+      if (strcmp(val, "caches") != 0) return iris_cli_usage_error(CMD, "unknown AOV '%s' (caches)", val);
+      aov_caches = true;
     } else if (strcmp(a, "--sample-offset") == 0) {
       NEED_VALUE();
       if (!iris_cli_parse_u64(CMD, a, val, &p.sample_offset)) return IRIS_EXIT_USAGE;
@@ -276,6 +335,12 @@ int iris_cmd_render(int argc, char **argv) {
   if (variance && !out_exr) return iris_cli_usage_error(CMD, "--variance needs -o OUT.exr");
   if ((out_exr && !output_dir_ok(out_exr)) || (out_png && !output_dir_ok(out_png)))
     return iris_cli_usage_error(CMD, "the folder of the output file does not exist");
+  if ((aov_caches || gp.dump_dir) && !iris_method_uses_guiding(p.method))
+    return iris_cli_usage_error(CMD, "%s needs --method guided or guided-nee",
+                                aov_caches ? "--aov caches" : "--dump-caches");
+  if (gp.dump_dir && !iris_path_exists(gp.dump_dir))
+    return iris_cli_usage_error(CMD, "the --dump-caches folder '%s' does not exist", gp.dump_dir);
+  if (aov_caches) gp.marks = &marks;
   if (iris_method_uses_guiding(p.method)) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &gp;
@@ -295,7 +360,7 @@ int iris_cmd_render(int argc, char **argv) {
     st = iris_builtin_create(input, &scene, &err);
   } else {
     return iris_cli_usage_error(CMD, "'%s' is neither a file nor a built-in scene "
-                                     "(cornell-box, veach-mis, furnace-diffuse, furnace-glossy, "
+                                     "(cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, "
                                      "inside-sphere)", input);
   }
   if (st != IRIS_OK) return iris_cli_report(&err);
@@ -329,12 +394,15 @@ int iris_cmd_render(int argc, char **argv) {
   sigaction(SIGTERM, &old_term, NULL);
   if (ps.enabled) fprintf(stderr, "\n");
   if (st != IRIS_OK) {
+    iris_guiding_marks_destroy(&marks);
     iris_scene_destroy(scene);
     return iris_cli_report(&err);
   }
   int rc = IRIS_EXIT_OK;
   if (out_exr) st = iris_render_write_exr(&res, out_exr, input, variance, &err);
   if (st == IRIS_OK && out_png) st = iris_render_write_png(&res, out_png, (float)exposure, &err);
+  if (st == IRIS_OK && aov_caches) st = write_cache_marks(&res, &marks, out_png ? out_png : out_exr, (float)exposure, &err);
+  iris_guiding_marks_destroy(&marks);
   if (st != IRIS_OK) rc = iris_cli_report(&err);
 
   double samples = (double)res.spp * (double)res.film.width * (double)res.film.height;
