@@ -186,7 +186,8 @@ chi2_result chi2_run(const chi2_domain *domain, chi2_sample_fn sample, chi2_pdf_
       double e = cell_integral(&g, pdf, ctx, it, ip, share > 0.02 ? 6 : (share > 0.002 ? 4 : 1), 9);
       double ne = e * (double)n_samples;
       static const int min_d[2] = {5, 7}, max_d[2] = {9, 11};
-      for (int k = 0; k < 2 && fabs(b->observed - ne) > 4.0 * sqrt(ne) + 4.0; ++k) {
+      for (int k = 0; k < 2 && (fabs(b->observed - ne) > 4.0 * sqrt(ne) + 4.0 ||
+                                  (ne == 0.0 && b->observed > 0.0)); ++k) {
         e = cell_integral(&g, pdf, ctx, it, ip, min_d[k], max_d[k]);
         ne = e * (double)n_samples;
       }
