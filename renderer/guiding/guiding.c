@@ -155,7 +155,8 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
      * gives every cache ~ 1/8 of its neighbourhood to itself; more lights
      * need more photons to cover each one. */
     int64_t n = p->caches * (int64_t)p->cache_k / 20;
-    n = (int64_t)((double)n * (1.0 + 0.05 * (double)(s->lights->count > 1 ? s->lights->count - 1 : 0)));
+    size_t lights = s->lights->group_count; /* emitting instances + punctual + sky, not triangles */
+    n = (int64_t)((double)n * (1.0 + 0.05 * (double)(lights > 1 ? lights - 1 : 0)));
     p->photons = n < 100000 ? 100000 : (n > 4000000 ? 4000000 : n);
   }
   if (!(p->alpha_max >= 0.0f)) p->alpha_max = 0.0f;
