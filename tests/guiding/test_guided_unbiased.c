@@ -4,8 +4,8 @@
  * tests/render/test_unbiased.c). Threshold: two-sided normal quantile,
  * Bonferroni-corrected for a family-wise level of 0.1% over this run's tests,
  * never below 3 sigma. Guiding runs at its defaults (the scene-driven budget)
- * and also with alpha_max 0.9 and nearest splatting, so the unbiasedness does
- * not rest on one parameter set. */
+ * (forced on where the budget would skip it) and also with alpha_max 0.9 and
+ * nearest splatting, so the unbiasedness does not rest on one parameter set. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -39,6 +39,7 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   iris_guiding_params gp = iris_guiding_params_default();
   if (v->alpha_max > 0.0f) gp.alpha_max = v->alpha_max;
   gp.splat = v->splat;
+  gp.force = true; /* exercise the guide even where the budget would skip it (Veach) */
   p.width = w;
   p.height = h;
   p.spp = spp;
