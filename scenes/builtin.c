@@ -5,9 +5,14 @@
 #include <string.h>
 
 #include "scenes/door.h"
+#include "scenes/stress/stress.h"
 
 static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "furnace-diffuse",
-                                    "furnace-glossy", "inside-sphere", NULL};
+                                    "furnace-glossy", "inside-sphere",
+                                    /* the failure-stability scenes, scenes/stress/stress.h */
+                                    "stress-gap", "stress-veach-lights", "stress-caustic",
+                                    "stress-thin-walls", "stress-small-dim", "stress-closed-box",
+                                    "stress-firefly", "stress-glossy-room", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -311,6 +316,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = build_furnace(s, IRIS_MATERIAL_DIFFUSE);
   else if (strcmp(name, "furnace-glossy") == 0)
     st = build_furnace(s, IRIS_MATERIAL_GLOSSY);
+  else if (iris_stress_find(name))
+    st = iris_stress_build(name, s);
   else
     st = build_inside(s);
   if (st == IRIS_OK) {

@@ -5,7 +5,8 @@
  * guiding benchmark, scenes/door.h). Also small analytic
  * scenes for tests: `furnace-diffuse`, `furnace-glossy` (albedo-1 spheres under
  * a uniform sky of radiance 1) and `inside-sphere` (a sphere of radiance 1 seen
- * from inside). */
+ * from inside). The failure-stability scenes `stress-*` (scenes/stress/stress.h,
+ * docs/stability.md). */
 #ifndef IRIS_SCENES_BUILTIN_H
 #define IRIS_SCENES_BUILTIN_H
 
