@@ -135,14 +135,16 @@ static float power_heuristic(float pa, float pb) {
 }
 
 /* Direct light at a shading point by light sampling (NEE), MIS-weighted
- * against the path's direction sampler when `mis`. */
+ * against the path's direction sampler when `mis`. The light was chosen at
+ * the hit with this vertex's first number (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
-                               iris_sampler *rng, bool mis, iris_path_stats *stats) {
-  float u_sel = iris_sampler_next(rng);
+                               const iris_light_choice *choice, iris_sampler *rng, bool mis,
+                               iris_path_stats *stats) {
+  (void)iris_sampler_next(rng); /* u_select, already used by the choice */
   float u0 = iris_sampler_next(rng);
   float u1 = iris_sampler_next(rng);
   iris_light_sample ls;
-  if (!iris_lights_sample(it->lights, sp->si.p, u_sel, u0, u1, &ls)) return iris_v3(0, 0, 0);
+  if (!iris_lights_sample_choice(it->lights, sp->si.p, choice, u0, u1, &ls)) return iris_v3(0, 0, 0);
   if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
   iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
@@ -185,6 +187,10 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     }
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
+    /* Choose the light for NEE now, with the number sample_direct will draw,
+     * so that the emitter's record loads while the point is shaded. */
+    iris_light_choice choice = {0, 0.0f};
+    if (nee) iris_lights_choose(it->lights, si.p, iris_sampler_get(rng, rng->dimension), &choice);
     iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
       float w = 1.0f;
@@ -197,7 +203,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
     iris_integrator_prepare_direction(it, &sp);
-    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, rng, mis, stats)));
+    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, stats)));
 
     iris_direction_sample ds;
     if (!iris_integrator_sample_direction(it, &sp, rng, &ds)) break;

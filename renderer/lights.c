@@ -1,6 +1,7 @@
 /* Light list, next-event sampling and photon emission; see lights.h. */
 #include "renderer/lights.h"
 
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -109,7 +110,7 @@ static iris_status build_groups(iris_lights *L, iris_error *err) {
 }
 
 /* Estimated irradiance of each group at ref (the selection weights); returns the sum. */
-static double group_weights(const iris_lights *L, iris_vec3 ref, float *w) {
+static double group_weights_at(const iris_lights *L, iris_vec3 ref, float *w) {
   double sum = 0.0;
   for (size_t k = 0; k < L->group_count; k++) {
     const iris_light_group *g = &L->groups[k];
@@ -129,6 +130,27 @@ static double group_weights(const iris_lights *L, iris_vec3 ref, float *w) {
   return sum;
 }
 
+/* The weights of the last point this thread asked about: a path asks at a
+ * vertex for light sampling and again, from the same point, for the MIS pdf of
+ * the emitter its next ray hits. */
+static atomic_ullong next_lights_id = 1;
+static _Thread_local struct {
+  uint64_t id;
+  iris_vec3 ref;
+  double sum;
+  float w[IRIS_LIGHTS_MAX_GROUPS + 1];
+} weight_cache;
+
+static const float *group_weights(const iris_lights *L, iris_vec3 ref, double *sum) {
+  if (weight_cache.id != L->id || memcmp(&weight_cache.ref, &ref, sizeof ref) != 0) {
+    weight_cache.sum = group_weights_at(L, ref, weight_cache.w);
+    weight_cache.id = L->id;
+    weight_cache.ref = ref;
+  }
+  *sum = weight_cache.sum;
+  return weight_cache.w;
+}
+
 static float entry_pmf_in_group(const iris_lights *L, uint32_t index) {
   const iris_light_group *g = &L->groups[L->entries[index].group];
   return g->count > 1 ? iris_distrib1d_pmf(&g->select, index - g->first) : 1.0f;
@@ -138,8 +160,8 @@ static float entry_pmf_in_group(const iris_lights *L, uint32_t index) {
  * within the group is pe. */
 static float select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t group, float pe) {
   if (L->group_count == 1) return pe;
-  float w[IRIS_LIGHTS_MAX_GROUPS + 1];
-  double sum = group_weights(L, ref, w);
+  double sum;
+  const float *w = group_weights(L, ref, &sum);
   if (!(sum > 0.0)) return 0.0f;
   return (float)(w[group] / sum) * pe;
 }
@@ -154,21 +176,19 @@ static float pmf_in_group(const iris_lights *L, uint32_t i) {
   return i < L->tri_count ? L->tris[i].pmf_in_group : entry_pmf_in_group(L, i);
 }
 
-/* Two-step choice at ref; returns the entry and its probability. */
-static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf) {
+/* Two-step choice at ref; returns the entry and the probability of its group
+ * (the entry's probability is that times pmf_in_group, which is left to the
+ * caller so that the entry's record is not read here). */
+static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf_group) {
   if (L->group_count == 1) {
     const iris_light_group *g = &L->groups[0];
-    if (g->count == 1) {
-      *pmf = 1.0f;
-      return 0;
-    }
-    uint32_t i = (uint32_t)iris_distrib1d_sample(&g->select, u, NULL, NULL);
-    *pmf = pmf_in_group(L, i);
-    return i;
+    *pmf_group = 1.0f;
+    if (g->count == 1) return 0;
+    return (uint32_t)iris_distrib1d_sample(&g->select, u, NULL, NULL);
   }
-  float w[IRIS_LIGHTS_MAX_GROUPS + 1];
-  double sum = group_weights(L, ref, w);
-  *pmf = 0.0f;
+  double sum;
+  const float *w = group_weights(L, ref, &sum);
+  *pmf_group = 0.0f;
   if (!(sum > 0.0)) return 0;
   double target = (double)u * sum, acc = 0.0;
   size_t k = 0, last = 0;
@@ -184,20 +204,19 @@ static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *p
   const iris_light_group *g = &L->groups[k];
   float pg = (float)(w[k] / sum);
   uint32_t index = g->first;
-  float pe = 1.0f;
   if (g->count > 1) {
     float ur = (float)((target - acc) / w[k]);
     ur = iris_clampf(ur, 0.0f, 0x1.fffffep-1f);
     index = g->first + (uint32_t)iris_distrib1d_sample(&g->select, ur, NULL, NULL);
-    pe = pmf_in_group(L, index);
   }
-  *pmf = pg * pe;
+  *pmf_group = pg;
   return index;
 }
 
 iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                               const iris_textures *textures, iris_lights *out, iris_error *err) {
   memset(out, 0, sizeof *out);
+  out->id = atomic_fetch_add(&next_lights_id, 1);
   out->scene = scene;
   out->accel = accel;
   out->textures = textures;
@@ -385,11 +404,28 @@ iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction 
   return surface_emission(lights, m, si);
 }
 
+void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select,
+                        iris_light_choice *c) {
+  c->light = 0;
+  c->pmf_group = 0.0f;
+  if (lights->count == 0) return;
+  c->light = select_at(lights, ref, u_select, &c->pmf_group);
+  if (c->light < lights->tri_count) __builtin_prefetch(&lights->tris[c->light]);
+}
+
 bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
                         float u1, iris_light_sample *s) {
-  if (lights->count == 0) return false;
-  float pmf;
-  uint32_t i = select_at(lights, ref, u_select, &pmf);
+  iris_light_choice c;
+  iris_lights_choose(lights, ref, u_select, &c);
+  return iris_lights_sample_choice(lights, ref, &c, u0, u1, s);
+}
+
+bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
+                               const iris_light_choice *c, float u0, float u1,
+                               iris_light_sample *s) {
+  uint32_t i = c->light;
+  if (!(c->pmf_group > 0.0f) || i >= lights->count) return false;
+  float pmf = c->pmf_group * pmf_in_group(lights, i); /* 1 * pe = pe exactly */
   if (!(pmf > 0.0f)) return false;
   s->light = i;
   if (i < lights->tri_count) { /* a triangle: only its cache line is read */

@@ -96,6 +96,7 @@ typedef struct iris_lights {
   iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */
   float radius;
   double total_power;
+  uint64_t id;            /* unique per build (keys the per-thread selection cache) */
 } iris_lights;
 
 /* Builds the light list. A scene without emitters gives count == 0 (renders black
@@ -132,6 +133,23 @@ typedef struct iris_light_sample {
  * one-sided emitter, zero-area triangle, outside a spot cone...). */
 bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
                         float u1, iris_light_sample *s);
+
+/* iris_lights_sample in two halves, so that the path tracer can choose the
+ * light as soon as it knows the shading point and do the shading while the
+ * chosen emitter's record (usually a cache miss in scenes with thousands of
+ * emitter triangles) is being loaded: choose + sample_choice with the same
+ * numbers give exactly what iris_lights_sample gives. The selection weights of
+ * the last point a thread asked about are cached, so the MIS pdf of an
+ * emitter hit from that point (iris_lights_pdf_triangle) does not recompute them. */
+typedef struct iris_light_choice {
+  uint32_t light;   /* entry index */
+  float pmf_group;  /* probability of its group at ref; 0 = nothing to sample */
+} iris_light_choice;
+void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select,
+                        iris_light_choice *c);
+bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
+                               const iris_light_choice *c, float u0, float u1,
+                               iris_light_sample *s);
 
 /* Radiance leaving surface point `si` towards -d (the direction of the ray
  * that hit it); zero for non-emissive materials and for the back face of
