@@ -23,12 +23,11 @@ static float alpha_of(float roughness) {
 
 static bool alpha_is_singular(float alpha) { return alpha * alpha <= IRIS_BSDF_SINGULAR_ALPHA2; }
 
-static iris_vec3 sanitize3(iris_vec3 v) {
-  if (!iris_isfinite3(v)) return zero3;
-  return iris_v3(fmaxf(v.x, 0.0f), fmaxf(v.y, 0.0f), fmaxf(v.z, 0.0f));
-}
-
+/* NaN, Inf and negative values become 0 (per channel for colours). Written
+ * as comparisons rather than fmaxf so it inlines without -ffinite-math-only. */
 static float sanitize1(float v) { return (isfinite(v) && v > 0.0f) ? v : 0.0f; }
+
+static iris_vec3 sanitize3(iris_vec3 v) { return iris_v3(sanitize1(v.x), sanitize1(v.y), sanitize1(v.z)); }
 
 static iris_vec3 flip_z(iris_vec3 v) { return iris_v3(v.x, v.y, -v.z); }
 
@@ -463,6 +462,7 @@ bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, 
 }
 
 uint32_t iris_bsdf_lobes(const iris_bsdf *b) {
+  if (b->type == IRIS_BSDF_DIFFUSE) return IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
   bool smooth = alpha_is_singular(alpha_of(b->roughness));
   uint32_t spec = smooth ? IRIS_LOBE_DELTA : IRIS_LOBE_GLOSSY;
   switch (b->type) {
@@ -485,6 +485,7 @@ uint32_t iris_bsdf_lobes(const iris_bsdf *b) {
 }
 
 bool iris_bsdf_is_delta(const iris_bsdf *b) {
+  if (b->type == IRIS_BSDF_DIFFUSE) return false;
   uint32_t l = iris_bsdf_lobes(b);
   return (l & IRIS_LOBE_DELTA) && !(l & (IRIS_LOBE_DIFFUSE | IRIS_LOBE_GLOSSY));
 }
