@@ -115,6 +115,16 @@ static bool same_size(const iris_image *a, const iris_image *b, iris_error *err)
   return false;
 }
 
+/* Test variance of channel c at pixel i, raised to the reference-derived floor. */
+static inline double test_var(const iris_image *ref, iris_ref_variance rv, double var_t, size_t i,
+                              int c) {
+  if (rv.rv0 >= 0 && rv.test_floor > 0.0) {
+    double f = rv.test_floor * finite_or_zero(px(ref, i, rv.rv0 + c));
+    if (f > var_t) return f;
+  }
+  return var_t;
+}
+
 /* Variance of the reference pixel value of channel c at pixel i. */
 static inline double ref_var(const iris_image *ref, iris_ref_variance rv, double var_t, size_t i,
                              int c) {
@@ -159,7 +169,7 @@ iris_status iris_metric_blocks(const iris_image *test, int tc0, int tv0, const i
         a[c] += finite_or_zero(px(test, i, tc0 + c));
         a[3 + c] += finite_or_zero(px(ref, i, rc0 + c));
         if (tv0 >= 0) {
-          double vt = finite_or_zero(px(test, i, tv0 + c));
+          double vt = test_var(ref, rv, finite_or_zero(px(test, i, tv0 + c)), i, c);
           a[6 + c] += vt;
           a[9 + c] += ref_var(ref, rv, vt, i, c);
         }
@@ -250,7 +260,7 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
   if (!vs) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
   for (size_t i = 0; i < n; i++)
     for (int c = 0; c < 3; c++) {
-      double vt = vs[3 * i + (size_t)c];
+      double vt = test_var(ref, rv, vs[3 * i + (size_t)c], i, c);
       if (vt + ref_var(ref, rv, vt, i, c) > 0.0) out->tests++;
     }
   out->z_crit = iris_metric_normal_two_sided_z(alpha / (double)(out->tests ? out->tests : 1));
@@ -258,7 +268,7 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
     float zmax = 0.0f;
     for (int c = 0; c < 3; c++) {
       double t = px(test, i, tc0 + c), r = px(ref, i, rc0 + c);
-      double vt = vs[3 * i + (size_t)c];
+      double vt = test_var(ref, rv, vs[3 * i + (size_t)c], i, c);
       double v = vt + ref_var(ref, rv, vt, i, c);
       double z;
       if (v > 0.0) {

@@ -59,6 +59,11 @@ typedef struct iris_ref_variance {
   int rv0;      /* variance channels of the reference image, or -1 */
   double scale; /* when rv0 < 0: var_ref = scale * var_test (e.g. test_spp / ref_spp,
                    assuming the same per-sample variance); 0: the reference is exact */
+  double test_floor; /* when rv0 >= 0 and > 0: var_test is raised to at least
+                        test_floor * var_ref (ref_spp / test_spp): at low spp a test
+                        pixel that missed a rare bright path (an emitter edge covering
+                        1% of it) estimates its variance as 0, which the reference's
+                        per-sample variance, estimated from many more samples, corrects */
 } iris_ref_variance;
 
 /* Energy (sum of R+G+B) per block x block tile (edge tiles may be smaller),

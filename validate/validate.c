@@ -348,10 +348,17 @@ static iris_status run_blender_reference(const iris_scene *scene, const iris_val
 
 static void describe_ref_variance(const iris_validate_reference *ref, int spp, iris_ref_variance *rv,
                                   char *buf, size_t size) {
+  rv->test_floor = 0.0;
   if (ref->has_variance) {
     rv->rv0 = 3;
     rv->scale = 0.0;
-    snprintf(buf, size, "the reference's own var.R/G/B channels");
+    if (ref->spp > 0) {
+      rv->test_floor = (double)ref->spp / (double)spp;
+      snprintf(buf, size, "the reference's own var.R/G/B channels; iris's variance at least "
+                          "theirs x %d/%d spp", ref->spp, spp);
+    } else {
+      snprintf(buf, size, "the reference's own var.R/G/B channels");
+    }
   } else if (ref->spp > 0) {
     rv->rv0 = -1;
     rv->scale = (double)spp / (double)ref->spp;
@@ -455,6 +462,20 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
   if (p.source == IRIS_REFERENCE_FILE) {
     res->width = ref.width;
     res->height = ref.height;
+    /* A reference of the scene at another resolution is fine; one with
+     * another aspect ratio is of another framing (or a crop): refused. */
+    iris_export_params ep = iris_export_params_default();
+    ep.camera_name = p.camera_name;
+    iris_export_view view;
+    st = iris_export_resolve_view(scene, &ep, p.input, &view, err);
+    if (st != IRIS_OK) goto done;
+    double skew = fabs((double)ref.width * view.height - (double)ref.height * view.width);
+    if (skew > (double)(view.width > view.height ? view.width : view.height)) {
+      st = iris_error_set(err, IRIS_ERR_INVALID, p.reference_path, 0, NULL,
+                          "image sizes differ: the reference is %dx%d but the camera frames %dx%d "
+                          "(another aspect ratio)", ref.width, ref.height, view.width, view.height);
+      goto done;
+    }
   } else {
     iris_export_params ep = iris_export_params_default();
     ep.camera_name = p.camera_name;
