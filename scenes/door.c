@@ -14,7 +14,9 @@ static int32_t add_diffuse(iris_scene *s, const char *name, float r, float g, fl
   return m.name ? iris_scene_add_material(s, &m) : -1;
 }
 
-iris_status iris_door_scene_build(iris_scene *s) {
+iris_status iris_door_scene_build(iris_scene *s) { return iris_door_scene_build_variant(s, IRIS_DOOR_LIT); }
+
+iris_status iris_door_scene_build_variant(iris_scene *s, iris_door_variant variant) {
   int32_t wall = add_diffuse(s, "wall", 0.75f, 0.75f, 0.72f);
   int32_t floor = add_diffuse(s, "floor", 0.55f, 0.45f, 0.35f);
   int32_t box = add_diffuse(s, "box", 0.3f, 0.45f, 0.65f);
@@ -41,8 +43,16 @@ iris_status iris_door_scene_build(iris_scene *s) {
   ok = ok && iris_builtin_add_quad(s, iris_v3(-2.0f, 0.4f, -0.6f), iris_v3(0.4f, 0, 0), iris_v3(0, 0.4f, 0), 1, box, "box_front") >= 0;
   ok = ok && iris_builtin_add_quad(s, iris_v3(-1.6f, 0.4f, -1.0f), iris_v3(0, 0.4f, 0), iris_v3(0, 0, 0.4f), 1, box, "box_east") >= 0;
   ok = ok && iris_builtin_add_quad(s, iris_v3(-2.4f, 0.4f, -1.0f), iris_v3(0, 0, 0.4f), iris_v3(0, 0.4f, 0), 1, box, "box_west") >= 0;
-  /* The light: 1 m x 1 m under room B's ceiling, facing down (cross(a, b) = -y). */
-  ok = ok && iris_builtin_add_quad(s, iris_v3(2.5f, 2.98f, 0), iris_v3(0.5f, 0, 0), iris_v3(0, 0, 0.5f), 1, light, "light") >= 0;
+  if (variant == IRIS_DOOR_SHIELDED) {
+    /* The light: 1 m x 1 m, upright in room B 0.4 m before the east wall and
+     * facing it (cross(a, b) = +x); its black back faces the door, so no
+     * point of room A sees it: room A gets light only after >= 1 bounce in
+     * room B, through the door. */
+    ok = ok && iris_builtin_add_quad(s, iris_v3(3.6f, 1.5f, 0), iris_v3(0, 0.5f, 0), iris_v3(0, 0, 0.5f), 1, light, "light") >= 0;
+  } else {
+    /* The light: 1 m x 1 m under room B's ceiling, facing down (cross(a, b) = -y). */
+    ok = ok && iris_builtin_add_quad(s, iris_v3(2.5f, 2.98f, 0), iris_v3(0.5f, 0, 0), iris_v3(0, 0, 0.5f), 1, light, "light") >= 0;
+  }
   if (!ok) return IRIS_ERR_NOMEM;
   iris_camera cam;
   cam.name = iris_strdup("camera");

@@ -63,9 +63,12 @@ bool iris_cache_build_tables(const iris_octmap *map, const float *hist, float fl
     cdf[i] = (float)acc;
   }
   cdf[n - 1] = 1.0f;
+  /* pdf(w) = P[texel] * res^2 / (2 |w|_1^3): uniform in the texel's (a, b)
+   * square of area 4 / res^2, times d(a,b)/d(omega) = 2 / |w|_1^3. */
+  const float scale = 0.5f * (float)map->res * (float)map->res;
   for (uint32_t i = 0; i < n; ++i) {
     float p = cdf[i] - (i ? cdf[i - 1] : 0.0f);
-    pdf[i] = (float)(p / map->solid_angle[i]);
+    pdf[i] = p * scale;
   }
   return true;
 }
@@ -79,13 +82,36 @@ iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const floa
     if (cdf[mid] > u0) hi = mid;
     else lo = mid + 1;
   }
-  float c0 = lo ? cdf[lo - 1] : 0.0f, p = cdf[lo] - c0;
-  float r = p > 0.0f ? iris_clampf((u0 - c0) / p, 0.0f, 0x1.fffffep-1f) : 0.5f;
-  *pdf_out = pdf[lo];
-  return iris_octmap_sample_in_texel(map, lo, r, u1, u2);
+  (void)u0;
+  /* Uniform point of the texel in map coordinates (no trigonometry). The
+   * octahedron point q (|q|_1 = 1) normalised is w = q / |q|_2, so
+   * 1 / |w|_1^3 = |q|_2^3. */
+  uint32_t i = lo % (uint32_t)map->width, j = lo / (uint32_t)map->width;
+  float u = (float)i + u1, v = (float)j + u2;
+  float a, sign = 1.0f, n = (float)map->res;
+  if (i < (uint32_t)map->res) {
+    a = 2.0f * u / n - 1.0f;
+  } else {
+    a = 1.0f - 2.0f * (u - n) / n;
+    sign = -1.0f;
+  }
+  float b = 2.0f * v / n - 1.0f;
+  float x = 0.5f * (a + b), y = 0.5f * (b - a);
+  float z = sign * fmaxf(0.0f, 1.0f - fabsf(x) - fabsf(y));
+  float l2 = sqrtf(x * x + y * y + z * z);
+  float inv = 1.0f / l2;
+  *pdf_out = pdf[lo] * l2 * l2 * l2;
+  return iris_v3(x * inv, y * inv, z * inv);
+}
+
+float iris_cache_density_factor(iris_vec3 w) {
+  float l1 = fabsf(w.x) + fabsf(w.y) + fabsf(w.z);
+  float l2 = sqrtf(w.x * w.x + w.y * w.y + w.z * w.z);
+  float r = l2 / l1;
+  return r * r * r;
 }
 
 float iris_cache_pdf(const iris_octmap *map, const float *pdf, iris_vec3 w) {
   int32_t t = iris_octmap_dir_to_texel(map, w);
-  return t < 0 ? 0.0f : pdf[t];
+  return t < 0 ? 0.0f : pdf[t] * iris_cache_density_factor(w);
 }

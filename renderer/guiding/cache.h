@@ -1,8 +1,11 @@
 /* One irradiance cache's directional distribution (thesis 4.2.3, 5.1): a photon
  * histogram over an octahedral map turned into a pdf with a floor, its CDF,
  * sampling (Algorithm 2, uniform in solid angle inside the texel) and the pdf
- * of any direction (5.1.2). The pdf is piecewise constant over solid angle:
- * pdf(w) = P[texel(w)] / solid_angle[texel(w)], exactly what sampling does. */
+ * of any direction (5.1.2). Sampling picks a texel by the CDF and a point
+ * uniformly in the texel's (a, b) square, so the solid-angle density is
+ * pdf(w) = P[texel(w)] * res^2 / (2 |w|_1^3) (w unit; d(a,b)/d(omega) =
+ * 2 / |w|_1^3), exactly what sampling does; the pdf table stores
+ * P * res^2 / 2 per texel (docs/guiding.md). */
 #ifndef IRIS_RENDERER_GUIDING_CACHE_H
 #define IRIS_RENDERER_GUIDING_CACHE_H
 
@@ -32,17 +35,20 @@ bool iris_cache_splat(const iris_octmap *map, float *hist, iris_vec3 wi, float e
  * discrete distribution over texels, raise values below `floor` to `floor`,
  * renormalise; cdf[i] = P[0..i] (cdf[last] = 1) and pdf[i] = P[i] /
  * solid_angle[i], with P[i] recomputed as cdf differences so that pdf and
- * sampling agree to the last bit. Returns false (tables untouched) when the
+ * sampling agree to the last bit, and pdf[i] = P[i] * res^2 / 2 (multiply by
+ * iris_cache_density_factor(w) for a density). Returns false (tables untouched) when the
  * histogram is empty. */
 bool iris_cache_build_tables(const iris_octmap *map, const float *hist, float floor, float *pdf,
                              float *cdf);
 
 /* Samples a local direction (Algorithm 2): texel by binary search of u0 in the
- * CDF, then uniformly in solid angle inside the texel (the rescaled rest of u0
- * picks one of the texel's four spherical triangles, u1, u2 place the point).
+ * CDF, then (u1, u2) uniformly in the texel's map square (no trigonometry).
  * *pdf_out is the solid-angle density of the returned direction. */
 iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const float *cdf, float u0,
                             float u1, float u2, float *pdf_out);
+/* 1 / |w|_1^3 for w normalised: the factor that turns a texel's pdf-table
+ * entry into the solid-angle density at w (any non-zero length). */
+float iris_cache_density_factor(iris_vec3 w);
 /* Solid-angle density with which iris_cache_sample returns local direction w
  * (0 below a hemisphere map). */
 float iris_cache_pdf(const iris_octmap *map, const float *pdf, iris_vec3 w);

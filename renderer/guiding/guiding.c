@@ -460,16 +460,20 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
 /* Cache-sampling density of the vertex's tied caches (their average). */
 static float vertex_cache_pdf(const iris_guiding *g, const guide_vertex *v, iris_vec3 wi) {
   int32_t texel[IRIS_GUIDING_PICK_K] = {-1, -1, -1, -1, -1};
+  float jac[IRIS_GUIDING_PICK_K];
   float sum = 0.0f;
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *c = &g->caches[v->ids[i]];
     if (v->same_as[i] == i) {
       const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
-      texel[i] = iris_octmap_dir_to_texel(map, iris_frame_to_local(&c->frame, wi));
+      iris_vec3 wl = iris_frame_to_local(&c->frame, wi);
+      texel[i] = iris_octmap_dir_to_texel(map, wl);
+      jac[i] = iris_cache_density_factor(wl);
     } else {
       texel[i] = texel[v->same_as[i]];
+      jac[i] = jac[v->same_as[i]];
     }
-    if (texel[i] >= 0) sum += g->pdf[c->table + (uint32_t)texel[i]];
+    if (texel[i] >= 0) sum += g->pdf[c->table + (uint32_t)texel[i]] * jac[i];
   }
   return v->m > 0 ? sum / (float)v->m : 0.0f;
 }

@@ -130,7 +130,7 @@ iris_status iris_guiding_dump_caches(const iris_guiding *g, const iris_guide_set
       char path[1200];
       /* pdf as texel probability (what sampling picks), not density. */
       for (uint32_t t = 0; t < map->texel_count; ++t)
-        values[t] = g->pdf[c->table + t] * (float)map->solid_angle[t];
+        values[t] = g->pdf[c->table + t] * 2.0f / ((float)map->res * (float)map->res);
       snprintf(path, sizeof path, "%s/cache_px%04d_py%04d_pdf.png", dir, px, py);
       st = write_map_png(map, values, path, err);
       if (st != IRIS_OK) break;

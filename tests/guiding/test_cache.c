@@ -56,13 +56,30 @@ static void test_tables(int res, bool sphere, int pattern, iris_splat_mode mode,
     goto done;
   }
   EXPECT(ok, "tables not built (res %d sphere %d pattern %d)", res, sphere, pattern);
-  /* integral of the pdf over solid angle is 1 */
+  /* texel probabilities (pdf table = P * res^2 / 2) sum to 1 */
   double integral = 0.0, pmin = 1.0;
   for (uint32_t t = 0; t < m.texel_count; ++t) {
-    integral += pdf[t] * m.solid_angle[t];
-    pmin = fmin(pmin, pdf[t] * m.solid_angle[t]);
+    double pt = pdf[t] * 2.0 / ((double)res * res);
+    integral += pt;
+    pmin = fmin(pmin, pt);
   }
-  EXPECT(fabs(integral - 1.0) < 1e-5, "pdf integrates to %.8f", integral);
+  EXPECT(fabs(integral - 1.0) < 1e-5, "texel probabilities sum to %.8f", integral);
+  /* the density integrates to 1 over solid angle: Monte Carlo with uniform
+   * directions (independent of the map's parametrisation) */
+  {
+    const int nq = 400000;
+    double acc = 0.0, acc2 = 0.0, area = sphere ? 4.0 * PI_D : 2.0 * PI_D;
+    for (int i = 0; i < nq; ++i) {
+      iris_sampler s = iris_sampler_start(11, (uint64_t)i, 7);
+      double zq = 1.0 - (sphere ? 2.0 : 1.0) * iris_sampler_next(&s);
+      double ph = 2.0 * PI_D * iris_sampler_next(&s), rq = sqrt(fmax(0.0, 1.0 - zq * zq));
+      double f = area * iris_cache_pdf(&m, pdf, iris_v3((float)(rq * cos(ph)), (float)(rq * sin(ph)), (float)zq));
+      acc += f;
+      acc2 += f * f;
+    }
+    double mq = acc / nq, se = sqrt(fmax(0.0, acc2 / nq - mq * mq) / nq);
+    EXPECT(fabs(mq - 1.0) < 5.0 * se + 1e-3, "pdf integrates to %g +- %g over solid angle", mq, se);
+  }
   /* floor: every texel keeps at least floor / (1 + n floor) probability */
   EXPECT(pmin >= floor / (1.0 + m.texel_count * floor) * 0.999, "floor violated: %g", pmin);
   EXPECT(cdf[m.texel_count - 1] == 1.0f, "cdf end");
