@@ -260,7 +260,12 @@ int iris_cmd_bench(int argc, char **argv) {
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
   p.quiet = quiet;
   bool bar = !quiet && iris_log_progress_enabled();
-  if (bar) p.progress = draw_progress;
+  if (bar) {
+    p.progress = draw_progress;
+    /* the progress line says what runs; per-run messages (e.g. the guide's
+     * statistics) would break it */
+    iris_log_set_level(IRIS_LOG_WARN);
+  }
   p.cancel = &g_stop;
 
   struct sigaction sa, old_int, old_term;

@@ -109,6 +109,14 @@ static void fmt_seconds(char *buf, size_t size, double s) {
     snprintf(buf, size, "%.0f s", s);
 }
 
+/* A speed-up factor with two significant digits also when it is tiny. */
+static void fmt_factor(char *buf, size_t size, double f) {
+  if (f >= 0.095)
+    snprintf(buf, size, "%.2fx", f);
+  else
+    snprintf(buf, size, "%.2gx", f);
+}
+
 /* One cell of the equal-time table and the time-to-target cells, as text;
  * html selects the HTML flavour (title attributes with the spread). */
 static void cell_relmse(char *buf, size_t size, const method_curve *m, const method_curve *base,
@@ -120,8 +128,18 @@ static void cell_relmse(char *buf, size_t size, const method_curve *m, const met
   }
   const iris_bench_point *bp = base ? at_budget(base, budget) : NULL;
   char speed[64] = "";
-  if (bp && pt->relmse > 0 && m != base) snprintf(speed, sizeof speed, " (%.2fx)", bp->relmse / pt->relmse);
+  if (bp && pt->relmse > 0 && m != base) {
+    char x[32];
+    fmt_factor(x, sizeof x, bp->relmse / pt->relmse);
+    snprintf(speed, sizeof speed, " (%s)", x);
+  }
   char at[64] = "";
+  /* setup alone over the budget: the run took longer, say so */
+  if (pt->seconds > 1.25 * budget + 0.05) {
+    char s[32];
+    fmt_seconds(s, sizeof s, pt->seconds);
+    snprintf(at, sizeof at, " [took %s]", s);
+  }
   if (strcmp(m->name, "cycles") == 0) {
     char s[32];
     fmt_seconds(s, sizeof s, pt->seconds);
@@ -167,11 +185,13 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
   fprintf(m, "relMSE (eps 0.01, top 0.1%% of pixels dropped) is the mean over the seeds; in brackets the\n"
              "speed-up against mis at equal time, relMSE(mis) / relMSE(method). Budgets are wall-clock\n"
              "seconds with setup included. Time to target is interpolated in log-log between the two\n"
-             "budgets around the target (~: extrapolated with relMSE ~ 1/t).\n\n");
+             "budgets around the target (~: extrapolated with relMSE ~ 1/t). [took T]: the run needed T\n"
+             "seconds, more than its budget (setup alone exceeded it; at least one pass always runs).\n\n");
   fprintf(h, "<p>relMSE (&epsilon; = 0.01, top 0.1%% of pixels dropped), mean over the seeds (hover for the "
              "spread); in brackets the speed-up against mis at equal time, relMSE(mis) / relMSE(method). "
              "Budgets are wall-clock seconds with setup included. Time to target is interpolated in log-log "
-             "between the budgets around the target (~: extrapolated with relMSE &prop; 1/t).</p>\n");
+             "between the budgets around the target (~: extrapolated with relMSE &prop; 1/t). [took T]: the run "
+             "needed T seconds, more than its budget (setup alone exceeded it; at least one pass always runs).</p>\n");
   for (int s = 0; s < res->scene_count; s++) {
     iris_bench_scene *sc = &res->scenes[s];
     method_curve mc[IRIS_METHOD_COUNT + 1];
@@ -212,9 +232,11 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
         char s2[32];
         fmt_seconds(s2, sizeof s2, mc[k].ttt);
         snprintf(ts, sizeof ts, "%s%s", mc[k].extrapolated ? "~" : "", s2);
-        if (base && base->ttt > 0)
-          snprintf(sp, sizeof sp, "%s%.2fx", (mc[k].extrapolated || base->extrapolated) ? "~" : "",
-                   base->ttt / mc[k].ttt);
+        if (base && base->ttt > 0) {
+          char x[32];
+          fmt_factor(x, sizeof x, base->ttt / mc[k].ttt);
+          snprintf(sp, sizeof sp, "%s%s", (mc[k].extrapolated || base->extrapolated) ? "~" : "", x);
+        }
       }
       fprintf(m, " %s | %s |\n", ts, sp);
       fprintf(h, "<td>%s</td><td>%s</td></tr>\n", ts, sp);
