@@ -173,8 +173,9 @@ static int compare_float(const void *a, const void *b) {
  * reached) is better served by BSDF sampling, and bounding the search keeps
  * its cost flat there. Radius = 3x the 90th percentile, over the caches, of
  * the distance to their 5th nearest other cache. */
-static float pick_radius2(const iris_guiding *g) {
+static float pick_radius2(const iris_guiding *g, float *spacing) {
   size_t n = g->cache_count;
+  *spacing = 0.0f;
   if (n <= IRIS_GUIDING_PICK_K) return INFINITY;
   float *d = malloc(sizeof(float) * n);
   if (!d) return INFINITY;
@@ -186,6 +187,7 @@ static float pick_radius2(const iris_guiding *g) {
   }
   qsort(d, n, sizeof(float), compare_float);
   float r2 = 9.0f * d[(size_t)(0.9 * (double)(n - 1))];
+  *spacing = sqrtf(d[(n - 1) / 2]); /* median distance to the 5th nearest other cache */
   free(d);
   return r2 > 0.0f ? r2 : INFINITY;
 }
@@ -330,10 +332,15 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       skip(g, "no cache received photons");
     } else {
       st = iris_kdtree_build(&g->tree, &g->caches[0].p, sizeof(iris_cache), (uint32_t)kept, err);
-      if (st == IRIS_OK) g->pick_radius2 = pick_radius2(g);
+      float spacing = 0.0f;
+      if (st == IRIS_OK) g->pick_radius2 = pick_radius2(g, &spacing);
+      if (st == IRIS_OK)
+        st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing,
+                                  s->threads, err);
       g->stats.memory_bytes = sizeof(iris_cache) * kept + 2 * sizeof(float) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
-                              sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count);
+                              sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +
+                              g->grid.memory_bytes;
     }
   }
   g->stats.cache_seconds = iris_time_now() - t1;
@@ -385,6 +392,7 @@ void iris_guiding_destroy(iris_guiding *g) {
   iris_octmap_destroy(&g->hemi);
   iris_octmap_destroy(&g->sphere);
   iris_kdtree_destroy(&g->tree);
+  iris_pick_grid_destroy(&g->grid);
   free(g->caches);
   free(g->pdf);
   free(g->cdf);
@@ -397,7 +405,7 @@ int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t 
   if (g->cache_count == 0) return 0;
   uint32_t near[IRIS_GUIDING_PICK_K];
   float d2[IRIS_GUIDING_PICK_K], cosv[IRIS_GUIDING_PICK_K];
-  uint32_t m = iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
+  uint32_t m = iris_pick_grid_knn(&g->grid, &g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
   float best = -2.0f;
   for (uint32_t i = 0; i < m; ++i) {
     cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);

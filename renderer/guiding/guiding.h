@@ -15,6 +15,7 @@
 #include "renderer/guiding/cache.h"
 #include "renderer/guiding/kdtree.h"
 #include "renderer/guiding/octmap.h"
+#include "renderer/guiding/pickgrid.h"
 #include "renderer/integrator.h"
 #include "renderer/render.h"
 
@@ -84,6 +85,7 @@ typedef struct iris_guiding {
   float *pdf, *cdf;    /* all tables, pdf over solid angle and CDF per texel */
   iris_kdtree tree;    /* over caches[i].p */
   float pick_radius2;  /* Algorithm 1 ignores caches farther than this (squared) */
+  iris_pick_grid grid; /* candidate caches per cell: Algorithm 1's search without the tree */
   iris_guiding_stats stats;
 } iris_guiding;
 

@@ -5,6 +5,7 @@
 
 #include "core/rng.h"
 #include "renderer/guiding/kdtree.h"
+#include "renderer/guiding/pickgrid.h"
 
 static int failures = 0;
 
@@ -71,7 +72,63 @@ static void run(uint32_t n, int grid, uint64_t seed) {
   free(pts);
 }
 
+/* The candidate grid answers exactly like the kd-tree (same ids, same
+ * distances, same tie order) for points on and off the surfaces. Points lie on
+ * the six faces of a 4 x 3 x 2 box, some duplicated (ties). */
+static void run_grid(uint32_t n, float radius, uint64_t seed) {
+  iris_vec3 *pts = malloc(sizeof(iris_vec3) * n);
+  const float ext[3] = {4.0f, 3.0f, 2.0f};
+  for (uint32_t i = 0; i < n; ++i) {
+    iris_sampler s = iris_sampler_start(seed, i, 0);
+    float c[3] = {iris_sampler_next(&s) * ext[0], iris_sampler_next(&s) * ext[1], iris_sampler_next(&s) * ext[2]};
+    int face = (int)(iris_sampler_next(&s) * 6.0f) % 6;
+    c[face / 2] = (face & 1) ? ext[face / 2] : 0.0f;
+    pts[i] = i % 17 == 3 && i > 0 ? pts[i - 1] : iris_v3(c[0], c[1], c[2]);
+  }
+  iris_kdtree t;
+  iris_pick_grid g;
+  if (iris_kdtree_build(&t, pts, sizeof(iris_vec3), n, NULL) != IRIS_OK ||
+      iris_pick_grid_build(&g, &t, 5, radius * radius, 0.25f, 2, NULL) != IRIS_OK) {
+    ++failures;
+    return;
+  }
+  if (g.n[0] == 0 || g.candidates == 0 || g.fallback_cells >= g.cells) {
+    fprintf(stderr, "FAIL grid not built (%zu cells, %zu fallback)\n", g.cells, g.fallback_cells);
+    ++failures;
+  }
+  int bad = 0;
+  for (int q = 0; q < 20000; ++q) {
+    iris_sampler s = iris_sampler_start(seed + 7, (uint64_t)q, 0);
+    float c[3] = {iris_sampler_next(&s) * 5.0f - 0.5f, iris_sampler_next(&s) * 4.0f - 0.5f,
+                  iris_sampler_next(&s) * 3.0f - 0.5f};
+    if (q % 4 != 0) { /* on a face, slightly off it */
+      int face = (int)(iris_sampler_next(&s) * 6.0f) % 6;
+      c[face / 2] = ((face & 1) ? ext[face / 2] : 0.0f) + (iris_sampler_next(&s) - 0.5f) * 0.02f;
+    }
+    if (q % 97 == 5) { /* exactly on a stored point */
+      uint32_t i = (uint32_t)q % n;
+      c[0] = pts[i].x, c[1] = pts[i].y, c[2] = pts[i].z;
+    }
+    iris_vec3 p = iris_v3(c[0], c[1], c[2]);
+    uint32_t ia[5], ib[5];
+    float da[5], db[5];
+    uint32_t k = 1 + (uint32_t)q % 5;
+    uint32_t na = iris_kdtree_knn(&t, p, k, radius * radius, ia, da);
+    uint32_t nb = iris_pick_grid_knn(&g, &t, p, k, radius * radius, ib, db);
+    bool same = na == nb;
+    for (uint32_t i = 0; same && i < na; ++i) same = ia[i] == ib[i] && da[i] == db[i];
+    if (!same && bad++ < 5)
+      fprintf(stderr, "FAIL grid q=%d (%g %g %g) k=%u: tree %u, grid %u neighbours\n", q, c[0], c[1], c[2], k, na, nb);
+  }
+  failures += bad;
+  iris_pick_grid_destroy(&g);
+  iris_kdtree_destroy(&t);
+  free(pts);
+}
+
 int main(void) {
+  run_grid(1500, 0.8f, 11);
+  run_grid(300, 2.5f, 12); /* sparse: many cells with more than the cap fall back */
   run(1, 0, 1);
   run(2, 0, 2);
   run(37, 0, 3);
