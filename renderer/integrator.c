@@ -126,6 +126,11 @@ float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shadin
   return iris_integrator_bsdf_pdf(sp, wi);
 }
 
+/* Adjoint-driven Russian roulette: paths whose expected contribution is at
+ * least 1/RR_WINDOW of the pixel estimate always survive (Vorba & Krivanek
+ * 2016 use a window of width 5: lower end 2/(1+5) = 1/3 of the estimate). */
+#define RR_WINDOW 3.0f
+
 /* Power heuristic (beta = 2), Veach 1997 eq. 9.13, for one sample of each. */
 static float power_heuristic(float pa, float pb) {
   if (!(pa > 0.0f)) return 0.0f;
@@ -168,6 +173,8 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
   const bool nee = iris_method_uses_nee(it->method) && it->lights->count > 0;
   const bool mis = nee && method_uses_mis(it->method);
   iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
+  const bool adjoint_rr = iris_method_uses_guiding(it->method) && it->guide.radiance_estimate;
+  float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
   bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o;
@@ -209,6 +216,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     if (!iris_integrator_sample_direction(it, &sp, rng, &ds)) break;
     if (!direction_allowed(&sp, ds.wi)) break;
     float cos_i = fabsf(iris_dot(ds.wi, sp.si.ns));
+    const iris_vec3 beta_before = beta;
     beta = iris_mul(beta, iris_scale(ds.f, cos_i / ds.pdf));
     if (!iris_isfinite3(beta)) { /* a NaN/Inf from a sampler: count it, keep what is finite */
       stats->nan_count++;
@@ -220,9 +228,21 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     prev_p = sp.si.p;
     ray = iris_spawn_ray(&sp.si, ds.wi);
 
-    /* Russian roulette (docs/rendering.md): survive with q = min(0.95, max beta). */
+    /* Russian roulette (docs/rendering.md): survive with q = min(0.95, max beta).
+     * Guided methods whose guide estimates the radiance still to come (est):
+     * adjoint-driven survival (Vorba & Krivanek 2016, without splitting),
+     * q = RR_WINDOW * beta_before_this_bounce * est / pixel_estimate, clamped
+     * to [0.1 q_plain, 1]: a path is not killed for following the guide (which
+     * lowers beta) nor in bright regions, and is killed early where little
+     * light is left (docs/guiding.md, "Russian roulette"). Any q in (0, 1]
+     * with beta / q keeps the estimator unbiased. */
+    float est = adjoint_rr ? it->guide.radiance_estimate(it->guide.ctx, &sp) : -1.0f;
+    if (est >= 0.0f && !(pixel_estimate > 0.0f))
+      pixel_estimate = iris_avg3(L) + iris_avg3(beta_before) * est;
     if (bounce + 1 >= it->rr_depth) {
       float q = fminf(0.95f, iris_max3(beta));
+      if (est >= 0.0f && pixel_estimate > 0.0f)
+        q = iris_clampf(RR_WINDOW * iris_max3(beta_before) * est / pixel_estimate, 0.1f * q, 1.0f);
       if (iris_sampler_next(rng) >= q) break;
       beta = iris_scale(beta, 1.0f / q);
     }

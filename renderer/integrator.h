@@ -90,6 +90,12 @@ typedef struct iris_direction_sampler {
                  iris_direction_sample *out);
   float (*pdf)(void *ctx, const iris_shading_point *sp, iris_vec3 wi);
   void (*prepare)(void *ctx, iris_shading_point *sp);
+  /* Optional (may be NULL): after prepare, an estimate of the radiance a path
+   * continuing from sp will still collect per unit throughput (guiding: the
+   * caches' irradiance / pi; with light sampling only the indirect part), or
+   * < 0 when unknown. Drives the guided methods' Russian roulette
+   * (docs/guiding.md, "Russian roulette"). */
+  float (*radiance_estimate)(void *ctx, const iris_shading_point *sp);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

@@ -69,6 +69,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--cos-min")) gp.cos_min = (float)atof(v), ++i;
     else if (!strcmp(a, "--errmap")) g_errmap = v, ++i;
     else if (!strcmp(a, "--bilinear")) gp.splat = IRIS_SPLAT_BILINEAR;
+    else if (!strcmp(a, "--no-adjoint-rr")) gp.adjoint_rr = false;
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
     else if (!strcmp(a, "--width")) p.width = atoi(v), ++i;
     else if (!strcmp(a, "--height")) p.height = atoi(v), ++i;

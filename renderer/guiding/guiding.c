@@ -29,6 +29,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.cos_min = 0.9f;
   p.splat = IRIS_SPLAT_BILINEAR; /* thesis: nearest; measured in docs/guiding.md */
   p.direct_photons = -1;
+  p.adjoint_rr = true;
   return p;
 }
 
@@ -122,13 +123,23 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     photon_filter f = {c->photons->photons, cache->frame.n, cache->sphere != 0};
     uint32_t n = iris_kdtree_knn_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
     uint32_t used = 0;
+    double power = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
       const iris_photon *ph = &c->photons->photons[ids[j]];
       if (iris_dot(ph->n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
       iris_vec3 wl = iris_frame_to_local(&cache->frame, ph->wi);
-      used += iris_cache_splat(map, hist, wl, ph->energy, g->params.splat);
+      bool u = iris_cache_splat(map, hist, wl, ph->energy, g->params.splat);
+      used += u;
+      if (u) power += ph->energy;
     }
     cache->photons = used;
+    /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
+     * sum of powers / (paths * pi r_k^2); radiance of a white diffuse surface =
+     * irradiance / pi. The photons cover the disc to the k-th nearest. */
+    cache->radiance = n > 0 && d2[n - 1] > 0.0f
+                          ? (float)(power / ((double)c->photons->paths * 3.14159265358979 *
+                                             3.14159265358979 * (double)d2[n - 1]))
+                          : 0.0f;
     if (!used || !iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + cache->table,
                                           g->cdf + cache->table))
       cache->photons = 0;
@@ -440,6 +451,7 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
  * to the same texel, so pdf evaluation computes that texel once per group. */
 typedef struct guide_vertex {
   float alpha;                          /* cache-sampling probability; 0: BSDF only */
+  float radiance;                       /* tied caches' mean radiance estimate; < 0 none */
   int32_t m;                            /* tied caches */
   uint32_t ids[IRIS_GUIDING_PICK_K];
   uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
@@ -452,6 +464,12 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->alpha = iris_guiding_alpha(g, sp);
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
   if (v->m == 0) v->alpha = 0.0f;
+  v->radiance = -1.0f;
+  if (v->m > 0) {
+    float r = 0.0f;
+    for (int i = 0; i < v->m; ++i) r += g->caches[v->ids[i]].radiance;
+    v->radiance = r / (float)v->m;
+  }
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
     v->same_as[i] = (uint8_t)i;
@@ -533,6 +551,16 @@ static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
   return (1.0f - v->alpha) * pb + v->alpha * vertex_cache_pdf(g, v, wi);
 }
 
+/* Radiance still to come at a prepared vertex, per unit throughput: the tied
+ * caches' estimate (irradiance / pi; the surface's albedo is left out, as in
+ * the pixel estimate it is compared with), for the integrator's Russian
+ * roulette. */
+static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
+  (void)ctx;
+  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
+  return v->radiance;
+}
+
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   iris_direction_sampler s;
   memset(&s, 0, sizeof s);
@@ -541,6 +569,7 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.sample = guided_sample;
   s.pdf = guided_pdf;
   s.prepare = guided_prepare;
+  if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
   return s;
 }
 

@@ -48,6 +48,7 @@ typedef struct iris_guiding_params {
   bool force;           /* build caches even where the budget would skip guiding */
   bool use_nee;         /* the render also samples lights (guided-nee): skip if lit only directly */
   int direct_photons;   /* splat photons straight from a light: -1 auto (not with NEE), 0 no, 1 yes */
+  bool adjoint_rr;      /* Russian roulette from the caches' radiance estimates (default on) */
   /* Inspection (outputs of the build, NULL = off): */
   const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
                                  serving a 4 x 3 grid of pixels (docs/guiding.md) */
@@ -62,6 +63,8 @@ typedef struct iris_cache {
   iris_frame frame;
   uint32_t table;    /* first float of this cache's pdf/cdf in iris_guiding.pdf/.cdf */
   uint32_t photons;  /* photons splatted */
+  float radiance;    /* irradiance / pi from its k photons (mean of RGB, W m^-2 sr^-1): the
+                        radiance a diffuse white surface here reflects (Russian roulette) */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
 } iris_cache;
