@@ -176,15 +176,43 @@ static float pmf_in_group(const iris_lights *L, uint32_t i) {
   return i < L->tri_count ? L->tris[i].pmf_in_group : entry_pmf_in_group(L, i);
 }
 
-/* Two-step choice at ref; returns the entry and the probability of its group
- * (the entry's probability is that times pmf_in_group, which is left to the
- * caller so that the entry's record is not read here). */
-static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf_group) {
+/* Slot of a group's alias table from u in [0, 1): the entry index and the
+ * remainder for the alias test (exact in double: u has 24 bits, n <= 2^29). */
+static uint32_t alias_slot(const iris_light_group *g, float u, float *coin) {
+  double f = (double)u * (double)g->count;
+  uint32_t j = (uint32_t)f;
+  if (j >= g->count) j = g->count - 1;
+  *coin = (float)(f - (double)j);
+  return g->first + j;
+}
+
+/* In-group choice of a group with count > 1: triangles through the alias
+ * table (finished by alias_resolve), others (never more than one) directly. */
+static uint32_t choose_in_group(const iris_light_group *g, float u, float *coin) {
+  *coin = -1.0f;
+  if (g->kind == IRIS_LIGHT_KIND_TRIANGLE) return alias_slot(g, u, coin);
+  return g->first + (uint32_t)iris_distrib1d_sample(&g->select, u, NULL, NULL);
+}
+
+/* The alias redirection of a slot chosen by choose_in_group. */
+static uint32_t alias_resolve(const iris_lights *L, uint32_t i, float coin) {
+  if (coin < 0.0f || i >= L->tri_count) return i;
+  const iris_light_tri *t = &L->tris[i];
+  return coin < t->alias_q ? i : t->alias;
+}
+
+/* Two-step choice at ref; returns the entry (a slot to be resolved with
+ * alias_resolve(coin)) and the probability of its group (the entry's
+ * probability is that times pmf_in_group, which is left to the caller so that
+ * the entry's record is not read here). */
+static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *pmf_group,
+                          float *coin) {
+  *coin = -1.0f;
   if (L->group_count == 1) {
     const iris_light_group *g = &L->groups[0];
     *pmf_group = 1.0f;
     if (g->count == 1) return 0;
-    return (uint32_t)iris_distrib1d_sample(&g->select, u, NULL, NULL);
+    return choose_in_group(g, u, coin);
   }
   double sum;
   const float *w = group_weights(L, ref, &sum);
@@ -207,10 +235,59 @@ static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *p
   if (g->count > 1) {
     float ur = (float)((target - acc) / w[k]);
     ur = iris_clampf(ur, 0.0f, 0x1.fffffep-1f);
-    index = g->first + (uint32_t)iris_distrib1d_sample(&g->select, ur, NULL, NULL);
+    index = choose_in_group(g, ur, coin);
   }
   *pmf_group = pg;
   return index;
+}
+
+/* Vose's alias table over the group's entries in proportion to their power
+ * (sanitised as iris_distrib1d does; uniform when all are zero), in double. */
+static iris_status build_alias(iris_lights *L, const iris_light_group *g) {
+  uint32_t n = g->count;
+  double *p = malloc(sizeof(double) * n);
+  uint32_t *small = malloc(sizeof(uint32_t) * n), *large = malloc(sizeof(uint32_t) * n);
+  if (!p || !small || !large) {
+    free(p), free(small), free(large);
+    return IRIS_ERR_NOMEM;
+  }
+  double sum = 0.0;
+  for (uint32_t i = 0; i < n; i++) {
+    float w = L->entries[g->first + i].power;
+    p[i] = isfinite(w) && w > 0.0f ? (double)w : 0.0;
+    sum += p[i];
+  }
+  uint32_t ns = 0, nl = 0;
+  for (uint32_t i = 0; i < n; i++) {
+    p[i] = sum > 0.0 ? p[i] * n / sum : 1.0;
+    if (p[i] < 1.0)
+      small[ns++] = i;
+    else
+      large[nl++] = i;
+  }
+  while (ns > 0 && nl > 0) {
+    uint32_t s = small[--ns], l = large[--nl];
+    L->tris[g->first + s].alias_q = (float)p[s];
+    L->tris[g->first + s].alias = g->first + l;
+    p[l] -= 1.0 - p[s];
+    if (p[l] < 1.0)
+      small[ns++] = l;
+    else
+      large[nl++] = l;
+  }
+  /* what is left is full up to rounding */
+  while (nl > 0) {
+    uint32_t l = large[--nl];
+    L->tris[g->first + l].alias_q = 2.0f;
+    L->tris[g->first + l].alias = g->first + l;
+  }
+  while (ns > 0) {
+    uint32_t s = small[--ns];
+    L->tris[g->first + s].alias_q = 2.0f;
+    L->tris[g->first + s].alias = g->first + s;
+  }
+  free(p), free(small), free(large);
+  return IRIS_OK;
 }
 
 iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
@@ -325,7 +402,6 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
       iris_v3_store(e->v0, t->v0);
       iris_v3_store(e->e1, t->e1);
       iris_v3_store(e->e2, t->e2);
-      iris_v3_store(e->ng, t->ng);
       t->area = e->area;
       t->pmf_in_group = entry_pmf_in_group(out, (uint32_t)i);
       t->material = iris_accel_triangle_material(accel, e->prim);
@@ -333,6 +409,11 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                  (e->textured ? IRIS_LIGHT_TRI_TEXTURED : 0u) | (e->group << 8);
     }
     out->tri_count = tris;
+    for (size_t k = 0; k < out->group_count; k++)
+      if (out->groups[k].kind == IRIS_LIGHT_KIND_TRIANGLE && build_alias(out, &out->groups[k]) != IRIS_OK) {
+        iris_lights_destroy(out);
+        return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+      }
   }
   if (n > 0) {
     float *w = malloc(sizeof(float) * n);
@@ -409,7 +490,9 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select
   c->light = 0;
   c->pmf_group = 0.0f;
   if (lights->count == 0) return;
-  c->light = select_at(lights, ref, u_select, &c->pmf_group);
+  float coin = -1.0f;
+  uint32_t slot = select_at(lights, ref, u_select, &c->pmf_group, &coin);
+  c->light = alias_resolve(lights, slot, coin);
   if (c->light < lights->tri_count) __builtin_prefetch(&lights->tris[c->light]);
 }
 
@@ -423,8 +506,8 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
 bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
                                const iris_light_choice *c, float u0, float u1,
                                iris_light_sample *s) {
+  if (!(c->pmf_group > 0.0f) || c->light >= lights->count) return false;
   uint32_t i = c->light;
-  if (!(c->pmf_group > 0.0f) || i >= lights->count) return false;
   float pmf = c->pmf_group * pmf_in_group(lights, i); /* 1 * pe = pe exactly */
   if (!(pmf > 0.0f)) return false;
   s->light = i;
@@ -437,7 +520,7 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     if (t->flags & IRIS_LIGHT_TRI_TEXTURED) {
       iris_accel_surface_at(lights->accel, lights->entries[i].prim, b1, 1.0f - b0 - b1, &si);
     } else { /* position and normal are all an untextured emitter needs */
-      si.ng = iris_v3_load(t->ng);
+      si.ng = iris_normalize(iris_cross(iris_v3_load(t->e1), iris_v3_load(t->e2)));
       si.p = iris_add(iris_v3_load(t->v0), iris_add(iris_scale(iris_v3_load(t->e1), b1),
                                                     iris_scale(iris_v3_load(t->e2), 1.0f - b0 - b1)));
     }

@@ -68,14 +68,21 @@ typedef struct iris_light_group {
 
 /* What next-event estimation reads of a triangle entry, packed into one
  * 64-byte cache line (the entries themselves are larger and, for emitters of
- * thousands of triangles, mostly out of cache). */
+ * thousands of triangles, mostly out of cache). The choice within a group is
+ * an alias table (Walker 1977, Vose 1991) stored in the same lines: slot j of
+ * a group of n is picked with floor(u n), kept if the rest of u n is below
+ * alias_q and else replaced by `alias`, so a choice costs one cache miss
+ * (two when redirected) instead of a search through a CDF and then the record. */
 typedef struct iris_light_tri {
-  float v0[3], e1[3], e2[3]; /* world vertex 0 and edges (counter-clockwise, front) */
-  float ng[3];               /* unit front normal */
+  float v0[3], e1[3], e2[3]; /* world vertex 0 and edges (counter-clockwise, front);
+                                the unit front normal is normalize(e1 x e2) */
   float area;
   float pmf_in_group;        /* probability of the entry within its group */
   int32_t material;          /* its emission is the untextured radiance */
   uint32_t flags;            /* IRIS_LIGHT_TRI_* | group << 8 */
+  float alias_q;             /* keep this slot when the remainder is below */
+  uint32_t alias;            /* else this entry (global index) */
+  uint32_t pad_;
 } iris_light_tri;
 #define IRIS_LIGHT_TRI_TWO_SIDED 1u
 #define IRIS_LIGHT_TRI_TEXTURED 2u

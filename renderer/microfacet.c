@@ -3,6 +3,11 @@
 
 #include "renderer/sampling.h"
 
+/* fmaxf(x, 0.0f) and iris_safe_sqrt with the same results (x > 0 ? x : +0,
+ * NaN -> 0), inlined: without -ffinite-math-only fmaxf is a call into libm. */
+static inline float max0(float x) { return x > 0.0f ? x : 0.0f; }
+static inline float safe_sqrt(float x) { return sqrtf(max0(x)); }
+
 float iris_ggx_d(float alpha, iris_vec3 m) {
   if (m.z <= 0.0f) return 0.0f;
   /* 1 + (a^2 - 1) cos^2 written as sin^2 + a^2 cos^2 with sin^2 from the
@@ -18,7 +23,7 @@ float iris_ggx_d(float alpha, iris_vec3 m) {
 float iris_ggx_lambda(float alpha, iris_vec3 w) {
   float c2 = w.z * w.z;
   if (c2 <= 0.0f) return INFINITY;
-  float s2 = fmaxf(w.x * w.x + w.y * w.y, 0.0f);
+  float s2 = max0(w.x * w.x + w.y * w.y);
   float a2t2 = alpha * alpha * s2 / c2;
   return 0.5f * (sqrtf(1.0f + a2t2) - 1.0f);
 }
@@ -26,7 +31,7 @@ float iris_ggx_lambda(float alpha, iris_vec3 w) {
 float iris_ggx_g1(float alpha, iris_vec3 w) {
   float c2 = w.z * w.z;
   if (c2 <= 0.0f) return 0.0f;
-  float s2 = fmaxf(w.x * w.x + w.y * w.y, 0.0f);
+  float s2 = max0(w.x * w.x + w.y * w.y);
   /* 2 / (1 + sqrt(1 + a^2 tan^2)): the form Cycles 3.4 uses, finite at grazing. */
   return 2.0f / (1.0f + sqrtf(1.0f + alpha * alpha * s2 / c2));
 }
@@ -43,10 +48,10 @@ iris_vec3 iris_ggx_sample_vndf(float alpha, iris_vec3 wo, float u0, float u1) {
   float x, y;
   iris_sample_concentric_disk(u0, u1, &x, &y);
   float s = 0.5f * (1.0f + vh.z);
-  y = (1.0f - s) * iris_safe_sqrt(1.0f - x * x) + s * y;
+  y = (1.0f - s) * safe_sqrt(1.0f - x * x) + s * y;
   /* Section 4.3: reprojection onto the hemisphere. */
   iris_vec3 nh = iris_add(iris_add(iris_scale(t1, x), iris_scale(t2, y)),
-                          iris_scale(vh, iris_safe_sqrt(1.0f - x * x - y * y)));
+                          iris_scale(vh, safe_sqrt(1.0f - x * x - y * y)));
   /* Section 3.4: back to the ellipsoid configuration. */
   iris_vec3 m = iris_normalize(iris_v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z)));
   return m;

@@ -1,8 +1,13 @@
 /* Renderer benchmarks (not tests):
- *   bench_render raw SCENE THREADS SPP W H   raw Embree loop: camera rays, then
- *       cosine bounces with one occlusion ray per hit, as many closest-hit and
- *       occlusion rays per path as `iris render --method mis` casts on average
- *       (given on the command line), no shading: the ceiling for iris's ray rate.
+ *   bench_render raw SCENE THREADS SPP W H RAYS_PER_PATH [SHADOW_PER_PATH]
+ *       raw Embree loop: camera rays, then cosine bounces, and per hit an
+ *       occlusion ray to a uniformly chosen point on a uniformly chosen emissive
+ *       triangle (the kind of shadow ray next-event estimation casts), with as
+ *       many closest-hit and occlusion rays per path as `iris render --method
+ *       mis` casts on average (given on the command line), no shading: the
+ *       ceiling for iris's ray rate. Without SHADOW_PER_PATH (or in scenes
+ *       without emissive triangles) the old form: one occlusion ray per hit to
+ *       a point about one unit above it.
  *   bench_render instancing N                N copies of the bunny: BVH memory and
  *       ray rate with flattened triangles vs Embree instances (one BLAS).
  *   bench_render write-bunny-box OUT.json    the "bunny in a box" scene file.
@@ -18,6 +23,7 @@
 #include "importers/import.h"
 #include "renderer/accel.h"
 #include "renderer/camera.h"
+#include "renderer/lights.h"
 #include "scenes/builtin.h"
 
 static iris_scene *load(const char *name) {
@@ -35,38 +41,73 @@ static iris_scene *load(const char *name) {
 
 typedef struct raw_ctx {
   const iris_accel *accel;
+  const iris_lights *lights; /* emissive triangles (lights->tris) */
   iris_pinhole cam;
   int spp;
-  double rays_per_path;
-  atomic_ullong rays;
+  double p_continue; /* per hit: cast a bounce ray */
+  double p_shadow;   /* per hit: cast an occlusion ray */
+  bool to_emitters;  /* occlusion rays end on emissive triangles */
+  uint64_t sample0;  /* first sample index (the calibration runs use others) */
+  atomic_ullong rays, shadow_rays, hits, shadow_tries;
 } raw_ctx;
+
+/* An occlusion ray from p (normal n facing the arriving ray) to a point on an
+ * emissive triangle that p can see from its side and that faces p (what
+ * next-event estimation would cast); false after 4 tries without one. */
+static bool emitter_ray(const iris_lights *L, iris_vec3 p, iris_vec3 n, iris_sampler *rng,
+                        iris_ray *out) {
+  for (int k = 0; k < 4; k++) {
+    size_t i = (size_t)(iris_sampler_next(rng) * (float)L->tri_count);
+    if (i >= L->tri_count) i = L->tri_count - 1;
+    const iris_light_tri *t = &L->tris[i];
+    float b0, b1;
+    iris_sample_uniform_triangle(iris_sampler_next(rng), iris_sampler_next(rng), &b0, &b1);
+    iris_vec3 q = iris_add(iris_v3_load(t->v0), iris_add(iris_scale(iris_v3_load(t->e1), b1),
+                                                         iris_scale(iris_v3_load(t->e2), 1.0f - b0 - b1)));
+    iris_vec3 ng = iris_normalize(iris_cross(iris_v3_load(t->e1), iris_v3_load(t->e2))), d = iris_sub(q, p);
+    if (iris_dot(d, n) <= 0.0f) continue;
+    if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && iris_dot(d, ng) >= 0.0f) continue;
+    *out = iris_spawn_ray_to(p, n, q, ng);
+    return true;
+  }
+  return false;
+}
 
 static void raw_rows(void *vc, uint64_t begin, uint64_t end, int thread) {
   (void)thread;
   raw_ctx *c = (raw_ctx *)vc;
-  unsigned long long rays = 0;
-  /* rays_per_path = 1 + 2 * mean bounces: closest + occlusion per hit */
-  double p_continue = 1.0 - 2.0 / (c->rays_per_path + 1.0);
+  unsigned long long rays = 0, shadow = 0, hits = 0, tries = 0;
   for (uint64_t y = begin; y < end; y++)
     for (int x = 0; x < c->cam.width; x++)
       for (int s = 0; s < c->spp; s++) {
-        iris_sampler rng = iris_sampler_start(1, y * (uint64_t)c->cam.width + (uint64_t)x, (uint64_t)s);
+        iris_sampler rng = iris_sampler_start(1, y * (uint64_t)c->cam.width + (uint64_t)x, c->sample0 + (uint64_t)s);
         iris_ray ray = iris_pinhole_ray(&c->cam, (float)x + iris_sampler_next(&rng), (float)y + iris_sampler_next(&rng));
         for (;;) {
           iris_hit h;
           rays++;
           if (!iris_accel_intersect(c->accel, &ray, &h)) break;
+          hits++;
           iris_vec3 v[3];
           iris_accel_triangle(c->accel, h.prim, v);
           iris_vec3 n = iris_normalize(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));
           if (iris_dot(n, ray.d) > 0) n = iris_neg(n);
           iris_vec3 p = iris_add(ray.o, iris_scale(ray.d, h.t));
-          /* occlusion ray to a random point above (like NEE towards a light) */
-          iris_vec3 target = iris_add(p, iris_v3(iris_sampler_next(&rng) - 0.5f, 1.0f, iris_sampler_next(&rng) - 0.5f));
-          iris_ray sh = {iris_offset_origin(p, n, iris_sub(target, p)), 0.0f, iris_sub(target, p), 1.0f};
-          rays++;
-          (void)iris_accel_occluded(c->accel, &sh);
-          if (iris_sampler_next(&rng) >= p_continue) break;
+          if (c->to_emitters) {
+            iris_ray sh;
+            if (iris_sampler_next(&rng) < c->p_shadow && (tries++, emitter_ray(c->lights, p, n, &rng, &sh))) {
+              rays++;
+              shadow++;
+              (void)iris_accel_occluded(c->accel, &sh);
+            }
+          } else {
+            /* occlusion ray to a random point about one unit above */
+            iris_vec3 target = iris_add(p, iris_v3(iris_sampler_next(&rng) - 0.5f, 1.0f, iris_sampler_next(&rng) - 0.5f));
+            iris_ray sh = {iris_offset_origin(p, n, iris_sub(target, p)), 0.0f, iris_sub(target, p), 1.0f};
+            rays++;
+            shadow++;
+            (void)iris_accel_occluded(c->accel, &sh);
+          }
+          if (iris_sampler_next(&rng) >= c->p_continue) break;
           float u0 = iris_sampler_next(&rng), u1 = iris_sampler_next(&rng);
           float r = sqrtf(u0), phi = 6.2831853f * u1;
           iris_frame f = iris_frame_from_normal(n);
@@ -78,11 +119,22 @@ static void raw_rows(void *vc, uint64_t begin, uint64_t end, int thread) {
         }
       }
   atomic_fetch_add(&c->rays, rays);
+  atomic_fetch_add(&c->shadow_rays, shadow);
+  atomic_fetch_add(&c->hits, hits);
+  atomic_fetch_add(&c->shadow_tries, tries);
+}
+
+static void raw_run(raw_ctx *c, int threads) {
+  atomic_store(&c->rays, 0);
+  atomic_store(&c->shadow_rays, 0);
+  atomic_store(&c->hits, 0);
+  atomic_store(&c->shadow_tries, 0);
+  iris_parallel_for((uint64_t)c->cam.height, 1, threads, raw_rows, c);
 }
 
 static int cmd_raw(int argc, char **argv) {
   if (argc < 8) {
-    fprintf(stderr, "usage: bench_render raw SCENE THREADS SPP W H RAYS_PER_PATH\n");
+    fprintf(stderr, "usage: bench_render raw SCENE THREADS SPP W H RAYS_PER_PATH [SHADOW_PER_PATH]\n");
     return 2;
   }
   iris_scene *s = load(argv[2]);
@@ -90,19 +142,58 @@ static int cmd_raw(int argc, char **argv) {
   raw_ctx c;
   memset(&c, 0, sizeof c);
   c.spp = atoi(argv[4]);
-  c.rays_per_path = atof(argv[7]);
+  double rays_per_path = atof(argv[7]);
   iris_error err;
   iris_pinhole_setup(s, NULL, atoi(argv[5]), atoi(argv[6]), &c.cam, &err);
   iris_accel *a = NULL;
   if (iris_accel_build(s, &a, &err) != IRIS_OK) return 1;
   c.accel = a;
+  iris_textures tex;
+  memset(&tex, 0, sizeof tex);
+  iris_lights lights;
+  if (iris_lights_build(s, a, &tex, &lights, &err) != IRIS_OK) return 1;
+  c.lights = &lights;
   atomic_init(&c.rays, 0);
+  atomic_init(&c.shadow_rays, 0);
+  atomic_init(&c.hits, 0);
+  atomic_init(&c.shadow_tries, 0);
+  if (argc >= 9 && lights.tri_count > 0) {
+    /* Calibrate on 1-spp runs (other sample indices than the timed run) so the
+     * loop casts iris's closest-hit and occlusion rays per path: with a
+     * fraction h of closest-hit rays hitting, closest per path = 1 / (1 - p h);
+     * occlusion rays per hit = p_shadow * (fraction of tries finding a point). */
+    double shadow_target = atof(argv[8]), closest_target = rays_per_path - shadow_target;
+    c.to_emitters = true;
+    c.p_continue = closest_target > 1.0 ? 1.0 - 1.0 / closest_target : 0.0;
+    c.p_shadow = 1.0;
+    int spp = c.spp;
+    c.spp = 1;
+    for (int it = 0; it < 4; it++) {
+      c.sample0 = 1000000u + (uint64_t)it;
+      raw_run(&c, threads);
+      double paths = (double)c.cam.width * c.cam.height;
+      double closest = (double)(atomic_load(&c.rays) - atomic_load(&c.shadow_rays));
+      double hits = (double)atomic_load(&c.hits), tries = (double)atomic_load(&c.shadow_tries);
+      double h = closest > 0 ? hits / closest : 1.0;
+      double found = tries > 0 ? (double)atomic_load(&c.shadow_rays) / tries : 1.0;
+      c.p_continue = iris_clampf((float)((1.0 - 1.0 / closest_target) / (h > 0 ? h : 1.0)), 0.0f, 0.98f);
+      c.p_shadow = iris_clampf((float)(shadow_target / (hits / paths) / (found > 0 ? found : 1.0)), 0.0f, 1.0f);
+    }
+    c.spp = spp;
+    c.sample0 = 0;
+  } else {
+    /* rays_per_path = 1 + 2 * mean bounces: closest + occlusion per hit */
+    c.p_continue = 1.0 - 2.0 / (rays_per_path + 1.0);
+  }
   double t0 = iris_time_now();
-  iris_parallel_for((uint64_t)c.cam.height, 1, threads, raw_rows, &c);
+  raw_run(&c, threads);
   double dt = iris_time_now() - t0;
-  unsigned long long rays = atomic_load(&c.rays);
-  printf("{\"scene\": \"%s\", \"threads\": %d, \"seconds\": %.3f, \"rays\": %llu, \"rays_per_second\": %.0f}\n",
-         argv[2], threads, dt, rays, rays / dt);
+  unsigned long long rays = atomic_load(&c.rays), shadow = atomic_load(&c.shadow_rays);
+  double paths = (double)c.cam.width * c.cam.height * c.spp;
+  printf("{\"scene\": \"%s\", \"threads\": %d, \"seconds\": %.3f, \"rays\": %llu, \"shadow_rays\": %llu, "
+         "\"rays_per_path\": %.3f, \"shadow_per_path\": %.3f, \"to_emitters\": %s, \"rays_per_second\": %.0f}\n",
+         argv[2], threads, dt, rays, shadow, rays / paths, shadow / paths, c.to_emitters ? "true" : "false", rays / dt);
+  iris_lights_destroy(&lights);
   iris_accel_destroy(a);
   iris_scene_destroy(s);
   return 0;

@@ -1,7 +1,7 @@
 #!/bin/sh
 # Renderer benchmarks, side by side in one run (docs/performance.md, "Rendering"):
-# iris mis with 1 and 2 threads, the raw Embree loop (same scene, same ray count
-# per path), and Blender 3.4.1 Cycles on the exported scene (render time without
+# iris mis with 1 and 2 threads, the raw Embree loop (same scene, same closest-hit
+# and occlusion rays per path, occlusion rays ending on emitters; 1 and 2 threads), and Blender 3.4.1 Cycles on the exported scene (render time without
 # start-up), for cornell-box, veach-mis and the bunny in the box.
 # usage: bench/render/run.sh BUILD_DIR OUT_DIR [SPP [HEIGHT]]
 set -eu
@@ -25,8 +25,10 @@ for scene in cornell-box veach-mis "$O/bunny-box.json"; do
     "$IRIS" render "$scene" -o "$O/$name.iris.t$t.exr" --spp "$SPP" --width "$W" --height "$H" \
       --threads "$t" --json --quiet > "$O/$name.iris.t$t.json"
   done
-  rpp=$(/usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(d['rays']/d['samples'])" "$O/$name.iris.t2.json")
-  "$BENCH" raw "$scene" 2 "$SPP" "$W" "$H" "$rpp" > "$O/$name.raw.json" 2>/dev/null
+  # the raw loop casts iris's closest-hit and occlusion rays per path (calibrated)
+  set -- $(/usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(d['rays']/d['samples'], d['shadow_rays']/d['samples'])" "$O/$name.iris.t2.json")
+  "$BENCH" raw "$scene" 2 "$SPP" "$W" "$H" "$1" "$2" > "$O/$name.raw.json" 2>/dev/null
+  "$BENCH" raw "$scene" 1 "$SPP" "$W" "$H" "$1" "$2" > "$O/$name.raw.t1.json" 2>/dev/null
   if command -v blender > /dev/null; then
     "$IRIS" export "$scene" --to blender -o "$O/$name.py" --width "$W" --height "$H" --spp "$SPP" --quiet
     blender -b --factory-startup --python-exit-code 1 -P "$O/$name.py" -- --output "$O/$name.cycles.exr" \
