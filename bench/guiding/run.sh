@@ -8,14 +8,16 @@
 # neighbours). relMSE (eps = 0.01) at equal time T, preprocessing included, is
 #   relMSE_T = relMSE * render_cpu / (T - guide_cpu)
 # (variance ~ 1/samples for these unbiased estimators), T = BUDGET CPU seconds
-# (default 16: an 8-second render on 2 cores). Environment: SCENES, HEIGHT (96),
-# REF_SPP (2048), MIS_SPP (64), GUIDED_SPP (24), BUDGET (16), EXTRA (extra
-# bench_guiding options for the guided runs).
+# (default 16: an 8-second render on 2 cores). relMSE and CPU times are means
+# over SEEDS (heavy-tailed errors: one run is not enough). Environment: SCENES,
+# HEIGHT (96), REF_SPP (2048; door-shielded 8192), MIS_SPP (64), GUIDED_SPP (24),
+# BUDGET (16), SEEDS ("1 2 3"), EXTRA (extra bench_guiding options for the guided runs).
 set -eu
 BUILD=${1:?usage: run.sh BUILD_DIR [OUT_DIR]}
 OUT=${2:-bench-guiding-out}
 BIN="$BUILD/bench/guiding/bench_guiding"
-SCENES=${SCENES:-"door cornell-box veach-mis"}
+SCENES=${SCENES:-"door door-shielded cornell-box veach-mis"}
+SEEDS=${SEEDS:-"1 2 3"}
 HEIGHT=${HEIGHT:-96}
 REF_SPP=${REF_SPP:-2048}
 MIS_SPP=${MIS_SPP:-64}
@@ -28,16 +30,19 @@ RESULTS="$OUT/results.txt"
 for scene in $SCENES; do
   ref="$OUT/ref_$scene.exr"
   if [ ! -f "$ref" ]; then
-    echo "reference $scene ($REF_SPP spp)..." >&2
-    "$BIN" "$scene" mis --spp "$REF_SPP" --height "$HEIGHT" --seed 99 -o "$ref" >/dev/null
+    rs=$REF_SPP; [ "$scene" = door-shielded ] && rs=$((REF_SPP * 4))
+    echo "reference $scene ($rs spp)..." >&2
+    "$BIN" "$scene" mis --spp "$rs" --height "$HEIGHT" --seed 99 -o "$ref" >/dev/null
   fi
   for m in mis guided guided-nee; do
     spp=$GUIDED_SPP; opts=$EXTRA
     [ "$m" = mis ] && { spp=$MIS_SPP; opts=; }
-    # shellcheck disable=SC2086
-    line=$("$BIN" "$scene" "$m" --spp "$spp" --height "$HEIGHT" --threads 1 --ref "$ref" $opts 2>"$OUT/$scene-$m.log" | tail -1)
-    grep "^iris: guiding" "$OUT/$scene-$m.log" >&2 || true
-    echo "$line" | tee -a "$RESULTS" >&2
+    for seed in $SEEDS; do
+      # shellcheck disable=SC2086
+      line=$("$BIN" "$scene" "$m" --spp "$spp" --height "$HEIGHT" --threads 1 --seed "$seed" --ref "$ref" $opts 2>"$OUT/$scene-$m.log" | tail -1)
+      grep "^iris: guiding" "$OUT/$scene-$m.log" >&2 || true
+      echo "$line" | tee -a "$RESULTS" >&2
+    done
   done
 done
 /usr/bin/python3 - "$RESULTS" "$BUDGET" <<'PY'
@@ -46,7 +51,10 @@ rows = {}
 for line in open(sys.argv[1]):
     f = line.split()
     kv = dict(x.split("=", 1) for x in f[2:])
-    rows.setdefault(f[0], {})[f[1]] = {k: float(v) for k, v in kv.items()}
+    rows.setdefault(f[0], {}).setdefault(f[1], []).append({k: float(v) for k, v in kv.items()})
+# mean over seeds
+rows = {s: {m: {k: sum(r[k] for r in rs) / len(rs) for k in rs[0]} for m, rs in ms.items()}
+        for s, ms in rows.items()}
 print("| scene | method | spp run | ksamples/CPU s | preprocessing CPU s (% of T) | relMSE at equal time T | vs mis |")
 print("|---|---|---|---|---|---|---|")
 for scene, ms in rows.items():
