@@ -268,10 +268,10 @@ int iris_cmd_validate(int argc, char **argv) {
   if (!p.quiet) {
     for (int k = 0; k < res.method_count; k++) {
       const iris_validate_method *m = &res.methods[k];
-      iris_infof("validate: %s %s: energy ratio %.5f (R %.5f G %.5f B %.5f) %s, max block dev %+.2f%%, "
+      iris_infof("validate: %s %s: energy ratio %.5f (R %.5f G %.5f B %.5f, +-%.5f) %s, max block dev %+.2f%%, "
                  "block z %.2f/%.2f, pixel z %.2f/%.2f, |z|>3 %llu/%.0f allowed, z-test %s, relMSE %.4g -> %s",
                  res.scene, iris_method_name(m->method), m->energy_ratio, m->channel_ratio[0],
-                 m->channel_ratio[1], m->channel_ratio[2], m->energy_passed ? "ok" : "OFF",
+                 m->channel_ratio[1], m->channel_ratio[2], m->ratio_se[1], m->energy_passed ? "ok" : "OFF",
                  100.0 * m->blocks.signed_max_rel_dev, m->blocks.max_abs_z, m->blocks.z_crit,
                  m->pixels.max_abs_z, m->pixels.z_crit, (unsigned long long)m->pixels.over_count,
                  m->pixels.allowed_over, m->z_passed ? "ok" : "FAILED", m->relmse,

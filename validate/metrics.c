@@ -37,6 +37,15 @@ void iris_metric_channel_means(const iris_image *img, int c0, double mean[3]) {
   }
 }
 
+void iris_metric_mean_standard_error(const iris_image *img, int v0, double se[3]) {
+  size_t n = (size_t)img->width * (size_t)img->height;
+  for (int c = 0; c < 3; c++) {
+    double s = 0.0;
+    for (size_t i = 0; i < n; i++) s += finite_or_zero(px(img, i, v0 + c));
+    se[c] = n ? sqrt(s) / (double)n : 0.0;
+  }
+}
+
 double iris_metric_energy_ratio(const double test_mean[3], const double ref_mean[3]) {
   double t = test_mean[0] + test_mean[1] + test_mean[2];
   double r = ref_mean[0] + ref_mean[1] + ref_mean[2];
@@ -116,10 +125,10 @@ static bool same_size(const iris_image *a, const iris_image *b, iris_error *err)
 }
 
 /* Test variance of channel c at pixel i, raised to the reference-derived floor. */
-static inline double test_var(const iris_image *ref, iris_ref_variance rv, double var_t, size_t i,
-                              int c) {
-  if (rv.rv0 >= 0 && rv.test_floor > 0.0) {
-    double f = rv.test_floor * finite_or_zero(px(ref, i, rv.rv0 + c));
+static inline double test_var(const iris_image *ref, iris_ref_variance rv, double floor, double var_t,
+                              size_t i, int c) {
+  if (rv.rv0 >= 0 && floor > 0.0) {
+    double f = floor * finite_or_zero(px(ref, i, rv.rv0 + c));
     if (f > var_t) return f;
   }
   return var_t;
@@ -149,6 +158,13 @@ static inline bool nearly_equal(double t, double r) {
 iris_status iris_metric_blocks(const iris_image *test, int tc0, int tv0, const iris_image *ref,
                                int rc0, iris_ref_variance rv, int block, double alpha,
                                iris_block_stats *out, iris_error *err) {
+  return iris_metric_blocks_floored(test, tc0, tv0, ref, rc0, rv, 0.0, block, alpha, out, err);
+}
+
+iris_status iris_metric_blocks_floored(const iris_image *test, int tc0, int tv0,
+                                       const iris_image *ref, int rc0, iris_ref_variance rv,
+                                       double test_floor, int block, double alpha,
+                                       iris_block_stats *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   if (!same_size(test, ref, err)) return IRIS_ERR_INVALID;
   if (block < 1) block = 1;
@@ -169,7 +185,7 @@ iris_status iris_metric_blocks(const iris_image *test, int tc0, int tv0, const i
         a[c] += finite_or_zero(px(test, i, tc0 + c));
         a[3 + c] += finite_or_zero(px(ref, i, rc0 + c));
         if (tv0 >= 0) {
-          double vt = test_var(ref, rv, finite_or_zero(px(test, i, tv0 + c)), i, c);
+          double vt = test_var(ref, rv, test_floor, finite_or_zero(px(test, i, tv0 + c)), i, c);
           a[6 + c] += vt;
           a[9 + c] += ref_var(ref, rv, vt, i, c);
         }
@@ -249,6 +265,13 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
                                     const iris_image *ref, int rc0, iris_ref_variance rv,
                                     double alpha, float *z_image, iris_pixel_ztest *out,
                                     iris_error *err) {
+  return iris_metric_pixel_ztest_floored(test, tc0, tv0, ref, rc0, rv, 0.0, alpha, z_image, out, err);
+}
+
+iris_status iris_metric_pixel_ztest_floored(const iris_image *test, int tc0, int tv0,
+                                            const iris_image *ref, int rc0, iris_ref_variance rv,
+                                            double test_floor, double alpha, float *z_image,
+                                            iris_pixel_ztest *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   if (!same_size(test, ref, err)) return IRIS_ERR_INVALID;
   size_t n = (size_t)ref->width * (size_t)ref->height;
@@ -260,7 +283,7 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
   if (!vs) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
   for (size_t i = 0; i < n; i++)
     for (int c = 0; c < 3; c++) {
-      double vt = test_var(ref, rv, vs[3 * i + (size_t)c], i, c);
+      double vt = test_var(ref, rv, test_floor, vs[3 * i + (size_t)c], i, c);
       if (vt + ref_var(ref, rv, vt, i, c) > 0.0) out->tests++;
     }
   out->z_crit = iris_metric_normal_two_sided_z(alpha / (double)(out->tests ? out->tests : 1));
@@ -268,7 +291,7 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
     float zmax = 0.0f;
     for (int c = 0; c < 3; c++) {
       double t = px(test, i, tc0 + c), r = px(ref, i, rc0 + c);
-      double vt = test_var(ref, rv, vs[3 * i + (size_t)c], i, c);
+      double vt = test_var(ref, rv, test_floor, vs[3 * i + (size_t)c], i, c);
       double v = vt + ref_var(ref, rv, vt, i, c);
       double z;
       if (v > 0.0) {

@@ -36,6 +36,10 @@ void iris_metric_count_nonfinite(const iris_image *img, int c0, int channels, ui
  * as 0 so that the mean stays finite; count them separately). */
 void iris_metric_channel_means(const iris_image *img, int c0, double mean[3]);
 
+/* Standard error of each channel's image mean from per-pixel variances of
+ * the mean (pixels independent): sqrt(sum_i var_i) / n. */
+void iris_metric_mean_standard_error(const iris_image *img, int v0, double se[3]);
+
 /* Ratio of the summed channel means: (mt_R + mt_G + mt_B) / (mr_R + mr_G + mr_B);
  * 1 when both are 0, +Inf when only the reference is 0. */
 double iris_metric_energy_ratio(const double test_mean[3], const double ref_mean[3]);
@@ -59,12 +63,14 @@ typedef struct iris_ref_variance {
   int rv0;      /* variance channels of the reference image, or -1 */
   double scale; /* when rv0 < 0: var_ref = scale * var_test (e.g. test_spp / ref_spp,
                    assuming the same per-sample variance); 0: the reference is exact */
-  double test_floor; /* when rv0 >= 0 and > 0: var_test is raised to at least
-                        test_floor * var_ref (ref_spp / test_spp): at low spp a test
-                        pixel that missed a rare bright path (an emitter edge covering
-                        1% of it) estimates its variance as 0, which the reference's
-                        per-sample variance, estimated from many more samples, corrects */
 } iris_ref_variance;
+
+/* Optional floor for the test's variance in the z-tests (the _floored
+ * variants): when rv.rv0 >= 0 and test_floor > 0, var_test is raised to at
+ * least test_floor * var_ref, with test_floor = ref_spp / test_spp. At low spp
+ * a test pixel that missed a rare bright path (an emitter edge covering 1% of
+ * it) estimates its variance as 0; the reference's per-sample variance,
+ * estimated from many more samples, corrects that. 0: no floor. */
 
 /* Energy (sum of R+G+B) per block x block tile (edge tiles may be smaller),
  * the relative deviation (E_t - E_r) / E_r of tiles brighter than
@@ -93,6 +99,10 @@ typedef struct iris_block_stats {
 iris_status iris_metric_blocks(const iris_image *test, int tc0, int tv0, const iris_image *ref,
                                int rc0, iris_ref_variance rv, int block, double alpha,
                                iris_block_stats *out, iris_error *err);
+iris_status iris_metric_blocks_floored(const iris_image *test, int tc0, int tv0,
+                                       const iris_image *ref, int rc0, iris_ref_variance rv,
+                                       double test_floor, int block, double alpha,
+                                       iris_block_stats *out, iris_error *err);
 
 /* Per-pixel, per-channel z = (t - r) / sqrt(var_t + var_r), with var_t the
  * test variance averaged over the pixel's 3x3 neighbourhood (see metrics.c,
@@ -132,6 +142,10 @@ iris_status iris_metric_pixel_ztest(const iris_image *test, int tc0, int tv0,
                                     const iris_image *ref, int rc0, iris_ref_variance rv,
                                     double alpha, float *z_image, iris_pixel_ztest *out,
                                     iris_error *err);
+iris_status iris_metric_pixel_ztest_floored(const iris_image *test, int tc0, int tv0,
+                                            const iris_image *ref, int rc0, iris_ref_variance rv,
+                                            double test_floor, double alpha, float *z_image,
+                                            iris_pixel_ztest *out, iris_error *err);
 
 #ifdef __cplusplus
 }

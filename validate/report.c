@@ -98,6 +98,7 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddStringToObject(r, "source", params->source == IRIS_REFERENCE_BLENDER ? "blender" : "file");
   cJSON_AddNumberToObject(r, "spp", res->reference.spp);
   cJSON_AddItemToObject(r, "mean", triple(res->reference.mean));
+  cJSON_AddItemToObject(r, "mean_standard_error", triple(res->reference.mean_se));
   cJSON_AddNumberToObject(r, "nan_count", (double)res->reference.nan_count);
   cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
   cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
@@ -110,7 +111,9 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
     cJSON_AddNumberToObject(j, "spp", m->spp);
     add_num(j, "seconds", m->seconds);
     cJSON_AddItemToObject(j, "mean", triple(m->mean));
+    cJSON_AddItemToObject(j, "mean_standard_error", triple(m->mean_se));
     cJSON_AddItemToObject(j, "channel_ratio", triple(m->channel_ratio));
+    cJSON_AddItemToObject(j, "channel_ratio_standard_error", triple(m->ratio_se));
     add_num(j, "energy_ratio", m->energy_ratio);
     cJSON_AddNumberToObject(j, "nan_count", (double)m->nan_count);
     cJSON_AddNumberToObject(j, "inf_count", (double)m->inf_count);
@@ -242,11 +245,11 @@ iris_status iris_report_write_html(const char *dir, const iris_validate_params *
               "<th>z-test</th><th>result</th></tr>\n");
   for (int k = 0; k < res->method_count; k++) {
     const iris_validate_method *m = &res->methods[k];
-    fprintf(fp, "<tr><td class=l>%s</td><td>%d</td><td>%.2f</td><td>%.5f</td><td>%.5f</td><td>%.5f</td>"
+    fprintf(fp, "<tr><td class=l>%s</td><td>%d</td><td>%.2f</td><td>%.5f&plusmn;%.5f</td><td>%.5f&plusmn;%.5f</td><td>%.5f&plusmn;%.5f</td>"
                 "<td>%.5f</td><td>%s</td><td>%.4g</td><td>%.4g</td><td>%+.2f%%</td><td>%.2f / %.2f</td>"
                 "<td>%.2f / %.2f</td><td>%llu / %.0f</td><td>%llu</td><td>%s</td><td>%s</td></tr>\n",
-            iris_method_name(m->method), m->spp, m->seconds, m->channel_ratio[0], m->channel_ratio[1],
-            m->channel_ratio[2], m->energy_ratio, verdict(m->energy_passed), m->relmse, m->mape,
+            iris_method_name(m->method), m->spp, m->seconds, m->channel_ratio[0], m->ratio_se[0],
+            m->channel_ratio[1], m->ratio_se[1], m->channel_ratio[2], m->ratio_se[2], m->energy_ratio, verdict(m->energy_passed), m->relmse, m->mape,
             100.0 * m->blocks.signed_max_rel_dev, m->blocks.max_abs_z, m->blocks.z_crit,
             m->pixels.max_abs_z, m->pixels.z_crit, (unsigned long long)m->pixels.over_count,
             m->pixels.allowed_over, (unsigned long long)(m->nan_count + m->inf_count),

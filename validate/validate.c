@@ -19,7 +19,6 @@
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
-#include "scenes/door.h"
 #include "validate/blender_run.h"
 #include "validate/report.h"
 
@@ -70,26 +69,8 @@ iris_status iris_validate_load_scene(const char *input, const char *camera_name,
     return iris_import_file(input, &opts, out, err);
   }
   if (iris_builtin_exists(input)) return iris_builtin_create(input, out, err);
-  if (strcmp(input, "door") == 0) {
-    iris_scene *s = iris_scene_create();
-    if (!s) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
-    iris_status st = iris_door_scene_build(s);
-    if (st == IRIS_OK) {
-      s->source_path = iris_strdup("builtin:door");
-      st = iris_scene_validate(s, "builtin:door", err);
-    } else {
-      iris_error_set(err, st, NULL, 0, NULL, "cannot build the built-in scene 'door'");
-    }
-    if (st != IRIS_OK) {
-      iris_scene_destroy(s);
-      return st;
-    }
-    *out = s;
-    return IRIS_OK;
-  }
   return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
-                        "'%s' is neither a file nor a built-in scene (cornell-box, veach-mis, door, "
-                        "furnace-diffuse, furnace-glossy, inside-sphere)", input);
+                        "'%s' is neither a file nor a built-in scene (cornell-box, veach-mis, door, ...)", input);
 }
 
 /* ---- reference images ---------------------------------------------------- */
@@ -197,6 +178,7 @@ static iris_status load_reference(const char *path, iris_image *ref, iris_valida
                           (unsigned long long)info->nan_count, (unsigned long long)info->inf_count);
   }
   iris_metric_channel_means(ref, 0, info->mean);
+  if (info->has_variance) iris_metric_mean_standard_error(ref, 3, info->mean_se);
   return IRIS_OK;
 }
 
@@ -338,6 +320,7 @@ static iris_status run_blender_reference(const iris_scene *scene, const iris_val
   info->seconds = run.render_seconds;
   iris_metric_count_nonfinite(ref, 0, ref->channel_count, &info->nan_count, &info->inf_count);
   iris_metric_channel_means(ref, 0, info->mean);
+  if (info->has_variance) iris_metric_mean_standard_error(ref, 3, info->mean_se);
   snprintf(info->description, sizeof info->description,
            "Cycles %s, %d spp in %d batches (rendered here)",
            run.first.version[0] ? run.first.version : "?", run.spp, run.batches);
@@ -347,13 +330,13 @@ static iris_status run_blender_reference(const iris_scene *scene, const iris_val
 /* ---- rendering and comparing ------------------------------------------- */
 
 static void describe_ref_variance(const iris_validate_reference *ref, int spp, iris_ref_variance *rv,
-                                  char *buf, size_t size) {
-  rv->test_floor = 0.0;
+                                  double *test_floor, char *buf, size_t size) {
+  *test_floor = 0.0;
   if (ref->has_variance) {
     rv->rv0 = 3;
     rv->scale = 0.0;
     if (ref->spp > 0) {
-      rv->test_floor = (double)ref->spp / (double)spp;
+      *test_floor = (double)ref->spp / (double)spp;
       snprintf(buf, size, "the reference's own var.R/G/B channels; iris's variance at least "
                           "theirs x %d/%d spp", ref->spp, spp);
     } else {
@@ -376,10 +359,15 @@ static iris_status compare_method(const iris_image *img, const iris_image *ref,
                                   const iris_validate_params *p, const iris_validate_reference *rinfo,
                                   iris_validate_method *m, float *zimg, iris_error *err) {
   iris_metric_channel_means(img, 0, m->mean);
+  iris_metric_mean_standard_error(img, 3, m->mean_se);
   double ref_sum = rinfo->mean[0] + rinfo->mean[1] + rinfo->mean[2];
   m->energy_passed = true;
   for (int c = 0; c < 3; c++) {
     m->channel_ratio[c] = rinfo->mean[c] > 0 ? m->mean[c] / rinfo->mean[c] : (m->mean[c] > 0 ? INFINITY : 1.0);
+    /* first-order error propagation of a ratio of independent means */
+    double rt = m->mean[c] > 0 ? m->mean_se[c] / m->mean[c] : 0.0;
+    double rr = rinfo->mean[c] > 0 ? rinfo->mean_se[c] / rinfo->mean[c] : 0.0;
+    m->ratio_se[c] = isfinite(m->channel_ratio[c]) ? m->channel_ratio[c] * sqrt(rt * rt + rr * rr) : 0.0;
     /* A channel carrying under 0.1% of the energy cannot be held to a relative tolerance. */
     if (rinfo->mean[c] > 1e-3 * ref_sum && !(fabs(m->channel_ratio[c] - 1.0) <= p->tolerance))
       m->energy_passed = false;
@@ -390,9 +378,12 @@ static iris_status compare_method(const iris_image *img, const iris_image *ref,
   m->relmse = iris_metric_relmse(img, 0, ref, 0, IRIS_METRIC_EPS, IRIS_METRIC_DROP);
   m->mape = iris_metric_mape(img, 0, ref, 0, IRIS_METRIC_EPS, IRIS_METRIC_DROP);
   iris_ref_variance rv;
-  describe_ref_variance(rinfo, m->spp, &rv, m->ref_variance, sizeof m->ref_variance);
-  iris_status st = iris_metric_blocks(img, 0, 3, ref, 0, rv, IRIS_METRIC_BLOCK, p->alpha, &m->blocks, err);
-  if (st == IRIS_OK) st = iris_metric_pixel_ztest(img, 0, 3, ref, 0, rv, p->alpha, zimg, &m->pixels, err);
+  double floor;
+  describe_ref_variance(rinfo, m->spp, &rv, &floor, m->ref_variance, sizeof m->ref_variance);
+  iris_status st = iris_metric_blocks_floored(img, 0, 3, ref, 0, rv, floor, IRIS_METRIC_BLOCK, p->alpha,
+                                              &m->blocks, err);
+  if (st == IRIS_OK)
+    st = iris_metric_pixel_ztest_floored(img, 0, 3, ref, 0, rv, floor, p->alpha, zimg, &m->pixels, err);
   if (st != IRIS_OK) return st;
   m->z_passed = m->blocks.passed && (!p->pixel_test_gates || m->pixels.passed);
   m->passed = m->energy_passed && m->z_passed && m->nan_count == 0 && m->inf_count == 0;

@@ -31,8 +31,7 @@ extern "C" {
 /* Scenes with stored references, NULL-terminated: cornell-box, veach-mis, door. */
 const char *const *iris_validate_reference_scenes(void);
 
-/* Loads INPUT: an existing file (iris scene or importable), a built-in scene
- * name, or "door" (the guiding benchmark scene, scenes/door.h). */
+/* Loads INPUT: an existing file (iris scene or importable) or a built-in scene name. */
 iris_status iris_validate_load_scene(const char *input, const char *camera_name, iris_scene **out,
                                      iris_error *err);
 
@@ -73,6 +72,7 @@ typedef struct iris_validate_reference {
   int spp;                  /* 0: unknown */
   int width, height;
   double mean[3];
+  double mean_se[3];        /* standard error of mean[] (0 without variance channels) */
   uint64_t nan_count, inf_count;
   bool has_variance;        /* var.R/G/B channels */
   double seconds;           /* Blender render time when run here, else from provenance */
@@ -83,7 +83,9 @@ typedef struct iris_validate_method {
   int spp;
   double seconds;
   double mean[3];
+  double mean_se[3];        /* standard error of iris's mean per channel */
   double channel_ratio[3];  /* iris / reference per channel */
+  double ratio_se[3];       /* standard error of channel_ratio from both images' noise */
   double energy_ratio;      /* summed channels */
   uint64_t nan_count, inf_count;
   uint64_t dropped_samples; /* non-finite samples the renderer dropped */
