@@ -90,6 +90,31 @@ double iris_stress_energy_zcrit(double alpha) {
   return iris_metric_normal_two_sided_z(alpha / 3.0);
 }
 
+/* The sign of each failing region-channel of the gate (the z of
+ * iris_metric_blocks, which reports only |z|). */
+static void count_region_signs(const iris_image *test, const iris_image *ref, bool ref_exact,
+                               int block, double z_crit, iris_stress_compare *out) {
+  const int w = test->width, h = test->height;
+  for (int y0 = 0; y0 < h; y0 += block)
+    for (int x0 = 0; x0 < w; x0 += block)
+      for (int c = 0; c < 3; c++) {
+        double d = 0.0, v = 0.0;
+        for (int y = y0; y < y0 + block && y < h; y++)
+          for (int x = x0; x < x0 + block && x < w; x++) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            const float *t = test->data + i * (size_t)test->channel_count;
+            const float *r = ref->data + i * (size_t)ref->channel_count;
+            if (!isfinite(t[c]) || !isfinite(t[3 + c])) continue;
+            d += (double)t[c] - r[c];
+            v += t[3 + c] + (ref_exact ? 0.0 : r[3 + c]);
+          }
+        if (v <= 0.0) continue;
+        double z = d / sqrt(v);
+        if (z > z_crit) out->regions_high++;
+        if (z < -z_crit) out->regions_low++;
+      }
+}
+
 iris_status iris_stress_compare_images(const iris_image *test, const iris_image *ref,
                                        bool ref_exact, double alpha, int region,
                                        iris_stress_compare *out, iris_error *err) {
@@ -143,6 +168,7 @@ iris_status iris_stress_compare_images(const iris_image *test, const iris_image 
   if (s == IRIS_OK)
     s = iris_metric_blocks(test, 0, 3, ref, 0, rv, region > 0 ? region : IRIS_STRESS_REGION, alpha,
                            &out->regions, err);
+  if (s == IRIS_OK) count_region_signs(test, ref, ref_exact, out->regions.block, out->regions.z_crit, out);
   if (s == IRIS_OK) s = iris_metric_pixel_ztest(test, 0, 3, ref, 0, rv, alpha, NULL, &out->pixels, err);
   return s;
 }

@@ -65,6 +65,11 @@ typedef struct iris_stress_compare {
   iris_block_stats blocks;   /* 8x8 tiles (IRIS_METRIC_BLOCK): reported */
   iris_block_stats regions;  /* region x region tiles: the unbiasedness gate with the energy test */
   iris_pixel_ztest pixels;   /* per pixel: reported */
+  /* Region-channels beyond the regions' critical |z|, by sign: a render that
+   * misses rare large samples is too DARK where it fails (low), while a single
+   * rare sample that was drawn brings its own variance and rarely makes |z|
+   * large; a bias can go either way. */
+  int regions_low, regions_high;
   bool black_exact;       /* every value exactly 0 (meaningful for black references) */
 } iris_stress_compare;
 
