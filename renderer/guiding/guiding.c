@@ -416,7 +416,10 @@ int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t 
   if (g->cache_count == 0) return 0;
   uint32_t near[IRIS_GUIDING_PICK_K];
   float d2[IRIS_GUIDING_PICK_K], cosv[IRIS_GUIDING_PICK_K];
-  uint32_t m = iris_pick_grid_knn(&g->grid, &g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
+  /* The grid answers for p's cell centre (O(1)); without a grid (a handful of
+   * caches) the kd-tree answers for p itself. */
+  uint32_t m = g->grid.n[0] ? iris_pick_grid_query(&g->grid, p, near)
+                            : iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
   float best = -2.0f;
   for (uint32_t i = 0; i < m; ++i) {
     cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);

@@ -100,7 +100,7 @@ void iris_guiding_destroy(iris_guiding *g);
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g);
 
 /* Algorithm 1 without the coin flips: the caches among the 5 nearest to p
- * whose normal has the best cosine with n (ties within 1e-4), none if that
+ * (to the centre of p's pick-grid cell when there is a grid) whose normal has the best cosine with n (ties within 1e-4), none if that
  * cosine is <= cos_min. The guided strategy samples one of them uniformly
  * (with the path's sampler) and its density is their average, so `pdf`
  * evaluates exactly what `sample` does. Returns how many (<= 5). */
