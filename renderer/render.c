@@ -50,7 +50,10 @@ typedef struct pass_ctx {
 
 static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
   pass_ctx *c = (pass_ctx *)vctx;
-  iris_path_stats *st = &c->stats[thread];
+  /* Count on the stack and add once per chunk: the per-thread records sit
+   * side by side, and updating them per ray would share a cache line. */
+  iris_path_stats local = {0};
+  iris_path_stats *st = &local;
   for (uint64_t t = begin; t < end; t++) {
     int tx = c->x0 + (int)(t % (uint64_t)c->tiles_x) * TILE;
     int ty = c->y0 + (int)(t / (uint64_t)c->tiles_x) * TILE;
@@ -67,6 +70,11 @@ static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
         }
       }
   }
+  iris_path_stats *total = &c->stats[thread];
+  total->paths += local.paths;
+  total->rays += local.rays;
+  total->shadow_rays += local.shadow_rays;
+  total->nan_count += local.nan_count;
 }
 
 iris_status iris_render(const iris_scene *scene, const iris_render_params *params_in,
