@@ -2,6 +2,7 @@
 #include "renderer/guiding/cache.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 /* Texel (i, j) possibly outside the grid -> the texel that is its neighbour
  * on the sphere (sphere maps wrap and mirror at the seams, hemisphere maps
@@ -45,8 +46,8 @@ bool iris_cache_splat(const iris_octmap *map, float *hist, iris_vec3 wi, float e
 }
 
 bool iris_cache_build_tables(const iris_octmap *map, const float *hist, float floor, float *pdf,
-                             float *cdf) {
-  uint32_t n = map->texel_count;
+                             iris_cache_alias *alias) {
+  const uint32_t n = map->texel_count;
   double sum = 0.0;
   for (uint32_t i = 0; i < n; ++i) sum += hist[i] > 0.0f ? hist[i] : 0.0f;
   if (!(sum > 0.0) || !isfinite(sum)) return false;
@@ -56,52 +57,96 @@ bool iris_cache_build_tables(const iris_octmap *map, const float *hist, float fl
     double p = (hist[i] > 0.0f ? hist[i] : 0.0f) / sum;
     sum2 += p < floor ? floor : p;
   }
-  double acc = 0.0;
+  /* Vose's alias method in double, in place: scaled[i] = n P[i]; texels below 1
+   * ("small") are topped up by one above 1 ("large"). Worklists are index
+   * chains through alias[].alias, so no scratch memory is needed. */
+  double scaled_buf[512];
+  double *scaled = n <= 512 ? scaled_buf : malloc(sizeof(double) * n);
+  if (!scaled) return false;
+  const uint32_t NONE = UINT32_MAX;
+  uint32_t small = NONE, large = NONE;
   for (uint32_t i = 0; i < n; ++i) {
     double p = (hist[i] > 0.0f ? hist[i] : 0.0f) / sum;
-    acc += (p < floor ? floor : p) / sum2;
-    cdf[i] = (float)acc;
+    scaled[i] = (p < floor ? floor : p) / sum2 * (double)n;
   }
-  cdf[n - 1] = 1.0f;
-  /* pdf(w) = P[texel] * res^2 / (2 |w|_1^3): uniform in the texel's (a, b)
-   * square of area 4 / res^2, times d(a,b)/d(omega) = 2 / |w|_1^3. */
-  const float scale = 0.5f * (float)map->res * (float)map->res;
+  for (uint32_t i = n; i-- > 0;) { /* push in reverse: lists pop in index order */
+    if (scaled[i] < 1.0) {
+      alias[i].alias = small;
+      small = i;
+    } else {
+      alias[i].alias = large;
+      large = i;
+    }
+  }
+  while (small != NONE && large != NONE) {
+    uint32_t s = small, l = large;
+    small = alias[s].alias;
+    alias[s].q = (float)scaled[s];
+    alias[s].alias = l;
+    scaled[l] -= 1.0 - scaled[s];
+    if (scaled[l] < 1.0) { /* l becomes small */
+      large = alias[l].alias;
+      alias[l].alias = small;
+      small = l;
+    }
+  }
+  /* Leftovers are 1 up to rounding: keep themselves. */
+  while (large != NONE) {
+    uint32_t l = large;
+    large = alias[l].alias;
+    alias[l].q = 1.0f;
+    alias[l].alias = l;
+  }
+  while (small != NONE) {
+    uint32_t s = small;
+    small = alias[s].alias;
+    alias[s].q = 1.0f;
+    alias[s].alias = s;
+  }
+  /* The probabilities the float table actually samples, P[i] = (q_i + sum over
+   * columns aliased to i of (1 - q_j)) / n; pdf(w) = P[texel] * res^2 /
+   * (2 |w|_1^3): uniform in the texel's (a, b) square of area 4 / res^2, times
+   * d(a,b)/d(omega) = 2 / |w|_1^3. */
+  for (uint32_t i = 0; i < n; ++i) scaled[i] = 0.0;
   for (uint32_t i = 0; i < n; ++i) {
-    float p = cdf[i] - (i ? cdf[i - 1] : 0.0f);
-    pdf[i] = p * scale;
+    double q = alias[i].q;
+    scaled[i] += q;
+    scaled[alias[i].alias] += 1.0 - q;
   }
+  const double scale = 0.5 * (double)map->res * (double)map->res / (double)n;
+  for (uint32_t i = 0; i < n; ++i) pdf[i] = (float)(scaled[i] * scale);
+  if (scaled != scaled_buf) free(scaled);
   return true;
 }
 
-iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const float *cdf, float u0,
-                            float u1, float u2, float *pdf_out) {
-  /* First texel whose cdf exceeds u0. */
-  uint32_t lo = 0, hi = map->texel_count - 1;
-  while (lo < hi) {
-    uint32_t mid = lo + (hi - lo) / 2;
-    if (cdf[mid] > u0) hi = mid;
-    else lo = mid + 1;
-  }
-  (void)u0;
+iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const iris_cache_alias *alias,
+                            float u0, float u1, float u2, float *pdf_out) {
+  /* Alias table: column floor(u0 n), kept when the fraction is below q. */
+  const uint32_t n = map->texel_count;
+  float x = u0 * (float)n;
+  uint32_t col = (uint32_t)x;
+  if (col >= n) col = n - 1;
+  const iris_cache_alias e = alias[col];
+  const uint32_t texel = x - (float)col < e.q ? col : e.alias;
   /* Uniform point of the texel in map coordinates (no trigonometry). The
    * octahedron point q (|q|_1 = 1) normalised is w = q / |q|_2, so
    * 1 / |w|_1^3 = |q|_2^3. */
-  uint32_t i = lo % (uint32_t)map->width, j = lo / (uint32_t)map->width;
+  uint32_t i = texel % (uint32_t)map->width, j = texel / (uint32_t)map->width;
   float u = (float)i + u1, v = (float)j + u2;
-  float a, sign = 1.0f, n = (float)map->res;
+  float a, sign = 1.0f, r = (float)map->res;
   if (i < (uint32_t)map->res) {
-    a = 2.0f * u / n - 1.0f;
+    a = 2.0f * u / r - 1.0f;
   } else {
-    a = 1.0f - 2.0f * (u - n) / n;
+    a = 1.0f - 2.0f * (u - r) / r;
     sign = -1.0f;
   }
-  float b = 2.0f * v / n - 1.0f;
-  float x = 0.5f * (a + b), y = 0.5f * (b - a);
-  float z = sign * fmaxf(0.0f, 1.0f - fabsf(x) - fabsf(y));
-  float l2 = sqrtf(x * x + y * y + z * z);
+  float b = 2.0f * v / r - 1.0f;
+  float px = 0.5f * (a + b), py = 0.5f * (b - a);
+  float pz = sign * fmaxf(0.0f, 1.0f - fabsf(px) - fabsf(py));
+  float l2 = sqrtf(px * px + py * py + pz * pz);
   float inv = 1.0f / l2;
-  *pdf_out = pdf[lo] * l2 * l2 * l2;
-  return iris_v3(x * inv, y * inv, z * inv);
+  *pdf_out = pdf[texel] * l2 * l2 * l2;
+  return iris_v3(px * inv, py * inv, pz * inv);
 }
 
 float iris_cache_density_factor(iris_vec3 w) {
@@ -112,6 +157,8 @@ float iris_cache_density_factor(iris_vec3 w) {
 }
 
 float iris_cache_pdf(const iris_octmap *map, const float *pdf, iris_vec3 w) {
-  int32_t t = iris_octmap_dir_to_texel(map, w);
-  return t < 0 ? 0.0f : pdf[t] * iris_cache_density_factor(w);
+  float l2 = sqrtf(w.x * w.x + w.y * w.y + w.z * w.z), factor;
+  if (!(l2 > 0.0f)) return 0.0f;
+  int32_t t = iris_cache_texel(map->res, map->sphere, iris_scale(w, 1.0f / l2), &factor);
+  return t < 0 ? 0.0f : pdf[t] * factor;
 }

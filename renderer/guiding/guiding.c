@@ -141,7 +141,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
                                              3.14159265358979 * (double)d2[n - 1]))
                           : 0.0f;
     if (!used || !iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + cache->table,
-                                          g->cdf + cache->table))
+                                          g->alias + cache->table))
       cache->photons = 0;
   }
 }
@@ -283,10 +283,10 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     floats += g->caches[i].sphere ? g->sphere.texel_count : g->hemi.texel_count;
   }
   g->pdf = malloc(sizeof(float) * (floats ? floats : 1));
-  g->cdf = malloc(sizeof(float) * (floats ? floats : 1));
+  g->alias = malloc(sizeof(iris_cache_alias) * (floats ? floats : 1));
   iris_kdtree ptree;
   memset(&ptree, 0, sizeof ptree);
-  if (!g->pdf || !g->cdf || floats > UINT32_MAX)
+  if (!g->pdf || !g->alias || floats > UINT32_MAX)
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
   /* With light sampling the direct light needs no guide: photons straight
    * from a light leave the photon tree, so every cache's k photons describe
@@ -348,7 +348,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (st == IRIS_OK)
         st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing,
                                   s->threads, err);
-      g->stats.memory_bytes = sizeof(iris_cache) * kept + 2 * sizeof(float) * floats +
+      g->stats.memory_bytes = sizeof(iris_cache) * kept + (sizeof(float) + sizeof(iris_cache_alias)) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
                               sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +
                               g->grid.memory_bytes;
@@ -406,7 +406,7 @@ void iris_guiding_destroy(iris_guiding *g) {
   iris_pick_grid_destroy(&g->grid);
   free(g->caches);
   free(g->pdf);
-  free(g->cdf);
+  free(g->alias);
   free(g);
 }
 
@@ -473,6 +473,16 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
     for (int i = 0; i < v->m; ++i) r += g->caches[v->ids[i]].radiance;
     v->radiance = r / (float)v->m;
   }
+  /* The tables of the tied caches are needed after this vertex's shadow ray
+   * (the light sample's mixture pdf, then sampling): start loading them now so
+   * the ray hides the memory latency. */
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *ci = &g->caches[v->ids[i]];
+    const size_t texels = ci->sphere ? g->sphere.texel_count : g->hemi.texel_count;
+    const char *pdf = (const char *)(g->pdf + ci->table), *alias = (const char *)(g->alias + ci->table);
+    for (size_t b = 0; b < texels * sizeof(float); b += 64) __builtin_prefetch(pdf + b);
+    for (size_t b = 0; b < texels * sizeof(iris_cache_alias); b += 64) __builtin_prefetch(alias + b);
+  }
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
     v->same_as[i] = (uint8_t)i;
@@ -494,10 +504,7 @@ static float vertex_cache_pdf(const iris_guiding *g, const guide_vertex *v, iris
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *c = &g->caches[v->ids[i]];
     if (v->same_as[i] == i) {
-      const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
-      iris_vec3 wl = iris_frame_to_local(&c->frame, wi);
-      texel[i] = iris_octmap_dir_to_texel(map, wl);
-      jac[i] = iris_cache_density_factor(wl);
+      texel[i] = iris_cache_texel(g->hemi.res, c->sphere, iris_frame_to_local(&c->frame, wi), &jac[i]);
     } else {
       texel[i] = texel[v->same_as[i]];
       jac[i] = jac[v->same_as[i]];
@@ -532,7 +539,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   const iris_cache *c = &g->caches[v->ids[j < m ? j : m - 1]];
   const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
   float pdf_one;
-  iris_vec3 wl = iris_cache_sample(map, g->pdf + c->table, g->cdf + c->table, u0, u1, u2, &pdf_one);
+  iris_vec3 wl = iris_cache_sample(map, g->pdf + c->table, g->alias + c->table, u0, u1, u2, &pdf_one);
   iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
   iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
   out->wi = wi;

@@ -61,7 +61,7 @@ iris_guiding_params iris_guiding_params_default(void);
 typedef struct iris_cache {
   iris_vec3 p;
   iris_frame frame;
-  uint32_t table;    /* first float of this cache's pdf/cdf in iris_guiding.pdf/.cdf */
+  uint32_t table;    /* first texel of this cache's tables in iris_guiding.pdf/.alias */
   uint32_t photons;  /* photons splatted */
   float radiance;    /* irradiance / pi from its k photons (mean of RGB, W m^-2 sr^-1): the
                         radiance a diffuse white surface here reflects (Russian roulette) */
@@ -85,7 +85,8 @@ typedef struct iris_guiding {
   iris_octmap hemi, sphere;
   iris_cache *caches;
   size_t cache_count;
-  float *pdf, *cdf;    /* all tables, pdf over solid angle and CDF per texel */
+  float *pdf;              /* all tables: P * res^2 / 2 per texel (density / iris_cache_density_factor) */
+  iris_cache_alias *alias; /* all alias tables (texel choice in O(1)) */
   iris_kdtree tree;    /* over caches[i].p */
   float pick_radius2;  /* Algorithm 1 ignores caches farther than this (squared) */
   iris_pick_grid grid; /* candidate caches per cell: Algorithm 1's search without the tree */

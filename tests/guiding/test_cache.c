@@ -47,10 +47,10 @@ static void fill(const iris_octmap *m, float *hist, int pattern, iris_splat_mode
 static void test_tables(int res, bool sphere, int pattern, iris_splat_mode mode, float floor) {
   iris_octmap m;
   iris_octmap_create(&m, res, sphere, NULL);
-  float *hist = calloc(m.texel_count, sizeof(float)), *pdf = calloc(m.texel_count, sizeof(float)),
-        *cdf = calloc(m.texel_count, sizeof(float));
+  float *hist = calloc(m.texel_count, sizeof(float)), *pdf = calloc(m.texel_count, sizeof(float));
+  iris_cache_alias *alias = calloc(m.texel_count, sizeof(iris_cache_alias));
   fill(&m, hist, pattern, mode);
-  bool ok = iris_cache_build_tables(&m, hist, floor, pdf, cdf);
+  bool ok = iris_cache_build_tables(&m, hist, floor, pdf, alias);
   if (pattern == 3 && !sphere) {
     EXPECT(!ok, "photons from below filled a hemisphere cache");
     goto done;
@@ -82,7 +82,30 @@ static void test_tables(int res, bool sphere, int pattern, iris_splat_mode mode,
   }
   /* floor: every texel keeps at least floor / (1 + n floor) probability */
   EXPECT(pmin >= floor / (1.0 + m.texel_count * floor) * 0.999, "floor violated: %g", pmin);
-  EXPECT(cdf[m.texel_count - 1] == 1.0f, "cdf end");
+  /* The alias table samples exactly the table's probabilities: P_i = (q_i +
+   * sum of (1 - q_j) over columns j aliased to i) / n, recomputed here, and
+   * the table is proportional to the floored histogram. */
+  {
+    double *pa = calloc(m.texel_count, sizeof(double)), hsum = 0.0, fsum = 0.0, worst = 0.0;
+    bool valid = true;
+    for (uint32_t t = 0; t < m.texel_count; ++t) {
+      valid = valid && alias[t].q >= 0.0f && alias[t].q <= 1.0f && alias[t].alias < m.texel_count;
+      if (!valid) break;
+      pa[t] += alias[t].q;
+      pa[alias[t].alias] += 1.0 - alias[t].q;
+      hsum += hist[t] > 0.0f ? hist[t] : 0.0f;
+    }
+    EXPECT(valid, "alias table entries out of range");
+    for (uint32_t t = 0; valid && t < m.texel_count; ++t) fsum += fmax((hist[t] > 0.0f ? hist[t] : 0.0f) / hsum, floor);
+    for (uint32_t t = 0; valid && t < m.texel_count; ++t) {
+      double p_alias = pa[t] / m.texel_count, p_table = pdf[t] * 2.0 / ((double)res * res);
+      double p_hist = fmax((hist[t] > 0.0f ? hist[t] : 0.0f) / hsum, floor) / fsum;
+      worst = fmax(worst, fabs(p_alias - p_table) / p_table);
+      EXPECT(fabs(p_hist - p_table) <= 1e-5 * p_table + 1e-7, "texel %u: P %g, floored histogram %g", t, p_table, p_hist);
+    }
+    EXPECT(worst < 1e-5, "alias table and pdf table disagree by %g", worst);
+    free(pa);
+  }
   /* Unbiasedness with importance sampling: E[g/pdf] = integral of g.
    * g = max(z,0): integral pi; g = 1: 2 pi or 4 pi. */
   double acc_cos = 0.0, acc_one = 0.0, acc_cos2 = 0.0;
@@ -91,7 +114,7 @@ static void test_tables(int res, bool sphere, int pattern, iris_splat_mode mode,
   for (int i = 0; i < n; ++i) {
     iris_sampler s = iris_sampler_start(5, (uint64_t)i, (uint64_t)pattern);
     float u0 = iris_sampler_next(&s), u1 = iris_sampler_next(&s), u2 = iris_sampler_next(&s), p;
-    iris_vec3 d = iris_cache_sample(&m, pdf, cdf, u0, u1, u2, &p);
+    iris_vec3 d = iris_cache_sample(&m, pdf, alias, u0, u1, u2, &p);
     float q = iris_cache_pdf(&m, pdf, d);
     if (fabsf(q - p) > 1e-6f * p && fminf(fabsf(d.z), 1.0f) > 1e-4f) ++mismatch;
     if (!(p > 0.0f)) continue;
@@ -108,7 +131,7 @@ static void test_tables(int res, bool sphere, int pattern, iris_splat_mode mode,
 done:
   free(hist);
   free(pdf);
-  free(cdf);
+  free(alias);
   iris_octmap_destroy(&m);
 }
 

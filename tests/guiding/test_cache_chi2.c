@@ -13,13 +13,14 @@
 
 typedef struct cache_ctx {
   iris_octmap map;
-  float *pdf, *cdf;
+  float *pdf;
+  iris_cache_alias *alias;
 } cache_ctx;
 
 static bool sample_fn(void *ctx, const double u[3], double dir[3]) {
   cache_ctx *c = ctx;
   float p;
-  iris_vec3 d = iris_cache_sample(&c->map, c->pdf, c->cdf, (float)u[0], (float)u[1], (float)u[2], &p);
+  iris_vec3 d = iris_cache_sample(&c->map, c->pdf, c->alias, (float)u[0], (float)u[1], (float)u[2], &p);
   dir[0] = d.x;
   dir[1] = d.y;
   dir[2] = d.z;
@@ -43,7 +44,7 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
   iris_octmap_create(&c.map, res, sphere, NULL);
   float *hist = calloc(c.map.texel_count, sizeof(float));
   c.pdf = calloc(c.map.texel_count, sizeof(float));
-  c.cdf = calloc(c.map.texel_count, sizeof(float));
+  c.alias = calloc(c.map.texel_count, sizeof(iris_cache_alias));
   iris_vec3 lobe = iris_normalize(iris_v3(-0.4f, 0.7f, 0.3f));
   for (int i = 0; i < 3000; ++i) {
     iris_sampler s = iris_sampler_start(42 + pattern, (uint64_t)i, 0);
@@ -54,7 +55,7 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
     if (pattern == 2) e = (d.x > 0.0f) ? 1.0f : 0.0f;                   /* half dark: floor only */
     iris_cache_splat(&c.map, hist, d, e, mode);
   }
-  CHECK(iris_cache_build_tables(&c.map, hist, 2e-4f, c.pdf, c.cdf));
+  CHECK(iris_cache_build_tables(&c.map, hist, 2e-4f, c.pdf, c.alias));
   chi2_domain dom = {sphere ? CHI2_SPHERE : CHI2_HEMISPHERE, 0, 0, 1234 + (uint64_t)pattern};
   clock_t t0 = clock();
   chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 200000, 0.01, N_TESTS);
@@ -64,7 +65,7 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
   printf("res %d sphere %d pattern %d splat %d: %.1f s\n", res, sphere, pattern, mode, (double)(clock() - t0) / CLOCKS_PER_SEC);
   free(hist);
   free(c.pdf);
-  free(c.cdf);
+  free(c.alias);
   iris_octmap_destroy(&c.map);
 }
 

@@ -53,7 +53,7 @@ static bool same_guide(const iris_guiding *a, const iris_guiding *b) {
   if (a->cache_count != b->cache_count || a->stats.photons_stored != b->stats.photons_stored) return false;
   size_t n = table_floats(a);
   return n == table_floats(b) && memcmp(a->caches, b->caches, a->cache_count * sizeof(iris_cache)) == 0 &&
-         memcmp(a->pdf, b->pdf, n * sizeof(float)) == 0 && memcmp(a->cdf, b->cdf, n * sizeof(float)) == 0;
+         memcmp(a->pdf, b->pdf, n * sizeof(float)) == 0 && memcmp(a->alias, b->alias, n * sizeof(iris_cache_alias)) == 0;
 }
 
 static bool render(const iris_scene *s, int threads, iris_render_result *r) {
