@@ -7,7 +7,7 @@
 #include "scenes/door.h"
 #include "scenes/stress/stress.h"
 
-static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "furnace-diffuse",
+static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-shielded", "furnace-diffuse",
                                     "furnace-glossy", "inside-sphere",
                                     /* the failure-stability scenes, scenes/stress/stress.h */
                                     "stress-gap", "stress-veach-lights", "stress-caustic",
@@ -312,6 +312,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = build_veach(s);
   else if (strcmp(name, "door") == 0)
     st = iris_door_scene_build(s);
+  else if (strcmp(name, "door-shielded") == 0) /* light faces away from the door (docs/guiding.md) */
+    st = iris_door_scene_build_variant(s, IRIS_DOOR_SHIELDED);
   else if (strcmp(name, "furnace-diffuse") == 0)
     st = build_furnace(s, IRIS_MATERIAL_DIFFUSE);
   else if (strcmp(name, "furnace-glossy") == 0)

@@ -16,7 +16,6 @@
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
-#include "scenes/door.h"
 
 static double rel_mse(const iris_film *film, const iris_image *ref, int *ok);
 static const char *g_errmap = NULL; /* --errmap FILE.png: per-pixel relSE (mean of channels) */
@@ -87,13 +86,7 @@ int main(int argc, char **argv) {
   iris_error_clear(&err);
   iris_scene *scene = NULL;
   iris_status st;
-  if (strcmp(scene_name, "door-shielded") == 0) { /* not a registered built-in (yet) */
-    scene = iris_scene_create();
-    st = scene ? iris_door_scene_build_variant(scene, IRIS_DOOR_SHIELDED) : IRIS_ERR_NOMEM;
-    if (st == IRIS_OK) st = iris_scene_validate(scene, "builtin:door-shielded", &err);
-  } else {
-    st = iris_builtin_create(scene_name, &scene, &err);
-  }
+  st = iris_builtin_create(scene_name, &scene, &err); /* door-shielded is a built-in too */
   if (st != IRIS_OK) {
     char b[1400];
     iris_error_format(&err, b, sizeof b);
