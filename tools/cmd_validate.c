@@ -3,6 +3,7 @@
  * `iris validate --refresh` regenerates the stored references. The library
  * does the work (validate/validate.h); docs/cli.md ("validate") lists the flags. */
 #include <getopt.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -276,6 +277,11 @@ int iris_cmd_validate(int argc, char **argv) {
                  m->pixels.max_abs_z, m->pixels.z_crit, (unsigned long long)m->pixels.over_count,
                  m->pixels.allowed_over, m->z_passed ? "ok" : "FAILED", m->relmse,
                  m->passed ? "pass" : "FAIL");
+      double se = fmax(m->ratio_se[0], fmax(m->ratio_se[1], m->ratio_se[2]));
+      if (se > p.tolerance / 3.0)
+        iris_warnf("validate: %s: the energy ratio's standard error (%.2f%%) is not small against "
+                   "the tolerance (%.2f%%): the energy check is dominated by noise; raise --spp",
+                   iris_method_name(m->method), 100.0 * se, 100.0 * p.tolerance);
     }
     iris_infof("validate: report in %s/report.html", p.out_dir);
   }
