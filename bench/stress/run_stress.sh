@@ -14,6 +14,7 @@
 # Exit status: that of stress_suite (1 when any method gave NaN/Inf, light in
 # the closed box, or a z-test failure that does not shrink with time).
 set -eu
+ORIG_ARGS="$*"
 HERE=$(cd "$(dirname "$0")" && pwd)
 ROOT=$(cd "$HERE/../.." && pwd)
 B=${1:-$ROOT/build-stress}
@@ -35,7 +36,7 @@ if [ "${STRESS_TEST_REFS:-0}" = 1 ]; then
   "$SUITE" --refs "$ROOT/tests/stress/ref" --refs-only --width 64 --height 48 --ref-spp 2048 --seed 77
 fi
 
-CMD="bench/stress/run_stress.sh $*"
+CMD="bench/stress/run_stress.sh${ORIG_ARGS:+ $ORIG_ARGS}"
 LOAD_BEFORE=$(cut -d' ' -f1-3 /proc/loadavg)
 START=$(date +%s)
 set +e
