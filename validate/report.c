@@ -260,8 +260,11 @@ iris_status iris_report_write_html(const char *dir, const iris_validate_params *
               "relative deviation of tile energy (tiles above %g of the mean tile energy) and a "
               "per-tile, per-channel z-test with Bonferroni correction. Pixels: per-pixel z with "
               "Bonferroni (no |z| above crit) and a count test (number of |z|&gt;3 within its "
-              "binomial expectation). Formulas: docs/validation.md.</p>\n",
-          IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK_FLOOR);
+              "binomial expectation)%s. Formulas: docs/validation.md.</p>\n",
+          IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK, IRIS_METRIC_BLOCK_FLOOR,
+          params->pixel_test_gates ? ", which gates (--strict-pixels)"
+                                   : ", reported only: at low spp the skew of path-tracing samples "
+                                     "makes it reject unbiased renders; the block z-test gates");
 
   for (int k = 0; k < res->method_count; k++) {
     const iris_validate_method *m = &res->methods[k];
