@@ -161,12 +161,35 @@ static iris_status exr_fail(iris_error *err, iris_status status, const char *pat
 
 /* -------------------------------------------------------- EXR writing */
 
+/* OpenEXR 3.1's ZIP writer stores a chunk whose compressed size comes out
+ * exactly equal to its raw size as compressed, while every reader takes a
+ * chunk of raw size to be uncompressed, so that chunk reads back as garbage
+ * (upstream issue #2306; seen on a 128x96x6 float image). The file format
+ * says a chunk that does not shrink is stored raw: do that for >= as well. */
+typedef struct exr_compressor {
+  exr_result_t (*compress)(exr_encode_pipeline_t *enc);
+} exr_compressor;
+
+static exr_result_t exr_compress_or_store_raw(exr_encode_pipeline_t *enc) {
+  const exr_compressor *c = (const exr_compressor *)enc->encoding_user_data;
+  exr_result_t rv = c->compress(enc);
+  if (rv != EXR_ERR_SUCCESS) return rv;
+  if (enc->compressed_buffer && enc->compressed_buffer != enc->packed_buffer &&
+      enc->compressed_bytes >= enc->packed_bytes) {
+    if (enc->compressed_alloc_size < enc->packed_bytes) return EXR_ERR_OUT_OF_MEMORY;
+    memcpy(enc->compressed_buffer, enc->packed_buffer, enc->packed_bytes);
+    enc->compressed_bytes = enc->packed_bytes;
+  }
+  return EXR_ERR_SUCCESS;
+}
+
 static iris_status exr_write_pixels(exr_context_t ctx, const iris_image *img, const char *path,
                                     const exr_stream *s, iris_error *err) {
   int32_t lines = 0;
   exr_result_t rv = exr_get_scanlines_per_chunk(ctx, 0, &lines);
   if (rv != EXR_ERR_SUCCESS || lines <= 0) return exr_fail(err, IRIS_ERR_INTERNAL, path, s, rv, "cannot write EXR");
   exr_encode_pipeline_t enc = EXR_ENCODE_PIPELINE_INITIALIZER;
+  exr_compressor compressor = {NULL};
   bool started = false;
   iris_status st = IRIS_OK;
   const size_t pixel_stride = (size_t)img->channel_count * sizeof(float);
@@ -193,6 +216,11 @@ static iris_status exr_write_pixels(exr_context_t ctx, const iris_image *img, co
     if (!started) {
       rv = exr_encoding_choose_default_routines(ctx, 0, &enc);
       started = true;
+      if (rv == EXR_ERR_SUCCESS && enc.compress_fn) {
+        compressor.compress = enc.compress_fn;
+        enc.encoding_user_data = &compressor;
+        enc.compress_fn = exr_compress_or_store_raw;
+      }
     }
     if (rv == EXR_ERR_SUCCESS) rv = exr_encoding_run(ctx, 0, &enc);
     if (rv != EXR_ERR_SUCCESS) st = exr_fail(err, IRIS_ERR_IO, path, s, rv, "cannot write EXR");
