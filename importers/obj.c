@@ -778,10 +778,16 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
     size_t corner = 0;
     for (size_t f = 0; f < g->face_count; f++) {
       const uint32_t n = g->face_sizes[f];
-      if (g->corners[3 * corner + 2] == OBJ_FLAT) {
+      /* A face may mix corners with and without vn ("f 1//1 2 3"): only the
+       * corners without one are flat, and any of them may be. */
+      bool flat = false;
+      for (uint32_t i = 0; i < n; i++) flat |= g->corners[3 * (corner + i) + 2] == OBJ_FLAT;
+      if (flat) {
         float fn[3];
         polygon_normal(c->pos.v, g->corners + 3 * corner, n, fn);
-        for (uint32_t i = 0; i < n; i++) memcpy(m.normals + 3 * (size_t)corner_vertex[corner + i], fn, sizeof fn);
+        for (uint32_t i = 0; i < n; i++)
+          if (g->corners[3 * (corner + i) + 2] == OBJ_FLAT)
+            memcpy(m.normals + 3 * (size_t)corner_vertex[corner + i], fn, sizeof fn);
       }
       corner += n;
     }

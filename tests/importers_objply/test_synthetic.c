@@ -46,6 +46,24 @@ static void obj_cases(void) {
     CHECK_EQ_INT(m->material, -1);
     iris_scene_destroy(s);
   }
+  /* A face mixing a corner with vn and corners without, outside smoothing
+   * groups (found by fuzzing: the flat corners' normals were left unset). The
+   * first corner keeps vn (1,0,0); the other two get the face normal (0,0,1). */
+  const char *mixed = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 1 0 0\nf 1//1 2 3\n";
+  s = load("obj", mixed, strlen(mixed), &st, &err);
+  CHECK_OK(st, &err);
+  if (s && CHECK(s->meshes[0].normals != NULL)) {
+    const iris_mesh *m = &s->meshes[0];
+    int with_vn = 0, flat = 0;
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+      const float *nv = m->normals + 3 * v;
+      if (nv[0] == 1.0f && nv[1] == 0.0f && nv[2] == 0.0f) with_vn++;
+      if (nv[0] == 0.0f && nv[1] == 0.0f && nv[2] == 1.0f) flat++;
+    }
+    CHECK_EQ_INT(with_vn, 1);
+    CHECK_EQ_INT(flat, 2);
+  }
+  iris_scene_destroy(s);
   /* Convex pentagon (unit square + roof apex at (0.5, 1.5)): 3 triangles, area 1.25. */
   const char *b = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0.5 1.5 0\nv 0 1 0\nf 1 2 3 4 5\n";
   s = load("obj", b, strlen(b), &st, &err);
