@@ -1,10 +1,17 @@
 #include "tools/cli.h"
 
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/fileio.h"
+#include "importers/import.h"
+#include "scenes/builtin.h"
 
 int iris_cli_report(const iris_error *err) {
   char buf[1400];
@@ -76,4 +83,79 @@ bool iris_cli_parse_float(const char *cmd, const char *opt, const char *text, do
   }
   *out = v;
   return true;
+}
+
+const char *iris_cli_split_option(const char *arg, char *name, size_t cap, const char **val) {
+  *val = NULL;
+  const char *eq = strchr(arg, '=');
+  if (strncmp(arg, "--", 2) != 0 || !eq) return arg;
+  size_t n = (size_t)(eq - arg);
+  if (n >= cap) n = cap - 1;
+  memcpy(name, arg, n);
+  name[n] = 0;
+  *val = eq + 1;
+  return name;
+}
+
+bool iris_cli_take_value(const char *cmd, const char *opt, int argc, char **argv, int *i,
+                         const char **val) {
+  if (*val) return true;
+  if (*i + 1 >= argc) {
+    iris_cli_usage_error(cmd, "option %s needs a value", opt);
+    return false;
+  }
+  *val = argv[++*i];
+  return true;
+}
+
+int iris_cli_getopt_error(const char *cmd, int c, char **argv) {
+  if (c == ':') return iris_cli_usage_error(cmd, "option '%s' needs a value", argv[optind - 1]);
+  if (optopt) return iris_cli_usage_error(cmd, "unknown option '-%c'", optopt);
+  return iris_cli_usage_error(cmd, "unknown option '%s'", argv[optind - 1]);
+}
+
+bool iris_cli_set_once(const char *cmd, const char *opt, const char **slot, const char *value) {
+  if (*slot) {
+    iris_cli_usage_error(cmd, "%s given twice ('%s' and '%s')", opt, *slot, value);
+    return false;
+  }
+  *slot = value;
+  return true;
+}
+
+bool iris_cli_output_folder_ok(const char *cmd, const char *output) {
+  char dir[1024];
+  iris_path_dir(output, dir, sizeof dir);
+  struct stat st;
+  if (stat(dir, &st) == 0 && S_ISDIR(st.st_mode)) return true;
+  iris_cli_usage_error(cmd, "output folder '%s' does not exist", dir);
+  return false;
+}
+
+bool iris_cli_same_file(const char *a, const char *b) {
+  struct stat sa, sb;
+  if (strcmp(a, b) == 0) return true;
+  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_name,
+                        const char *builtin_list, iris_scene **out) {
+  iris_error err;
+  iris_error_clear(&err);
+  *out = NULL;
+  iris_status st;
+  if (iris_path_exists(input)) {
+    iris_import_options opts = iris_import_options_default();
+    opts.camera_name = camera_name;
+    st = iris_import_file(input, &opts, out, &err);
+  } else if (iris_builtin_exists(input)) {
+    st = iris_builtin_create(input, out, &err);
+  } else {
+    char names[512] = "";
+    for (const char *const *n = iris_builtin_names(); !builtin_list && *n && strlen(names) < 400; n++)
+      snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", names[0] ? ", " : "", *n);
+    return iris_cli_usage_error(cmd, "'%s' is neither a file nor a built-in scene (%s)", input,
+                                builtin_list ? builtin_list : names);
+  }
+  return st == IRIS_OK ? IRIS_EXIT_OK : iris_cli_report(&err);
 }

@@ -5,9 +5,11 @@
 #define IRIS_TOOLS_CLI_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
+#include "scene/scene.h"
 
 /* Exit codes: 0 success, 2 bad usage or bad input, 1 any other failure. */
 enum { IRIS_EXIT_OK = 0, IRIS_EXIT_FAILURE = 1, IRIS_EXIT_USAGE = 2 };
@@ -28,6 +30,31 @@ bool iris_cli_parse_int(const char *cmd, const char *opt, const char *text, long
 bool iris_cli_parse_u64(const char *cmd, const char *opt, const char *text, uint64_t *out);
 bool iris_cli_parse_float(const char *cmd, const char *opt, const char *text, double lo,
                           double hi, double *out);
+
+/* Hand-rolled long options: "--name=value" is split into `name` (a copy of at
+ * most cap - 1 bytes) and *val, which is returned as the option; any other
+ * argument is returned as it is, with *val = NULL. */
+const char *iris_cli_split_option(const char *arg, char *name, size_t cap, const char **val);
+/* The value of option `opt` at argv[*i]: *val when already split off, else
+ * the next argument (advancing *i); false (after a usage error) when none. */
+bool iris_cli_take_value(const char *cmd, const char *opt, int argc, char **argv, int *i,
+                         const char **val);
+/* getopt_long's ':' (missing value) and '?' (unknown option) results as
+ * usage errors; returns 2. */
+int iris_cli_getopt_error(const char *cmd, int c, char **argv);
+/* Stores `value` in *slot; false (after "OPT given twice") when already set. */
+bool iris_cli_set_once(const char *cmd, const char *opt, const char **slot, const char *value);
+/* True when the folder that will hold `output` exists; else a usage error. */
+bool iris_cli_output_folder_ok(const char *cmd, const char *output);
+/* True when paths `a` and `b` name the same file (same string or inode). */
+bool iris_cli_same_file(const char *a, const char *b);
+/* Loads INPUT: an existing file is imported (`camera_name` handed to the
+ * importer), else it must be a built-in scene name. Returns IRIS_EXIT_OK with
+ * *out set, or prints the error and returns the exit code. An INPUT that is
+ * neither is a usage error naming `builtin_list`, or all built-in scenes when
+ * NULL. */
+int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_name,
+                        const char *builtin_list, iris_scene **out);
 
 /* Subcommand entry points: argv[0] is the subcommand name. */
 typedef struct iris_command {

@@ -98,23 +98,12 @@ int iris_cmd_bench(int argc, char **argv) {
   const char *plot_script = NULL;
   char methods_buf[256] = "", times_buf[512] = "";
   for (int i = 1; i < argc; i++) {
-    const char *a = argv[i];
-    const char *val = NULL;
     char name[64];
-    if (strncmp(a, "--", 2) == 0 && strchr(a, '=')) {
-      size_t n = (size_t)(strchr(a, '=') - a);
-      if (n >= sizeof name) n = sizeof name - 1;
-      memcpy(name, a, n);
-      name[n] = 0;
-      val = strchr(a, '=') + 1;
-      a = name;
-    }
-#define NEED_VALUE()                                                                     \
-  do {                                                                                   \
-    if (!val) {                                                                          \
-      if (i + 1 >= argc) return iris_cli_usage_error(CMD, "option %s needs a value", a); \
-      val = argv[++i];                                                                   \
-    }                                                                                    \
+    const char *val;
+    const char *a = iris_cli_split_option(argv[i], name, sizeof name, &val);
+#define NEED_VALUE()                                                                           \
+  do {                                                                                         \
+    if (!iris_cli_take_value(CMD, a, argc, argv, &i, &val)) return IRIS_EXIT_USAGE;            \
   } while (0)
 #define NO_VALUE()                                                                        \
   do {                                                                                    \

@@ -5,14 +5,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 #include "core/fileio.h"
 #include "core/log.h"
 #include "exporters/blender.h"
 #include "exporters/pov.h"
-#include "importers/import.h"
-#include "scenes/builtin.h"
 #include "tools/cli.h"
 
 static const char *const CMD = "export";
@@ -51,12 +48,6 @@ static void print_help(void) {
          "failure. Outputs are written atomically.\n");
 }
 
-static bool same_file(const char *a, const char *b) {
-  struct stat sa, sb;
-  if (strcmp(a, b) == 0) return true;
-  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
-
 int iris_cmd_export(int argc, char **argv) {
   enum { OPT_TO = 256, OPT_CAMERA, OPT_WIDTH, OPT_HEIGHT, OPT_SPP, OPT_SEED, OPT_DEPTH, OPT_EMBED, OPT_COVERAGE };
   static const struct option longopts[] = {{"to", required_argument, NULL, OPT_TO},
@@ -82,18 +73,14 @@ int iris_cmd_export(int argc, char **argv) {
   while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
     switch (c) {
       case OPT_TO:
-        if (to) return iris_cli_usage_error(CMD, "--to given twice ('%s' and '%s')", to, optarg);
-        to = optarg;
+        if (!iris_cli_set_once(CMD, "--to", &to, optarg)) return IRIS_EXIT_USAGE;
         break;
       case 'o':
-        if (output) return iris_cli_usage_error(CMD, "--output given twice ('%s' and '%s')", output, optarg);
-        output = optarg;
+        if (!iris_cli_set_once(CMD, "--output", &output, optarg)) return IRIS_EXIT_USAGE;
         break;
       case OPT_CAMERA:
-        if (params.camera_name)
-          return iris_cli_usage_error(CMD, "--camera given twice ('%s' and '%s')", params.camera_name, optarg);
+        if (!iris_cli_set_once(CMD, "--camera", &params.camera_name, optarg)) return IRIS_EXIT_USAGE;
         if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
-        params.camera_name = optarg;
         break;
       case OPT_WIDTH:
         if (!iris_cli_parse_int(CMD, "--width", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
@@ -121,10 +108,7 @@ int iris_cmd_export(int argc, char **argv) {
       case OPT_COVERAGE: params.coverage = true; break;
       case 'q': quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
-      case ':': return iris_cli_usage_error(CMD, "option '%s' needs a value", argv[optind - 1]);
-      default:
-        if (optopt) return iris_cli_usage_error(CMD, "unknown option '-%c'", optopt);
-        return iris_cli_usage_error(CMD, "unknown option '%s'", argv[optind - 1]);
+      default: return iris_cli_getopt_error(CMD, c, argv);
     }
   }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
@@ -148,33 +132,16 @@ int iris_cmd_export(int argc, char **argv) {
   if (!blender && params.embed_meshes) return iris_cli_usage_error(CMD, "--embed needs --to blender");
   if (!blender && (params.spp > 0 || params.has_seed))
     return iris_cli_usage_error(CMD, "--spp and --seed apply to --to blender only");
-  char outdir[1024];
-  iris_path_dir(output, outdir, sizeof outdir);
-  struct stat st;
-  if (stat(outdir, &st) != 0 || !S_ISDIR(st.st_mode))
-    return iris_cli_usage_error(CMD, "output folder '%s' does not exist", outdir);
-  bool is_file = iris_path_exists(input);
-  if (is_file && same_file(input, output)) return iris_cli_usage_error(CMD, "output '%s' is also the input", output);
+  if (!iris_cli_output_folder_ok(CMD, output)) return IRIS_EXIT_USAGE;
+  if (iris_path_exists(input) && iris_cli_same_file(input, output))
+    return iris_cli_usage_error(CMD, "output '%s' is also the input", output);
 
+  iris_scene *scene = NULL;
+  int rc = iris_cli_load_scene(CMD, input, params.camera_name, NULL, &scene);
+  if (rc != IRIS_EXIT_OK) return rc;
   iris_error err;
   iris_error_clear(&err);
-  iris_scene *scene = NULL;
-  iris_status status;
-  if (is_file) {
-    iris_import_options opts = iris_import_options_default();
-    opts.camera_name = params.camera_name;
-    status = iris_import_file(input, &opts, &scene, &err);
-  } else if (iris_builtin_exists(input)) {
-    status = iris_builtin_create(input, &scene, &err);
-  } else {
-    char names[512] = "";
-    for (const char *const *n = iris_builtin_names(); *n && strlen(names) < 400; n++)
-      snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", names[0] ? ", " : "", *n);
-    return iris_cli_usage_error(CMD, "'%s' is neither a file nor a built-in scene (%s)", input, names);
-  }
-  if (status != IRIS_OK) return iris_cli_report(&err);
-
-  status = blender ? iris_export_blender(scene, output, &params, &err) : iris_export_pov(scene, output, &params, &err);
+  iris_status status = blender ? iris_export_blender(scene, output, &params, &err) : iris_export_pov(scene, output, &params, &err);
   if (status != IRIS_OK) {
     iris_scene_destroy(scene);
     /* Write failures are failures (1); everything else is bad input (2). */

@@ -43,12 +43,6 @@ static bool supported_input(const char *path) {
   return false;
 }
 
-static bool same_file(const char *a, const char *b) {
-  struct stat sa, sb;
-  if (strcmp(a, b) == 0) return true;
-  return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
-
 /* Moves the camera called `name` to index 0; false when there is none. */
 static bool select_camera(iris_scene *s, const char *name) {
   for (size_t i = 0; i < s->camera_count; i++) {
@@ -80,23 +74,17 @@ int iris_cmd_import(int argc, char **argv) {
   while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
     switch (c) {
       case 'o':
-        if (output) return iris_cli_usage_error(CMD, "--output given twice ('%s' and '%s')", output, optarg);
-        output = optarg;
+        if (!iris_cli_set_once(CMD, "--output", &output, optarg)) return IRIS_EXIT_USAGE;
         break;
       case OPT_CAMERA:
-        if (opts.camera_name)
-          return iris_cli_usage_error(CMD, "--camera given twice ('%s' and '%s')", opts.camera_name, optarg);
+        if (!iris_cli_set_once(CMD, "--camera", &opts.camera_name, optarg)) return IRIS_EXIT_USAGE;
         if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
-        opts.camera_name = optarg;
         break;
       case OPT_WELD: opts.weld = true; break;
       case OPT_NO_NORMALS: opts.compute_normals = false; break;
       case 'q': quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
-      case ':': return iris_cli_usage_error(CMD, "option '%s' needs a value", argv[optind - 1]);
-      default:
-        if (optopt) return iris_cli_usage_error(CMD, "unknown option '-%c'", optopt);
-        return iris_cli_usage_error(CMD, "unknown option '%s'", argv[optind - 1]);
+      default: return iris_cli_getopt_error(CMD, c, argv);
     }
   }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
@@ -109,11 +97,8 @@ int iris_cmd_import(int argc, char **argv) {
   char ext[16];
   iris_path_ext(output, ext, sizeof ext);
   if (strcmp(ext, "json") != 0) return iris_cli_usage_error(CMD, "output '%s' must end in .json", output);
-  char outdir[1024];
-  iris_path_dir(output, outdir, sizeof outdir);
+  if (!iris_cli_output_folder_ok(CMD, output)) return IRIS_EXIT_USAGE;
   struct stat st;
-  if (stat(outdir, &st) != 0 || !S_ISDIR(st.st_mode))
-    return iris_cli_usage_error(CMD, "output folder '%s' does not exist", outdir);
   for (int i = 0; i < ninputs; i++) {
     if (!supported_input(inputs[i]))
       return iris_cli_usage_error(CMD, "input '%s' is not an .obj, .ply, .gltf, .glb or .json file", inputs[i]);
@@ -123,7 +108,7 @@ int iris_cmd_import(int argc, char **argv) {
       iris_error_set(&err, IRIS_ERR_IO, inputs[i], 0, NULL, "cannot open: no such file");
       return iris_cli_report(&err);
     }
-    if (same_file(inputs[i], output))
+    if (iris_cli_same_file(inputs[i], output))
       return iris_cli_usage_error(CMD, "output '%s' is also an input", output);
   }
 

@@ -213,9 +213,7 @@ int iris_cmd_info(int argc, char **argv) {
       case 'j': json = true; break;
       case 'q': quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
-      default:
-        if (optopt) return iris_cli_usage_error(CMD, "unknown option '-%c'", optopt);
-        return iris_cli_usage_error(CMD, "unknown option '%s'", argv[optind - 1]);
+      default: return iris_cli_getopt_error(CMD, c, argv);
     }
   }
   if (optind >= argc) return iris_cli_usage_error(CMD, "no input file");

@@ -13,10 +13,8 @@
 #include "core/image.h"
 #include "core/log.h"
 #include "core/rng.h"
-#include "importers/import.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
-#include "scenes/builtin.h"
 #include "tools/cli.h"
 
 static const char *CMD = "render";
@@ -184,23 +182,12 @@ int iris_cmd_render(int argc, char **argv) {
   bool variance = false, quiet = false, json = false, have_spp = false, have_seed = false;
   double exposure = 0.0;
   for (int i = 1; i < argc; i++) {
-    const char *a = argv[i];
-    const char *val = NULL;
     char name[64];
-    if (strncmp(a, "--", 2) == 0 && strchr(a, '=')) {
-      size_t n = (size_t)(strchr(a, '=') - a);
-      if (n >= sizeof name) n = sizeof name - 1;
-      memcpy(name, a, n);
-      name[n] = 0;
-      val = strchr(a, '=') + 1;
-      a = name;
-    }
-#define NEED_VALUE()                                                                 \
-  do {                                                                               \
-    if (!val) {                                                                      \
-      if (i + 1 >= argc) return iris_cli_usage_error(CMD, "option %s needs a value", a); \
-      val = argv[++i];                                                               \
-    }                                                                                \
+    const char *val;
+    const char *a = iris_cli_split_option(argv[i], name, sizeof name, &val);
+#define NEED_VALUE()                                                                           \
+  do {                                                                                         \
+    if (!iris_cli_take_value(CMD, a, argc, argv, &i, &val)) return IRIS_EXIT_USAGE;            \
   } while (0)
     long lv;
     double dv;
@@ -348,22 +335,14 @@ int iris_cmd_render(int argc, char **argv) {
   }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
+  iris_scene *scene = NULL;
+  int rc = iris_cli_load_scene(CMD, input, camera,
+                               "cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, inside-sphere",
+                               &scene);
+  if (rc != IRIS_EXIT_OK) return rc;
   iris_error err;
   iris_error_clear(&err);
-  iris_scene *scene = NULL;
   iris_status st;
-  if (iris_path_exists(input)) {
-    iris_import_options opts = iris_import_options_default();
-    opts.camera_name = camera;
-    st = iris_import_file(input, &opts, &scene, &err);
-  } else if (iris_builtin_exists(input)) {
-    st = iris_builtin_create(input, &scene, &err);
-  } else {
-    return iris_cli_usage_error(CMD, "'%s' is neither a file nor a built-in scene "
-                                     "(cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, "
-                                     "inside-sphere)", input);
-  }
-  if (st != IRIS_OK) return iris_cli_report(&err);
   if (!have_seed && scene->render.has_seed) p.seed = scene->render.seed;
   p.camera_name = camera;
 
@@ -398,7 +377,7 @@ int iris_cmd_render(int argc, char **argv) {
     iris_scene_destroy(scene);
     return iris_cli_report(&err);
   }
-  int rc = IRIS_EXIT_OK;
+  rc = IRIS_EXIT_OK;
   if (out_exr) st = iris_render_write_exr(&res, out_exr, input, variance, &err);
   if (st == IRIS_OK && out_png) st = iris_render_write_png(&res, out_png, (float)exposure, &err);
   if (st == IRIS_OK && aov_caches) st = write_cache_marks(&res, &marks, out_png ? out_png : out_exr, (float)exposure, &err);

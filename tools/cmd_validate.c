@@ -144,9 +144,7 @@ int iris_cmd_validate(int argc, char **argv) {
         p.spp = (int)v;
         break;
       case OPT_REFERENCE:
-        if (p.reference_path)
-          return iris_cli_usage_error(CMD, "--reference given twice ('%s' and '%s')", p.reference_path, optarg);
-        p.reference_path = optarg;
+        if (!iris_cli_set_once(CMD, "--reference", &p.reference_path, optarg)) return IRIS_EXIT_USAGE;
         break;
       case OPT_BLENDER: blender = true; break;
       case OPT_TOLERANCE:
@@ -184,8 +182,7 @@ int iris_cmd_validate(int argc, char **argv) {
         p.max_depth = (int)v;
         break;
       case OPT_OUT:
-        if (p.out_dir) return iris_cli_usage_error(CMD, "--out given twice ('%s' and '%s')", p.out_dir, optarg);
-        p.out_dir = optarg;
+        if (!iris_cli_set_once(CMD, "--out", &p.out_dir, optarg)) return IRIS_EXIT_USAGE;
         break;
       case OPT_CAMERA:
         if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
@@ -197,10 +194,7 @@ int iris_cmd_validate(int argc, char **argv) {
       case OPT_STRICT: p.pixel_test_gates = true; break;
       case 'q': p.quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
-      case ':': return iris_cli_usage_error(CMD, "option '%s' needs a value", argv[optind - 1]);
-      default:
-        if (optopt) return iris_cli_usage_error(CMD, "unknown option '-%c'", optopt);
-        return iris_cli_usage_error(CMD, "unknown option '%s'", argv[optind - 1]);
+      default: return iris_cli_getopt_error(CMD, c, argv);
     }
   }
   if (p.quiet) iris_log_set_level(IRIS_LOG_QUIET);
