@@ -9,6 +9,7 @@
 
 #include "core/fileio.h"
 #include "core/log.h"
+#include "scene/framing.h"
 
 iris_export_params iris_export_params_default(void) {
   iris_export_params p;
@@ -37,11 +38,7 @@ iris_status iris_export_resolve_view(const iris_scene *scene, const iris_export_
   memset(view, 0, sizeof *view);
   view->camera = -1;
   if (params->camera_name && *params->camera_name) {
-    for (size_t i = 0; i < scene->camera_count; i++)
-      if (scene->cameras[i].name && strcmp(scene->cameras[i].name, params->camera_name) == 0) {
-        view->camera = (int32_t)i;
-        break;
-      }
+    view->camera = iris_scene_find_camera(scene, params->camera_name);
     if (view->camera < 0)
       return iris_error_set(err, IRIS_ERR_USAGE, file, 0, NULL, "no camera named '%s' (%zu cameras)",
                             params->camera_name, scene->camera_count);
@@ -49,24 +46,10 @@ iris_status iris_export_resolve_view(const iris_scene *scene, const iris_export_
     view->camera = 0;
   }
 
-  /* Mirrors renderer/camera.c (iris_pinhole_setup) so that an export frames
-   * exactly what `iris render` frames; tests/exporters checks the two agree. */
+  /* The same choices as renderer/camera.c (iris_pinhole_setup), so that an
+   * export frames exactly what `iris render` frames; tests/exporters checks. */
   const iris_camera *cam = view->camera >= 0 ? &scene->cameras[view->camera] : NULL;
-  float aspect = 1.0f;
-  if (cam && cam->aspect > 0.0f)
-    aspect = cam->aspect;
-  else if (scene->render.width > 0 && scene->render.height > 0)
-    aspect = (float)scene->render.width / (float)scene->render.height;
-  int w = params->width, h = params->height;
-  if (w <= 0 && h <= 0 && scene->render.width > 0 && scene->render.height > 0) {
-    w = scene->render.width;
-    h = scene->render.height;
-  }
-  if (w <= 0 && h <= 0) h = IRIS_EXPORT_DEFAULT_HEIGHT;
-  if (w <= 0) w = (int)lroundf((float)h * aspect);
-  if (h <= 0) h = (int)lroundf((float)w / aspect);
-  view->width = w < 1 ? 1 : w;
-  view->height = h < 1 ? 1 : h;
+  iris_framing_resolve_size(scene, cam, params->width, params->height, &view->width, &view->height);
 
   if (cam) {
     char element[64];
@@ -78,23 +61,13 @@ iris_status iris_export_resolve_view(const iris_scene *scene, const iris_export_
                             "vertical field of view %g is not in (0, pi)", (double)cam->yfov);
     view->yfov = cam->yfov;
   } else {
-    /* No camera: frame the bounding sphere from +Z, looking along -Z. */
-    iris_vec3 lo, hi;
-    if (!iris_scene_bounds(scene, &lo, &hi)) {
-      lo = iris_v3(-1, -1, -1);
-      hi = iris_v3(1, 1, 1);
-    }
-    iris_vec3 c = iris_scale(iris_add(lo, hi), 0.5f);
-    float r = 0.5f * iris_length(iris_sub(hi, lo));
-    if (!(r > 0.0f)) r = 1.0f;
+    /* No camera: the automatic one, looking along -Z with +Y up. */
     view->yfov = IRIS_EXPORT_FRAMING_YFOV;
-    float half_y = 0.5f * view->yfov;
-    float half_x = atanf(tanf(half_y) * ((float)view->width / (float)view->height));
-    float dist = r / sinf(fminf(half_y, half_x));
+    iris_vec3 o = iris_framing_auto_origin(scene, (float)view->width / (float)view->height);
     view->to_world = iris_mat4_identity();
-    view->to_world.m[0][3] = c.x;
-    view->to_world.m[1][3] = c.y;
-    view->to_world.m[2][3] = c.z + dist;
+    view->to_world.m[0][3] = o.x;
+    view->to_world.m[1][3] = o.y;
+    view->to_world.m[2][3] = o.z;
   }
 
   view->spp = params->spp > 0 ? params->spp

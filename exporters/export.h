@@ -8,6 +8,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "scene/framing.h"
 #include "scene/scene.h"
 
 #ifdef __cplusplus
@@ -25,11 +26,11 @@ typedef struct iris_export_params {
   bool coverage;           /* pov: every object pure white emitter, black background, no lights */
 } iris_export_params;
 
-#define IRIS_EXPORT_DEFAULT_HEIGHT 512
+#define IRIS_EXPORT_DEFAULT_HEIGHT IRIS_FRAMING_DEFAULT_HEIGHT
 #define IRIS_EXPORT_DEFAULT_SPP 64
 #define IRIS_EXPORT_DEFAULT_DEPTH 64
 /* Vertical field of view of the framing camera used when a scene has none. */
-#define IRIS_EXPORT_FRAMING_YFOV 0.6981317f /* 40 degrees */
+#define IRIS_EXPORT_FRAMING_YFOV IRIS_FRAMING_AUTO_YFOV /* 40 degrees */
 
 iris_export_params iris_export_params_default(void);
 

@@ -10,16 +10,16 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "renderer/accel.h"
+#include "scene/framing.h"
 #include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Height used when neither the flags nor the scene give a resolution. */
-#define IRIS_CAMERA_DEFAULT_HEIGHT 512
-/* Vertical field of view of an automatically framed camera (radians, 40 deg). */
-#define IRIS_CAMERA_AUTO_YFOV 0.6981317f
+/* Kept for callers of the old names; the values live in scene/framing.h. */
+#define IRIS_CAMERA_DEFAULT_HEIGHT IRIS_FRAMING_DEFAULT_HEIGHT
+#define IRIS_CAMERA_AUTO_YFOV IRIS_FRAMING_AUTO_YFOV
 
 typedef struct iris_pinhole {
   iris_vec3 origin;
@@ -32,10 +32,11 @@ typedef struct iris_pinhole {
   char name[64];
 } iris_pinhole;
 
-/* Picks the scene camera called `name` (NULL: the first one; none in the scene:
- * auto-framing) and resolves the resolution: width/height <= 0 come from the
- * scene's render settings, then from the camera's aspect ratio, with
- * IRIS_CAMERA_DEFAULT_HEIGHT pixels high as the last resort. */
+/* Picks the scene camera called `name` (the first of that name; NULL: the
+ * first camera; none in the scene: auto-framing) and resolves the resolution
+ * (iris_framing_resolve_size: width/height <= 0 come from the scene's render
+ * settings, then from the camera's aspect ratio, IRIS_FRAMING_DEFAULT_HEIGHT
+ * pixels high as the last resort). */
 iris_status iris_pinhole_setup(const iris_scene *scene, const char *name, int width, int height,
                                iris_pinhole *out, iris_error *err);
 
