@@ -12,6 +12,7 @@
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/import.h"
+#include "importers/mapped.h"
 #include "importers/meshproc.h"
 #include "importers/numparse.h"
 
@@ -957,11 +958,5 @@ iris_status iris_import_obj_memory(const char *data, size_t size, const char *pa
 
 iris_status iris_import_obj(const char *path, const iris_import_options *opts, iris_scene **out,
                             iris_error *err) {
-  *out = NULL;
-  iris_file_map map;
-  iris_status st = iris_file_map_open(path, &map, err);
-  if (st != IRIS_OK) return st;
-  st = iris_import_obj_memory(map.data, map.size, path, opts, out, err);
-  iris_file_map_close(&map);
-  return st;
+  return iris_import_mapped(path, iris_import_obj_memory, opts, out, err);
 }
