@@ -13,6 +13,7 @@
 #include "core/image.h"
 #include "core/log.h"
 #include "core/rng.h"
+#include "scenes/builtin.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "tools/cli.h"
@@ -23,9 +24,19 @@ static void print_help(void) {
   printf(
       "Usage: iris render INPUT [-o OUT.exr] [--png OUT.png] [options]\n"
       "\n"
-      "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene:\n"
-      "cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, inside-sphere).\n"
-      "\n"
+      "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene).\n"
+      "Built-in scenes:");
+  int column = 16;
+  for (const char *const *n = iris_builtin_names(); *n; n++) {
+    if (column + (int)strlen(*n) + 2 > 78) {
+      printf("\n ");
+      column = 1;
+    }
+    printf(" %s", *n);
+    column += (int)strlen(*n) + 1;
+  }
+  printf(
+      "\n\n"
       "Output:\n"
       "  -o, --output FILE   OpenEXR output (float RGB + metadata)\n"
       "      --variance      also write var.R/G/B: variance of each pixel's mean\n"
@@ -336,9 +347,7 @@ int iris_cmd_render(int argc, char **argv) {
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
   iris_scene *scene = NULL;
-  int rc = iris_cli_load_scene(CMD, input, camera,
-                               "cornell-box, veach-mis, door, furnace-diffuse, furnace-glossy, inside-sphere",
-                               &scene);
+  int rc = iris_cli_load_scene(CMD, input, camera, NULL, &scene);
   if (rc != IRIS_EXIT_OK) return rc;
   iris_error err;
   iris_error_clear(&err);
