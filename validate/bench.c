@@ -27,6 +27,7 @@
 #include "renderer/render.h"
 #include "validate/bench_table.h"
 #include "validate/blender_run.h"
+#include "validate/json_out.h"
 #include "validate/metrics.h"
 #include "validate/report.h"
 #include "validate/validate.h"
@@ -712,13 +713,6 @@ iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res,
   return iris_atomic_commit(&f, err);
 }
 
-static void add_num(cJSON *o, const char *k, double v) {
-  if (isfinite(v))
-    cJSON_AddNumberToObject(o, k, v);
-  else
-    cJSON_AddNullToObject(o, k);
-}
-
 iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
                                   const iris_bench_result *res, iris_error *err) {
   cJSON *o = cJSON_CreateObject();
@@ -765,7 +759,7 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddStringToObject(r, "path", sc->reference);
     cJSON_AddStringToObject(r, "description", sc->reference_description);
     cJSON_AddNumberToObject(r, "spp", sc->reference_spp);
-    add_num(j, "target_relmse", sc->target_relmse > 0 ? sc->target_relmse : NAN);
+    iris_json_add_number(j, "target_relmse", sc->target_relmse > 0 ? sc->target_relmse : NAN);
     cJSON *im = cJSON_AddArrayToObject(j, "images");
     for (int k = 0; k < sc->image_count; k++) {
       cJSON *e = cJSON_CreateObject();
@@ -794,12 +788,12 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddStringToObject(j, "method", r->method);
     cJSON_AddNumberToObject(j, "seed", (double)r->seed);
     cJSON_AddNumberToObject(j, "budget_s", r->budget_s);
-    add_num(j, "seconds", r->seconds);
-    add_num(j, "setup_seconds", r->setup_seconds);
+    iris_json_add_number(j, "seconds", r->seconds);
+    iris_json_add_number(j, "setup_seconds", r->setup_seconds);
     cJSON_AddNumberToObject(j, "spp", r->spp);
-    add_num(j, "relmse", r->relmse);
-    add_num(j, "mape", r->mape);
-    add_num(j, "energy_ratio", r->energy_ratio);
+    iris_json_add_number(j, "relmse", r->relmse);
+    iris_json_add_number(j, "mape", r->mape);
+    iris_json_add_number(j, "energy_ratio", r->energy_ratio);
     cJSON_AddNumberToObject(j, "nonfinite", (double)r->nonfinite);
     cJSON_AddItemToArray(rows, j);
   }
@@ -812,12 +806,5 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddStringToObject(out, "chart_png", "charts/convergence.png");
     cJSON_AddStringToObject(out, "chart_svg", "charts/convergence.svg");
   }
-  char *text = cJSON_Print(o);
-  cJSON_Delete(o);
-  if (!text) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
-  size_t len = strlen(text);
-  text[len] = '\n';
-  iris_status st = iris_file_write_atomic(path, text, len + 1, err);
-  free(text);
-  return st;
+  return iris_json_write_file(o, path, err);
 }

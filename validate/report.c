@@ -9,6 +9,7 @@
 #include <cjson/cJSON.h>
 
 #include "core/fileio.h"
+#include "validate/json_out.h"
 #include "validate/metrics.h"
 
 float iris_report_exposure(const double ref_mean[3]) {
@@ -72,14 +73,6 @@ static cJSON *triple(const double v[3]) {
   return a;
 }
 
-/* JSON has no Inf: non-finite numbers are written as null. */
-static void add_num(cJSON *o, const char *k, double v) {
-  if (isfinite(v))
-    cJSON_AddNumberToObject(o, k, v);
-  else
-    cJSON_AddNullToObject(o, k);
-}
-
 iris_status iris_report_write_summary(const char *path, const iris_validate_params *params,
                                       const iris_validate_result *res, iris_error *err) {
   cJSON *o = cJSON_CreateObject();
@@ -88,8 +81,8 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddNumberToObject(o, "height", res->height);
   cJSON_AddNumberToObject(o, "max_depth", res->max_depth);
   cJSON_AddNumberToObject(o, "seed", (double)params->seed);
-  add_num(o, "tolerance", params->tolerance);
-  add_num(o, "alpha", params->alpha);
+  iris_json_add_number(o, "tolerance", params->tolerance);
+  iris_json_add_number(o, "alpha", params->alpha);
   cJSON_AddBoolToObject(o, "pixel_test_gates", params->pixel_test_gates);
   cJSON_AddBoolToObject(o, "passed", res->passed);
   cJSON *r = cJSON_AddObjectToObject(o, "reference");
@@ -102,53 +95,53 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddNumberToObject(r, "nan_count", (double)res->reference.nan_count);
   cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
   cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
-  add_num(r, "seconds", res->reference.seconds);
+  iris_json_add_number(r, "seconds", res->reference.seconds);
   cJSON *ms = cJSON_AddArrayToObject(o, "methods");
   for (int k = 0; k < res->method_count; k++) {
     const iris_validate_method *m = &res->methods[k];
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "method", iris_method_name(m->method));
     cJSON_AddNumberToObject(j, "spp", m->spp);
-    add_num(j, "seconds", m->seconds);
+    iris_json_add_number(j, "seconds", m->seconds);
     cJSON_AddItemToObject(j, "mean", triple(m->mean));
     cJSON_AddItemToObject(j, "mean_standard_error", triple(m->mean_se));
     cJSON_AddItemToObject(j, "channel_ratio", triple(m->channel_ratio));
     cJSON_AddItemToObject(j, "channel_ratio_standard_error", triple(m->ratio_se));
-    add_num(j, "energy_ratio", m->energy_ratio);
+    iris_json_add_number(j, "energy_ratio", m->energy_ratio);
     cJSON_AddNumberToObject(j, "nan_count", (double)m->nan_count);
     cJSON_AddNumberToObject(j, "inf_count", (double)m->inf_count);
     cJSON_AddNumberToObject(j, "dropped_nonfinite_samples", (double)m->dropped_samples);
-    add_num(j, "relmse", m->relmse);
-    add_num(j, "mape", m->mape);
+    iris_json_add_number(j, "relmse", m->relmse);
+    iris_json_add_number(j, "mape", m->mape);
     cJSON_AddStringToObject(j, "reference_variance", m->ref_variance);
     cJSON *b = cJSON_AddObjectToObject(j, "blocks");
     cJSON_AddNumberToObject(b, "block", m->blocks.block);
     cJSON_AddNumberToObject(b, "tiles", (double)m->blocks.tiles_x * m->blocks.tiles_y);
     cJSON_AddNumberToObject(b, "compared", m->blocks.compared);
-    add_num(b, "max_rel_dev", m->blocks.signed_max_rel_dev);
+    iris_json_add_number(b, "max_rel_dev", m->blocks.signed_max_rel_dev);
     cJSON *at = cJSON_AddArrayToObject(b, "max_at_pixel");
     cJSON_AddItemToArray(at, cJSON_CreateNumber(m->blocks.max_tile_x * m->blocks.block));
     cJSON_AddItemToArray(at, cJSON_CreateNumber(m->blocks.max_tile_y * m->blocks.block));
-    add_num(b, "rms_rel_dev", m->blocks.rms_rel_dev);
+    iris_json_add_number(b, "rms_rel_dev", m->blocks.rms_rel_dev);
     cJSON_AddNumberToObject(b, "z_tests", (double)m->blocks.z_tests);
-    add_num(b, "max_abs_z", m->blocks.max_abs_z);
-    add_num(b, "z_crit", m->blocks.z_crit);
+    iris_json_add_number(b, "max_abs_z", m->blocks.max_abs_z);
+    iris_json_add_number(b, "z_crit", m->blocks.z_crit);
     cJSON_AddNumberToObject(b, "z_over", (double)m->blocks.z_over);
     cJSON_AddNumberToObject(b, "zero_variance_mismatches", (double)m->blocks.z_degenerate_fail);
     cJSON_AddBoolToObject(b, "passed", m->blocks.passed);
     cJSON *z = cJSON_AddObjectToObject(j, "pixels");
     cJSON_AddNumberToObject(z, "tests", (double)m->pixels.tests);
-    add_num(z, "max_abs_z", m->pixels.max_abs_z);
+    iris_json_add_number(z, "max_abs_z", m->pixels.max_abs_z);
     cJSON *zat = cJSON_AddArrayToObject(z, "max_at");
     cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_x));
     cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_y));
     cJSON_AddItemToArray(zat, cJSON_CreateNumber(m->pixels.max_c));
-    add_num(z, "z_crit", m->pixels.z_crit);
+    iris_json_add_number(z, "z_crit", m->pixels.z_crit);
     cJSON_AddNumberToObject(z, "over_crit", (double)m->pixels.over_crit);
-    add_num(z, "count_threshold", m->pixels.count_threshold);
+    iris_json_add_number(z, "count_threshold", m->pixels.count_threshold);
     cJSON_AddNumberToObject(z, "over_count", (double)m->pixels.over_count);
-    add_num(z, "expected_over", m->pixels.expected_over);
-    add_num(z, "allowed_over", m->pixels.allowed_over);
+    iris_json_add_number(z, "expected_over", m->pixels.expected_over);
+    iris_json_add_number(z, "allowed_over", m->pixels.allowed_over);
     cJSON_AddNumberToObject(z, "zero_variance", (double)m->pixels.degenerate);
     cJSON_AddNumberToObject(z, "zero_variance_mismatches", (double)m->pixels.degenerate_fail);
     cJSON_AddBoolToObject(z, "bonferroni_passed", m->pixels.bonferroni_passed);
@@ -159,14 +152,7 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
     cJSON_AddBoolToObject(j, "passed", m->passed);
     cJSON_AddItemToArray(ms, j);
   }
-  char *text = cJSON_Print(o);
-  cJSON_Delete(o);
-  if (!text) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
-  size_t len = strlen(text);
-  text[len] = '\n';
-  iris_status st = iris_file_write_atomic(path, text, len + 1, err);
-  free(text);
-  return st;
+  return iris_json_write_file(o, path, err);
 }
 
 /* ---- report.html ------------------------------------------------------- */

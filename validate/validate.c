@@ -20,6 +20,7 @@
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 #include "validate/blender_run.h"
+#include "validate/json_out.h"
 #include "validate/report.h"
 
 /* Stored references: size chosen small enough for git (ZIP float EXR, well
@@ -690,16 +691,7 @@ iris_status iris_validate_refresh(const iris_refresh_params *params, iris_error 
       cJSON_AddItemToArray(jm, cJSON_CreateNumber(mean[c]));
       cJSON_AddItemToArray(js, cJSON_CreateNumber(mean_se[c]));
     }
-    char *text = cJSON_Print(o);
-    cJSON_Delete(o);
-    if (!text) {
-      st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
-    } else {
-      size_t len = strlen(text);
-      text[len] = '\n'; /* the file ends in a newline, not a NUL */
-      st = iris_file_write_atomic(out_json, text, len + 1, err);
-      free(text);
-    }
+    st = iris_json_write_file(o, out_json, err);
     if (st != IRIS_OK) remove(out_exr);
   }
   iris_image_destroy(&ref);
