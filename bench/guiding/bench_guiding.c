@@ -16,8 +16,25 @@
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
+#include "validate/metrics.h"
 
 static double rel_mse(const iris_film *film, const iris_image *ref, int *ok);
+
+/* The reference as an R,G,B image: EXR files keep channels sorted by name
+ * (B, G, R, ...), and the error loops below walk R, G, B as consecutive channels. */
+static bool ref_to_rgb(iris_image *ref, iris_error *err) {
+  static const char *const names[3] = {"R", "G", "B"};
+  int src[3];
+  for (int c = 0; c < 3; ++c)
+    if ((src[c] = iris_image_channel(ref, names[c])) < 0) return false;
+  iris_image rgb;
+  if (iris_image_create(&rgb, ref->width, ref->height, 3, names, err) != IRIS_OK) return false;
+  for (size_t i = 0; i < (size_t)ref->width * (size_t)ref->height; ++i)
+    for (int c = 0; c < 3; ++c) rgb.data[i * 3 + (size_t)c] = ref->data[i * (size_t)ref->channel_count + (size_t)src[c]];
+  iris_image_destroy(ref);
+  *ref = rgb;
+  return true;
+}
 static const char *g_errmap = NULL; /* --errmap FILE.png: per-pixel relSE (mean of channels) */
 
 /* CPU seconds of the whole process (all threads): on a shared, loaded machine
@@ -105,13 +122,19 @@ int main(int argc, char **argv) {
     fprintf(stderr, "iris: %s\n", b);
     return 1;
   }
-  double rmse = -1.0;
+  double rmse = -1.0, rmse_drop = -1.0;
   if (ref_path) {
     iris_image ref;
-    if (iris_exr_read(ref_path, &ref, NULL, NULL, &err) == IRIS_OK) {
+    if (iris_exr_read(ref_path, &ref, NULL, NULL, &err) == IRIS_OK && ref_to_rgb(&ref, &err)) {
       int ok = 0;
       rmse = rel_mse(&res.film, &ref, &ok);
       if (!ok) rmse = -2.0;
+      iris_image img;
+      if (ok && iris_film_to_image(&res.film, false, &img, &err) == IRIS_OK) {
+        rmse_drop = iris_metric_relmse(&img, iris_image_channel(&img, "R"), &ref,
+                                       iris_image_channel(&ref, "R"), IRIS_METRIC_EPS, IRIS_METRIC_DROP);
+        iris_image_destroy(&img);
+      }
       iris_image_destroy(&ref);
     }
   }
@@ -122,10 +145,10 @@ int main(int argc, char **argv) {
    * tiny and the same for every method). */
   double samples = (double)res.spp * (double)res.film.width * (double)res.film.height;
   printf("%s %s spp=%d render_s=%.2f setup_s=%.2f guide_cpu=%.3f render_cpu=%.3f "
-         "ksamples_per_cpu_s=%.1f rays_per_path=%.2f relMSE=%.6g\n",
+         "ksamples_per_cpu_s=%.1f rays_per_path=%.2f relMSE=%.6g relMSE_drop=%.6g\n",
          scene_name, argv[2], res.spp, res.seconds, res.setup_seconds, g_guide_cpu,
          cpu_total - g_guide_cpu, samples / (cpu_total - g_guide_cpu) * 1e-3,
-         (double)(res.stats.rays + res.stats.shadow_rays) / (double)(res.stats.paths ? res.stats.paths : 1), rmse);
+         (double)(res.stats.rays + res.stats.shadow_rays) / (double)(res.stats.paths ? res.stats.paths : 1), rmse, rmse_drop);
   iris_render_result_destroy(&res);
   iris_scene_destroy(scene);
   return 0;
