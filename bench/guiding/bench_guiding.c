@@ -145,10 +145,11 @@ int main(int argc, char **argv) {
    * tiny and the same for every method). */
   double samples = (double)res.spp * (double)res.film.width * (double)res.film.height;
   printf("%s %s spp=%d render_s=%.2f setup_s=%.2f guide_cpu=%.3f render_cpu=%.3f "
-         "ksamples_per_cpu_s=%.1f rays_per_path=%.2f relMSE=%.6g relMSE_drop=%.6g\n",
+         "ksamples_per_cpu_s=%.1f rays_per_path=%.2f shadow_per_path=%.2f relMSE=%.6g relMSE_drop=%.6g\n",
          scene_name, argv[2], res.spp, res.seconds, res.setup_seconds, g_guide_cpu,
          cpu_total - g_guide_cpu, samples / (cpu_total - g_guide_cpu) * 1e-3,
-         (double)(res.stats.rays + res.stats.shadow_rays) / (double)(res.stats.paths ? res.stats.paths : 1), rmse, rmse_drop);
+         (double)(res.stats.rays + res.stats.shadow_rays) / (double)(res.stats.paths ? res.stats.paths : 1),
+         (double)res.stats.shadow_rays / (double)(res.stats.paths ? res.stats.paths : 1), rmse, rmse_drop);
   iris_render_result_destroy(&res);
   iris_scene_destroy(scene);
   return 0;
