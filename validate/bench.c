@@ -126,9 +126,43 @@ static int find_channel(const iris_image *img, const char *name) {
   return -1;
 }
 
-/* Reads an EXR into a 3-channel R, G, B image; all values must be finite. */
+/* The expected relMSE of an image against the exact one, from its variance
+ * channels (var.R/G/B: variance of each pixel's mean): mean over pixels of
+ * (1/3) sum_c var_c / (value_c^2 + eps). Every relMSE measured against a
+ * reference contains about this much of the reference's own noise. -1 when
+ * the image has no variance channels. */
+static double own_relmse(const iris_image *img) {
+  static const char *const names[3] = {"R", "G", "B"}, *const vnames[3] = {"var.R", "var.G", "var.B"};
+  int c0[3], v0[3];
+  for (int c = 0; c < 3; c++) {
+    c0[c] = iris_image_channel(img, names[c]);
+    v0[c] = iris_image_channel(img, vnames[c]);
+    if (c0[c] < 0 || v0[c] < 0) return -1.0;
+  }
+  size_t n = (size_t)img->width * (size_t)img->height;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++) {
+      double r = img->data[i * (size_t)img->channel_count + (size_t)c0[c]];
+      double v = img->data[i * (size_t)img->channel_count + (size_t)v0[c]];
+      if (isfinite(v) && v > 0.0) sum += v / (r * r + IRIS_METRIC_EPS) / 3.0;
+    }
+  return n ? sum / (double)n : -1.0;
+}
+
+/* Appends "; own relMSE X" to a reference description (X from own_relmse). */
+static void describe_own_relmse(iris_bench_scene *sc, double own) {
+  sc->reference_relmse = own;
+  if (!(own >= 0.0)) return;
+  size_t len = strlen(sc->reference_description);
+  snprintf(sc->reference_description + len, sizeof sc->reference_description - len,
+           "; its own relMSE ~%.2g", own);
+}
+
+/* Reads an EXR into a 3-channel R, G, B image; all values must be finite.
+ * *own (if not NULL) gets own_relmse of the file (-1 without variance). */
 static iris_status read_rgb(const char *path, iris_image *out, char *renderer, size_t rsize,
-                            int *spp, iris_error *err) {
+                            int *spp, double *own, iris_error *err) {
   iris_image raw;
   memset(&raw, 0, sizeof raw);
   iris_image_meta *meta = NULL;
@@ -147,6 +181,7 @@ static iris_status read_rgb(const char *path, iris_image *out, char *renderer, s
     if (spp && strcmp(meta[i].key, "iris:spp") == 0) *spp = atoi(meta[i].value);
   }
   free(meta);
+  if (own) *own = own_relmse(&raw);
   static const char *const names[3] = {"R", "G", "B"};
   int src[3];
   for (int c = 0; c < 3; c++) src[c] = find_channel(&raw, names[c]);
@@ -361,11 +396,13 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
     int got_spp = 0;
     iris_error e2;
     iris_error_clear(&e2);
-    if (read_rgb(sc->reference, &bs->ref, renderer, sizeof renderer, &got_spp, &e2) == IRIS_OK &&
+    double own = -1.0;
+    if (read_rgb(sc->reference, &bs->ref, renderer, sizeof renderer, &got_spp, &own, &e2) == IRIS_OK &&
         bs->ref.width == sc->width && bs->ref.height == sc->height) {
       bs->have_ref = true;
       snprintf(sc->reference_description, sizeof sc->reference_description,
                "iris mis, %d spp, seed %u (cached)", spp, REFERENCE_SEED);
+      describe_own_relmse(sc, own);
       if (!p->quiet) iris_infof("bench: %s: cached reference %s", sc->name, sc->reference);
       return IRIS_OK;
     }
@@ -389,12 +426,19 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
   }
   st = iris_render_write_exr(&rr, sc->reference, sc->input, true, err);
   if (st == IRIS_OK) st = iris_film_to_image(&rr.film, false, &bs->ref, err);
+  double own = -1.0;
+  iris_image with_var;
+  if (st == IRIS_OK && iris_film_to_image(&rr.film, true, &with_var, err) == IRIS_OK) {
+    own = own_relmse(&with_var);
+    iris_image_destroy(&with_var);
+  }
   iris_render_result_destroy(&rr);
   if (st != IRIS_OK) return st;
   bs->have_ref = true;
   snprintf(sc->reference_description, sizeof sc->reference_description,
            "iris mis, %d spp, seed %u (rendered in %.0f s)", spp, REFERENCE_SEED,
            now_seconds() - ctx->run_start);
+  describe_own_relmse(sc, own);
   return IRIS_OK;
 }
 
@@ -452,7 +496,7 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
     if (st != IRIS_OK) return st;
     if (!res->cycles_version[0]) snprintf(res->cycles_version, sizeof res->cycles_version, "%s", info.version);
     iris_image img;
-    st = read_rgb(exr, &img, NULL, 0, NULL, err);
+    st = read_rgb(exr, &img, NULL, 0, NULL, NULL, err);
     if (st != IRIS_OK) return st;
     if (img.width != sc->width || img.height != sc->height) {
       iris_image_destroy(&img);
@@ -564,6 +608,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
   for (int i = 0; i < p.input_count && st == IRIS_OK; i++) {
     iris_bench_scene *sc = &res->scenes[i];
     snprintf(sc->input, sizeof sc->input, "%s", p.inputs[i]);
+    sc->reference_relmse = -1.0;
     st = iris_validate_load_scene(p.inputs[i], NULL, &bs[i].scene, err);
     if (st != IRIS_OK) break;
     scene_label(res, p.inputs[i], sc->name, sizeof sc->name);
@@ -574,7 +619,8 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
     int rw = 0, rh = 0;
     if (p.references) {
       char renderer[256];
-      st = read_rgb(p.references[i], &bs[i].ref, renderer, sizeof renderer, &sc->reference_spp, err);
+      double own = -1.0;
+      st = read_rgb(p.references[i], &bs[i].ref, renderer, sizeof renderer, &sc->reference_spp, &own, err);
       if (st != IRIS_OK) break;
       bs[i].have_ref = true;
       rw = bs[i].ref.width;
@@ -585,6 +631,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
                  renderer, sc->reference_spp);
       else
         snprintf(sc->reference_description, sizeof sc->reference_description, "%.200s (given)", renderer);
+      describe_own_relmse(sc, own);
     }
     st = resolve_size(&p, bs[i].scene, p.inputs[i], rw, rh, &sc->width, &sc->height, err);
     if (st == IRIS_OK && bs[i].have_ref && (rw != sc->width || rh != sc->height))
@@ -759,6 +806,7 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddStringToObject(r, "path", sc->reference);
     cJSON_AddStringToObject(r, "description", sc->reference_description);
     cJSON_AddNumberToObject(r, "spp", sc->reference_spp);
+    iris_json_add_number(r, "own_relmse", sc->reference_relmse >= 0.0 ? sc->reference_relmse : NAN);
     iris_json_add_number(j, "target_relmse", sc->target_relmse > 0 ? sc->target_relmse : NAN);
     cJSON *im = cJSON_AddArrayToObject(j, "images");
     for (int k = 0; k < sc->image_count; k++) {

@@ -86,6 +86,8 @@ typedef struct iris_bench_scene {
   char reference[1024];  /* the EXR used */
   char reference_description[256];
   int reference_spp;
+  double reference_relmse; /* the reference's own expected relMSE, from its variance channels
+                              (contained in every measured relMSE); < 0 unknown */
   double target_relmse;  /* used for the time-to-target column */
   char images[IRIS_METHOD_COUNT + 2][64]; /* preview PNG names in DIR/images: reference, methods, cycles */
   int image_count;

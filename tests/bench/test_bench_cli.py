@@ -104,6 +104,18 @@ def main(argv):
     check(sc["name"] == "cornell-box" and sc["height"] == 32 and sc["width"] == 32,
           f"scene size from --height and the aspect: {sc}")
     check(sc["reference"]["spp"] == 2048, "reference spp")
+    # The reference's own relMSE (from its variance channels) predicts mis's measured
+    # relMSE: the run's own error (same per-sample variance, 2048/spp times the
+    # reference's) plus the reference's. A wrong variance scale (e.g. per-sample
+    # instead of the mean's) misses by ~2048x.
+    own = sc["reference"].get("own_relmse")
+    if check(isinstance(own, float) and own > 0, f"reference own_relmse: {own}"):
+        check("its own relMSE" in sc["reference"]["description"], "own relMSE in the description")
+        for b, r in mis.items():
+            predicted = own * (2048 / int(r["spp"]) + 1)
+            q = float(r["relmse"]) / predicted
+            check(0.5 < q < 2.0, f"mis at {b} s: relMSE {r['relmse']} vs predicted {predicted:.4g} from "
+                  f"the reference's own {own:.4g} ({r['spp']} spp)")
     check(js["outputs"]["charts"] is True, "charts drawn")
 
     # tables
