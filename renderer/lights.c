@@ -428,6 +428,17 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     }
     out->total_power = total;
     iris_status st = iris_distrib1d_create(&out->select, w, n, err);
+    /* By area: the triangles keep their total share of the power, split by area. */
+    double tri_power = 0.0, tri_area = 0.0;
+    for (size_t i = 0; i < n; i++)
+      if (out->entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE) {
+        tri_power += out->entries[i].power;
+        tri_area += out->entries[i].area;
+      }
+    for (size_t i = 0; i < n; i++)
+      if (out->entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE)
+        w[i] = tri_area > 0.0 ? (float)(tri_power * out->entries[i].area / tri_area) : 0.0f;
+    if (st == IRIS_OK) st = iris_distrib1d_create(&out->select_area, w, n, err);
     free(w);
     if (st != IRIS_OK) {
       iris_lights_destroy(out);
@@ -449,6 +460,7 @@ void iris_lights_destroy(iris_lights *lights) {
   lights->tri_count = 0;
   free(lights->light_of_prim);
   iris_distrib1d_destroy(&lights->select);
+  iris_distrib1d_destroy(&lights->select_area);
   lights->entries = NULL;
   lights->light_of_prim = NULL;
   lights->count = 0;
@@ -619,9 +631,16 @@ float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris
 
 bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
                                  float u2, float u3, iris_photon_emission *e) {
+  return iris_lights_sample_emission_by(lights, IRIS_EMIT_BY_POWER, u_select, u0, u1, u2, u3, e);
+}
+
+bool iris_lights_sample_emission_by(const iris_lights *lights, iris_emission_selection by,
+                                    float u_select, float u0, float u1, float u2, float u3,
+                                    iris_photon_emission *e) {
   if (lights->count == 0) return false;
   float pmf, u_side;
-  uint32_t i = (uint32_t)iris_distrib1d_sample(&lights->select, u_select, &pmf, &u_side);
+  const iris_distrib1d *d = by == IRIS_EMIT_BY_AREA ? &lights->select_area : &lights->select;
+  uint32_t i = (uint32_t)iris_distrib1d_sample(d, u_select, &pmf, &u_side);
   if (!(pmf > 0.0f)) return false;
   const iris_light_entry *le = &lights->entries[i];
   memset(e, 0, sizeof *e);

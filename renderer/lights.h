@@ -96,6 +96,8 @@ typedef struct iris_lights {
   iris_light_tri *tris;   /* entries [0, tri_count) are the triangles (64-byte aligned) */
   size_t tri_count;
   iris_distrib1d select;  /* over entries, in proportion to power (photon emission) */
+  iris_distrib1d select_area; /* photon emission "by area": emissive triangles in proportion to
+                                 area (sharing the triangles' total power share), others by power */
   iris_light_group *groups;
   size_t group_count;
   uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
@@ -185,11 +187,23 @@ typedef struct iris_photon_emission {
   float pdf_dir;     /* solid-angle density of dir */
 } iris_photon_emission;
 
+/* How photon emission picks a light: in proportion to power (every photon of
+ * a light-only scene carries the same energy) or, as the thesis does, emissive
+ * triangles in proportion to area (docs/guiding.md, "Preprocessing"). */
+typedef enum iris_emission_selection {
+  IRIS_EMIT_BY_POWER = 0,
+  IRIS_EMIT_BY_AREA = 1
+} iris_emission_selection;
+
 /* Samples a light in proportion to power, a point on it and an emission
  * direction (cosine-weighted for triangles, uniform for point/spot, a disk
  * covering the scene for directional/environment) from five uniform numbers. */
 bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
                                  float u2, float u3, iris_photon_emission *e);
+/* The same with the light chosen as `by` says. */
+bool iris_lights_sample_emission_by(const iris_lights *lights, iris_emission_selection by,
+                                    float u_select, float u0, float u1, float u2, float u3,
+                                    iris_photon_emission *e);
 
 #ifdef __cplusplus
 }

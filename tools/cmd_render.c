@@ -60,6 +60,8 @@ static void print_help(void) {
       "      --alpha-max A   cap on the cache-sampling probability (default 0.5)\n"
       "      --cos-min C     cache normal agreement needed (default 0.9)\n"
       "      --splat nearest|bilinear   photon splatting (default bilinear)\n"
+      "      --photon-lights power|area   photons leave lights in proportion to\n"
+      "                      power (default) or, as the thesis, emitters by area\n"
       "      --force-guiding build caches even where guiding would be skipped\n"
       "      --dump-caches DIR   write pdf and photon-count PNGs of the caches that\n"
       "                      serve a 4x3 grid of pixels (DIR/caches.txt lists them)\n"
@@ -133,7 +135,8 @@ static bool parse_bounds(const char *text, iris_pixel_bounds *b) {
 static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
   uint64_t h = 0x6a1d1e5ULL;
   double v[] = {(double)gp->photons, (double)gp->caches, gp->cache_res, gp->cache_k,
-                gp->pdf_floor, gp->alpha_max, gp->cos_min, (double)gp->splat, gp->force};
+                gp->pdf_floor, gp->alpha_max, gp->cos_min, (double)gp->splat, gp->force,
+                (double)gp->photon_lights};
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
     uint64_t bits;
     memcpy(&bits, &v[i], sizeof bits);
@@ -284,6 +287,14 @@ int iris_cmd_render(int argc, char **argv) {
         gp.splat = IRIS_SPLAT_BILINEAR;
       else
         return iris_cli_usage_error(CMD, "unknown splat mode '%s' (nearest, bilinear)", val);
+    } else if (strcmp(a, "--photon-lights") == 0) {
+      NEED_VALUE();
+      if (strcmp(val, "power") == 0)
+        gp.photon_lights = IRIS_EMIT_BY_POWER;
+      else if (strcmp(val, "area") == 0)
+        gp.photon_lights = IRIS_EMIT_BY_AREA;
+      else
+        return iris_cli_usage_error(CMD, "unknown photon light choice '%s' (power, area)", val);
     } else if (strcmp(a, "--force-guiding") == 0) {
       gp.force = true;
     } else if (strcmp(a, "--dump-caches") == 0) {

@@ -1,6 +1,6 @@
 /* bench_guiding SCENE METHOD (--time S | --spp N) [--ref REF.exr] [-o OUT.exr]
  *               [--photons N] [--caches N] [--cache-res R] [--cache-k K]
- *               [--pdf-floor F] [--alpha-max A] [--cos-min C] [--bilinear]
+ *               [--pdf-floor F] [--alpha-max A] [--cos-min C] [--bilinear | --nearest]
  *               [--width W --height H] [--threads T] [--seed S]
  * Renders a built-in scene (or `door`) with iris_render and the guiding
  * provider, prints one line: scene method spp seconds setup relMSE. relMSE is
@@ -85,7 +85,10 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--cos-min")) gp.cos_min = (float)atof(v), ++i;
     else if (!strcmp(a, "--errmap")) g_errmap = v, ++i;
     else if (!strcmp(a, "--bilinear")) gp.splat = IRIS_SPLAT_BILINEAR;
+    else if (!strcmp(a, "--nearest")) gp.splat = IRIS_SPLAT_NEAREST;
     else if (!strcmp(a, "--no-adjoint-rr")) gp.adjoint_rr = false;
+    else if (!strcmp(a, "--photon-lights-area")) gp.photon_lights = IRIS_EMIT_BY_AREA;
+    else if (!strcmp(a, "--force")) gp.force = true;
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
     else if (!strcmp(a, "--width")) p.width = atoi(v), ++i;
     else if (!strcmp(a, "--height")) p.height = atoi(v), ++i;

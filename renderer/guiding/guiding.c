@@ -213,7 +213,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   iris_guiding_params *p = &g->params;
   double t0 = iris_time_now();
   iris_photon_map photons;
-  iris_status st = iris_photons_trace(s, (uint64_t)p->photons, &photons, err);
+  iris_status st = iris_photons_trace(s, p->photon_lights, (uint64_t)p->photons, &photons, err);
   if (st != IRIS_OK) return st;
   g->stats.photon_paths = photons.paths;
   g->stats.photons_stored = photons.count;

@@ -49,6 +49,8 @@ typedef struct iris_guiding_params {
   bool use_nee;         /* the render also samples lights (guided-nee): skip if lit only directly */
   int direct_photons;   /* splat photons straight from a light: -1 auto (not with NEE), 0 no, 1 yes */
   bool adjoint_rr;      /* Russian roulette from the caches' radiance estimates (default on) */
+  iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
+                                            area (thesis; --photon-lights) */
   /* Inspection (outputs of the build, NULL = off): */
   const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
                                  serving a 4 x 3 grid of pixels (docs/guiding.md) */

@@ -19,6 +19,7 @@ typedef struct photon_block {
 
 typedef struct trace_ctx {
   const iris_guide_setup *setup;
+  iris_emission_selection by;
   uint64_t paths;
   photon_block *blocks;
 } trace_ctx;
@@ -38,12 +39,13 @@ static void block_push(photon_block *b, const iris_photon *ph) {
   b->items[b->count++] = *ph;
 }
 
-static void trace_path(const iris_guide_setup *s, uint64_t index, photon_block *out) {
+static void trace_path(const iris_guide_setup *s, iris_emission_selection by, uint64_t index,
+                       photon_block *out) {
   iris_sampler rng = iris_sampler_start(s->seed, index, PHOTON_SAMPLE_INDEX);
   float us = iris_sampler_next(&rng), u0 = iris_sampler_next(&rng), u1 = iris_sampler_next(&rng),
         u2 = iris_sampler_next(&rng), u3 = iris_sampler_next(&rng);
   iris_photon_emission e;
-  if (!iris_lights_sample_emission(s->lights, us, u0, u1, u2, u3, &e)) return;
+  if (!iris_lights_sample_emission_by(s->lights, by, us, u0, u1, u2, u3, &e)) return;
   iris_vec3 beta = e.power;
   if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;
   iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
@@ -88,18 +90,18 @@ static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   for (uint64_t b = begin; b < end; ++b) {
     uint64_t lo = b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
     if (hi > c->paths) hi = c->paths;
-    for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, i, &c->blocks[b]);
+    for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->by, i, &c->blocks[b]);
   }
 }
 
-iris_status iris_photons_trace(const iris_guide_setup *setup, uint64_t paths,
-                               iris_photon_map *out, iris_error *err) {
+iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_selection by,
+                               uint64_t paths, iris_photon_map *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   if (paths == 0 || setup->lights->count == 0) return IRIS_OK;
   uint64_t nblocks = (paths + BLOCK_PATHS - 1) / BLOCK_PATHS;
   photon_block *blocks = calloc(nblocks, sizeof *blocks);
   if (!blocks) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
-  trace_ctx c = {setup, paths, blocks};
+  trace_ctx c = {setup, by, paths, blocks};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
   size_t total = 0;
   bool oom = false;

@@ -39,8 +39,8 @@ typedef struct iris_photon_map {
   uint64_t indirect;  /* stored photons with bounce >= 1 */
 } iris_photon_map;
 
-/* Traces `paths` photon paths. */
-iris_status iris_photons_trace(const iris_guide_setup *setup, uint64_t paths,
+/* Traces `paths` photon paths, choosing lights as `by` says. */
+iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
                                iris_photon_map *out, iris_error *err);
 void iris_photons_destroy(iris_photon_map *map);
 

@@ -97,27 +97,51 @@ int main(void) {
     else if (e->kind == IRIS_LIGHT_KIND_ENVIRONMENT)
       expect += 0.02 * 4.0 * IRIS_PI * IRIS_PI * lights.radius * lights.radius;
   }
-  uint64_t st = 99;
-  double sum = 0.0, sum2 = 0.0;
-  const int n = 400000;
-  int bad_dirs = 0;
-  for (int i = 0; i < n; i++) {
-    double u[5];
-    for (int k = 0; k < 5; k++) u[k] = chi2_uniform(&st);
-    iris_photon_emission e;
-    double v = 0.0;
-    if (iris_lights_sample_emission(&lights, (float)u[0], (float)u[1], (float)u[2], (float)u[3], (float)u[4], &e)) {
-      v = e.power.y;
-      if (!(fabsf(iris_length(e.dir) - 1.0f) < 1e-4f)) bad_dirs++;
+  /* Both photon light choices (by power, by area) must give the same total. */
+  for (int by = 0; by < 2; by++) {
+    uint64_t st = 99;
+    double sum = 0.0, sum2 = 0.0;
+    const int n = 400000;
+    int bad_dirs = 0;
+    double tri_hits = 0.0, tri_area_hits = 0.0; /* by area: picks of the largest triangle */
+    size_t big = 0;
+    double tri_area = 0.0;
+    for (size_t i = 0; i < lights.count; i++)
+      if (lights.entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE) {
+        tri_area += lights.entries[i].area;
+        if (lights.entries[i].area > lights.entries[big].area) big = i;
+      }
+    for (int i = 0; i < n; i++) {
+      double u[5];
+      for (int k = 0; k < 5; k++) u[k] = chi2_uniform(&st);
+      iris_photon_emission e;
+      double v = 0.0;
+      if (iris_lights_sample_emission_by(&lights, (iris_emission_selection)by, (float)u[0], (float)u[1],
+                                         (float)u[2], (float)u[3], (float)u[4], &e)) {
+        v = e.power.y;
+        if (!(fabsf(iris_length(e.dir) - 1.0f) < 1e-4f)) bad_dirs++;
+        if (lights.entries[e.light].kind == IRIS_LIGHT_KIND_TRIANGLE) {
+          tri_hits += 1.0;
+          tri_area_hits += e.light == big;
+        }
+      }
+      sum += v;
+      sum2 += v * v;
     }
-    sum += v;
-    sum2 += v * v;
+    CHECK_EQ_INT(bad_dirs, 0);
+    double mean = sum / n, sd = sqrt((sum2 / n - mean * mean) / n);
+    iris_check_record(fabs(mean - expect) <= 4.0 * sd + 1e-4 * expect, __FILE__, __LINE__,
+                      "photon power (%s): mean %.5f, expected %.5f (sigma %.3g)", by ? "area" : "power", mean,
+                      expect, sd);
+    printf("photon power (%s) %.5f vs %.5f (sigma %.3g)\n", by ? "area" : "power", mean, expect, sd);
+    if (by == IRIS_EMIT_BY_AREA && tri_hits > 0.0) {
+      /* Among the triangles, the largest is picked in proportion to its area. */
+      double f = tri_area_hits / tri_hits, want = lights.entries[big].area / tri_area;
+      double sf = sqrt(want * (1.0 - want) / tri_hits);
+      iris_check_record(fabs(f - want) <= 4.0 * sf + 1e-6, __FILE__, __LINE__,
+                        "by area: largest triangle picked %.5f of the time, its area share %.5f", f, want);
+    }
   }
-  CHECK_EQ_INT(bad_dirs, 0);
-  double mean = sum / n, sd = sqrt((sum2 / n - mean * mean) / n);
-  iris_check_record(fabs(mean - expect) <= 4.0 * sd + 1e-4 * expect, __FILE__, __LINE__,
-                    "photon power: mean %.5f, expected %.5f (sigma %.3g)", mean, expect, sd);
-  printf("photon power %.5f vs %.5f (sigma %.3g)\n", mean, expect, sd);
 
   iris_lights_destroy(&lights);
   iris_textures_destroy(&tex);
