@@ -157,7 +157,7 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
   int64_t cam = p->caches / 2 > 0 ? p->caches / 2 : 1;
   int st = (int)lrint(sqrt((double)pixels / (double)cam));
   *stride = st < 1 ? 1 : st;
-  if (p->cache_res <= 0) p->cache_res = 8; /* 16 (thesis-like) is noisier at k = 200: docs/guiding.md */
+  if (p->cache_res <= 0) p->cache_res = 8; /* 12-16 (thesis-like) cost more than they save: docs/guiding.md */
   if (p->cache_k <= 0) p->cache_k = 200;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
