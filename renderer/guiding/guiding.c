@@ -3,6 +3,7 @@
 #include "renderer/guiding/guiding.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -98,16 +99,23 @@ typedef struct fill_ctx {
  * hemisphere caches, arriving from above. The k nearest are searched among
  * these only, so a cache next to a brightly lit thin wall still gets k. */
 typedef struct photon_filter {
-  const iris_photon *photons;
   iris_vec3 n;
   bool sphere;
 } photon_filter;
 
-static bool photon_usable(void *ctx, uint32_t id) {
+/* What the filter reads of a photon, kept in the photon tree's order next to
+ * its position (iris_kdtree_set_payload): the photon's n and wi, adjacent in
+ * iris_photon. */
+typedef struct photon_dirs {
+  iris_vec3 n, wi;
+} photon_dirs;
+
+static bool photon_usable(void *ctx, const void *payload) {
   const photon_filter *f = ctx;
-  const iris_photon *ph = &f->photons[id];
-  if (iris_dot(ph->n, f->n) < PHOTON_NORMAL_COS) return false;
-  return f->sphere || iris_dot(ph->wi, f->n) > 0.0f;
+  photon_dirs ph;
+  memcpy(&ph, payload, sizeof ph);
+  if (iris_dot(ph.n, f->n) < PHOTON_NORMAL_COS) return false;
+  return f->sphere || iris_dot(ph.wi, f->n) > 0.0f;
 }
 
 static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
@@ -120,8 +128,8 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     iris_cache *cache = &g->caches[i];
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
-    photon_filter f = {c->photons->photons, cache->frame.n, cache->sphere != 0};
-    uint32_t n = iris_kdtree_knn_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
+    photon_filter f = {cache->frame.n, cache->sphere != 0};
+    uint32_t n = iris_kdtree_knn_payload_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
     uint32_t used = 0;
     double power = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
@@ -299,7 +307,12 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     photons.count = n;
   }
   if (st == IRIS_OK)
-    st = iris_kdtree_build(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count, err);
+    st = iris_kdtree_build_threads(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
+                                   s->threads, err);
+  _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3),
+                 "photon_dirs mirrors iris_photon's n, wi");
+  if (st == IRIS_OK)
+    st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
   fill_ctx fc = {g, &photons, &ptree, (uint32_t)p->cache_k, NULL, NULL, NULL};

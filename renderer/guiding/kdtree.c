@@ -1,5 +1,5 @@
-/* kd-tree: implicit balanced layout (median of each index range), bounded
- * max-heap search. */
+/* kd-tree: implicit balanced layout (median of each index range, leaves of at
+ * most IRIS_KDTREE_LEAF points), bounded max-heap search. */
 #include "renderer/guiding/kdtree.h"
 
 #include <math.h>
@@ -7,75 +7,177 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef struct build_ctx {
-  float *p;      /* 3 * count */
-  uint32_t *ids;
-  uint8_t *axis;
-} build_ctx;
+#include "core/parallel.h"
 
-static int key_less(const build_ctx *c, uint32_t a, uint32_t b, int ax) {
-  float pa = c->p[3 * a + ax], pb = c->p[3 * b + ax];
-  if (pa != pb) return pa < pb;
-  return c->ids[a] < c->ids[b];
+#define LEAF IRIS_KDTREE_LEAF
+
+/* ---- build ------------------------------------------------------------------ */
+
+/* A point and its index moved as one 16-byte record while partitioning. */
+typedef struct kd_rec {
+  float p[3];
+  uint32_t id;
+} kd_rec;
+
+static void swap_rec(kd_rec *a, kd_rec *b) {
+  kd_rec t = *a;
+  *a = *b;
+  *b = t;
 }
 
-static void swap_items(build_ctx *c, uint32_t a, uint32_t b) {
-  if (a == b) return;
-  for (int k = 0; k < 3; ++k) {
-    float t = c->p[3 * a + k];
-    c->p[3 * a + k] = c->p[3 * b + k];
-    c->p[3 * b + k] = t;
-  }
-  uint32_t t = c->ids[a];
-  c->ids[a] = c->ids[b];
-  c->ids[b] = t;
+/* (coordinate ax, index) order: distinct keys, so equal coordinates cost
+ * nothing special. Branch-free: the outcome is a coin flip on random points. */
+static inline uint32_t rec_less(const kd_rec *a, float v, uint32_t vid, int ax) {
+  float k = a->p[ax];
+  return (uint32_t)(k < v) | ((uint32_t)(k == v) & (uint32_t)(a->id < vid));
 }
 
-/* Quickselect: puts the element of rank m (by key) at m, smaller keys before. */
-static void select_nth(build_ctx *c, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
-  while (hi - lo > 1) {
-    uint32_t mid = lo + (hi - lo) / 2;
-    swap_items(c, mid, hi - 1); /* pivot at the end */
-    uint32_t store = lo;
-    for (uint32_t i = lo; i < hi - 1; ++i) {
-      if (key_less(c, i, hi - 1, ax)) swap_items(c, i, store++);
+#define SAMPLE 31
+
+/* A pivot for finding rank m in [lo, hi): the element of about m's relative
+ * rank among SAMPLE evenly spaced items (median of three for short ranges),
+ * so each partition cuts close to m. */
+static inline uint32_t choose_pivot(const kd_rec *r, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
+  uint32_t n = hi - lo;
+  if (n < 1024) {
+    uint32_t a = lo, b = lo + n / 2, c = hi - 1;
+    if (rec_less(&r[b], r[a].p[ax], r[a].id, ax)) { uint32_t t = a; a = b; b = t; }
+    if (rec_less(&r[c], r[b].p[ax], r[b].id, ax)) {
+      b = c;
+      if (rec_less(&r[b], r[a].p[ax], r[a].id, ax)) b = a;
     }
-    swap_items(c, store, hi - 1);
+    return b;
+  }
+  uint32_t idx[SAMPLE];
+  for (uint32_t j = 0; j < SAMPLE; ++j) { /* insertion sort of the sample by key */
+    uint32_t x = lo + (uint32_t)(((uint64_t)n * (2 * j + 1)) / (2 * SAMPLE)), i = j;
+    while (i > 0 && rec_less(&r[x], r[idx[i - 1]].p[ax], r[idx[i - 1]].id, ax)) {
+      idx[i] = idx[i - 1];
+      --i;
+    }
+    idx[i] = x;
+  }
+  return idx[(uint32_t)(((uint64_t)(m - lo) * SAMPLE) / n)];
+}
+
+/* Quickselect: puts the element of rank m (by key) at m, smaller keys before,
+ * larger after. Branch-free partitions: the smaller keys are compacted in
+ * place, the others go to tmp[lo, hi) and are copied back after them, so no load
+ * waits for the previous comparison. Short ranges by insertion. */
+static inline void select_nth(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
+  while (hi - lo > 16) {
+    uint32_t piv = choose_pivot(r, lo, hi, m, ax), last = hi - 1;
+    swap_rec(&r[piv], &r[last]);
+    const kd_rec pv = r[last];
+    uint32_t store = lo, right = 0;
+    for (uint32_t i = lo; i < last; ++i) {
+      kd_rec x = r[i];
+      uint32_t lt = rec_less(&x, pv.p[ax], pv.id, ax);
+      r[store] = x; /* store <= i: already read */
+      tmp[lo + right] = x;
+      store += lt;
+      right += lt ^ 1u;
+    }
+    r[store] = pv;
+    memcpy(&r[store + 1], &tmp[lo], sizeof(kd_rec) * right);
     if (store == m) return;
     if (m < store) hi = store;
     else lo = store + 1;
   }
+  for (uint32_t i = lo + 1; i < hi; ++i) {
+    kd_rec x = r[i];
+    uint32_t j = i;
+    while (j > lo && rec_less(&x, r[j - 1].p[ax], r[j - 1].id, ax)) {
+      r[j] = r[j - 1];
+      --j;
+    }
+    r[j] = x;
+  }
 }
 
-static void build_range(build_ctx *c, uint32_t lo, uint32_t hi) {
-  while (hi > lo) {
-    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (uint32_t i = lo; i < hi; ++i) {
-      for (int k = 0; k < 3; ++k) {
-        float v = c->p[3 * i + k]; /* plain compares: fminf is a libm call here */
-        mn[k] = v < mn[k] ? v : mn[k];
-        mx[k] = v > mx[k] ? v : mx[k];
-      }
+/* Splits [lo, hi) at its median along the widest extent of its points. */
+static uint32_t split_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi) {
+  float mn[4] = {INFINITY, INFINITY, INFINITY, INFINITY}, mx[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  for (uint32_t i = lo; i < hi; ++i) {
+    float v[4]; /* all four lanes (the id's bits in the last, ignored): one vector min/max */
+    memcpy(v, &r[i], sizeof v);
+    for (int k = 0; k < 4; ++k) { /* plain compares: fminf is a libm call here */
+      mn[k] = v[k] < mn[k] ? v[k] : mn[k];
+      mx[k] = v[k] > mx[k] ? v[k] : mx[k];
     }
-    int ax = 0;
-    for (int k = 1; k < 3; ++k)
-      if (mx[k] - mn[k] > mx[ax] - mn[ax]) ax = k;
-    uint32_t m = lo + (hi - lo) / 2;
-    select_nth(c, lo, hi, m, ax);
-    c->axis[m] = (uint8_t)ax;
-    build_range(c, lo, m);
+  }
+  int ax = 0;
+  for (int k = 1; k < 3; ++k)
+    if (mx[k] - mn[k] > mx[ax] - mn[ax]) ax = k;
+  uint32_t m = lo + (hi - lo) / 2;
+  switch (ax) { /* a constant axis in each copy: keys at fixed offsets */
+  case 0: select_nth(r, tmp, lo, hi, m, 0); break;
+  case 1: select_nth(r, tmp, lo, hi, m, 1); break;
+  default: select_nth(r, tmp, lo, hi, m, 2); break;
+  }
+  axis[m] = (uint8_t)ax;
+  return m;
+}
+
+/* tmp: scratch records, [lo, hi) used. */
+static void build_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi) {
+  while (hi - lo > LEAF) {
+    uint32_t m = split_range(r, tmp, axis, lo, hi);
+    build_range(r, tmp, axis, lo, m);
     lo = m + 1; /* loop instead of recursing on the right half */
   }
 }
 
-iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
-                              iris_error *err) {
+typedef struct build_task {
+  uint32_t lo, hi;
+} build_task;
+
+typedef struct build_ctx {
+  kd_rec *r, *tmp;
+  uint8_t *axis;
+  build_task *tasks;
+  uint32_t task_count;
+} build_ctx;
+
+/* The top `depth` levels, serially; the ranges below become tasks. */
+static void build_top(build_ctx *c, uint32_t lo, uint32_t hi, int depth) {
+  if (hi - lo <= LEAF) return;
+  if (depth == 0) {
+    c->tasks[c->task_count].lo = lo;
+    c->tasks[c->task_count].hi = hi;
+    c->task_count++;
+    return;
+  }
+  uint32_t m = split_range(c->r, c->tmp, c->axis, lo, hi);
+  build_top(c, lo, m, depth - 1);
+  build_top(c, m + 1, hi, depth - 1);
+}
+
+static void build_tasks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  build_ctx *c = ctx;
+  for (uint64_t t = begin; t < end; ++t) build_range(c->r, c->tmp, c->axis, c->tasks[t].lo, c->tasks[t].hi);
+}
+
+iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
+                                      int threads, iris_error *err) {
   memset(tree, 0, sizeof(*tree));
   if (count == 0) return IRIS_OK;
+  if (threads <= 0) threads = iris_parallel_default_threads();
+  /* Subtrees of at least ~16k points per task are worth a thread; 2 tasks per
+   * thread balance the load. The layout does not depend on who builds what. */
+  int depth = 0;
+  if (threads > 1)
+    while (depth < 8 && (1 << depth) < 2 * threads && (count >> (depth + 1)) >= 16384) ++depth;
+  kd_rec *r = malloc(sizeof(kd_rec) * (size_t)count), *tmp = malloc(sizeof(kd_rec) * (size_t)count);
+  build_task *tasks = malloc(sizeof(build_task) << depth);
   tree->points = malloc(sizeof(float) * 3 * (size_t)count);
   tree->ids = malloc(sizeof(uint32_t) * count);
-  tree->axis = malloc(count);
-  if (!tree->points || !tree->ids || !tree->axis) {
+  tree->axis = calloc(count, 1);
+  if (!r || !tmp || !tasks || !tree->points || !tree->ids || !tree->axis) {
+    free(r);
+    free(tmp);
+    free(tasks);
     iris_kdtree_destroy(tree);
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree of %u points",
                           count);
@@ -83,11 +185,40 @@ iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride
   tree->count = count;
   const unsigned char *b = base;
   for (uint32_t i = 0; i < count; ++i) {
-    memcpy(&tree->points[3 * (size_t)i], b + (size_t)i * stride, sizeof(float) * 3);
-    tree->ids[i] = i;
+    memcpy(r[i].p, b + (size_t)i * stride, sizeof(float) * 3);
+    r[i].id = i;
   }
-  build_ctx c = {tree->points, tree->ids, tree->axis};
-  build_range(&c, 0, count);
+  build_ctx c = {r, tmp, tree->axis, tasks, 0};
+  build_top(&c, 0, count, depth);
+  if (c.task_count) iris_parallel_for(c.task_count, 1, threads, build_tasks, &c);
+  for (uint32_t i = 0; i < count; ++i) {
+    memcpy(&tree->points[3 * (size_t)i], r[i].p, sizeof(float) * 3);
+    tree->ids[i] = r[i].id;
+  }
+  free(tasks);
+  free(tmp);
+  free(r);
+  return IRIS_OK;
+}
+
+iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
+                              iris_error *err) {
+  return iris_kdtree_build_threads(tree, base, stride, count, 1, err);
+}
+
+iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size,
+                                    iris_error *err) {
+  free(tree->payload);
+  tree->payload = NULL;
+  tree->payload_size = 0;
+  if (tree->count == 0 || size == 0) return IRIS_OK;
+  tree->payload = malloc(size * tree->count);
+  if (!tree->payload)
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree payload");
+  tree->payload_size = size;
+  const unsigned char *b = base;
+  for (uint32_t i = 0; i < tree->count; ++i)
+    memcpy(tree->payload + (size_t)i * size, b + (size_t)tree->ids[i] * stride, size);
   return IRIS_OK;
 }
 
@@ -95,15 +226,21 @@ void iris_kdtree_destroy(iris_kdtree *tree) {
   free(tree->points);
   free(tree->ids);
   free(tree->axis);
+  free(tree->payload);
   memset(tree, 0, sizeof(*tree));
 }
+
+/* ---- search ----------------------------------------------------------------- */
 
 typedef struct knn_heap {
   uint32_t k, n;
   uint32_t *ids;
   float *d2;
   float max_d2;
-  bool (*accept)(void *ctx, uint32_t id); /* NULL: every point */
+  bool (*accept)(void *ctx, uint32_t id); /* by id; NULL: see accept_payload */
+  bool (*accept_payload)(void *ctx, const void *payload); /* NULL with accept NULL: every point */
+  const unsigned char *payload;
+  size_t payload_size;
   void *ctx;
 } knn_heap;
 
@@ -130,51 +267,58 @@ static void sift_down(knn_heap *h, uint32_t i) {
     i = w;
   }
 }
-static void heap_offer(knn_heap *h, uint32_t id, float d2) {
-  if (d2 > h->max_d2) return;
-  if (h->n == h->k && (d2 > h->d2[0] || (d2 == h->d2[0] && id > h->ids[0]))) return;
+static float heap_bound(const knn_heap *h) { return h->n < h->k ? h->max_d2 : h->d2[0]; }
+
+/* Offers tree node i at squared distance d2 (already <= heap_bound). */
+static void heap_offer(knn_heap *h, const iris_kdtree *t, uint32_t i, float d2) {
+  uint32_t id = t->ids[i];
+  if (h->n == h->k && d2 == h->d2[0] && id > h->ids[0]) return;
   if (h->accept && !h->accept(h->ctx, id)) return;
+  if (h->accept_payload && !h->accept_payload(h->ctx, h->payload + (size_t)i * h->payload_size)) return;
   if (h->n < h->k) {
-    uint32_t i = h->n++;
-    h->ids[i] = id;
-    h->d2[i] = d2;
-    while (i > 0) {
-      uint32_t p = (i - 1) / 2;
-      if (!worse(h, i, p)) break;
-      heap_swap(h, i, p);
-      i = p;
+    uint32_t j = h->n++;
+    h->ids[j] = id;
+    h->d2[j] = d2;
+    while (j > 0) {
+      uint32_t p = (j - 1) / 2;
+      if (!worse(h, j, p)) break;
+      heap_swap(h, j, p);
+      j = p;
     }
     return;
   }
-  if (d2 > h->d2[0] || (d2 == h->d2[0] && id > h->ids[0])) return;
   h->ids[0] = id;
   h->d2[0] = d2;
   sift_down(h, 0);
 }
-static float heap_bound(const knn_heap *h) { return h->n < h->k ? h->max_d2 : h->d2[0]; }
+
+static inline float dist2(const float *p, const float q[3]) {
+  float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+  return dx * dx + dy * dy + dz * dz;
+}
 
 static void search(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q[3], knn_heap *h) {
-  while (hi > lo) {
+  while (hi - lo > LEAF) {
     uint32_t m = lo + (hi - lo) / 2;
     const float *p = &t->points[3 * (size_t)m];
-    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-    heap_offer(h, t->ids[m], dx * dx + dy * dy + dz * dz);
+    float d2 = dist2(p, q);
+    if (d2 <= heap_bound(h)) heap_offer(h, t, m, d2);
     int ax = t->axis[m];
     float diff = q[ax] - p[ax];
-    uint32_t nlo, nhi, flo, fhi; /* near and far halves */
-    if (diff < 0.0f) {
-      nlo = lo; nhi = m; flo = m + 1; fhi = hi;
-    } else {
-      nlo = m + 1; nhi = hi; flo = lo; fhi = m;
-    }
-    search(t, nlo, nhi, q, h);
     /* <= keeps equal-distance points reachable for the index tie-break. */
-    if (diff * diff <= heap_bound(h)) {
-      lo = flo;
-      hi = fhi;
+    if (diff < 0.0f) {
+      search(t, lo, m, q, h);
+      if (!(diff * diff <= heap_bound(h))) return;
+      lo = m + 1;
     } else {
-      return;
+      search(t, m + 1, hi, q, h);
+      if (!(diff * diff <= heap_bound(h))) return;
+      hi = m;
     }
+  }
+  for (uint32_t i = lo; i < hi; ++i) {
+    float d2 = dist2(&t->points[3 * (size_t)i], q);
+    if (d2 <= heap_bound(h)) heap_offer(h, t, i, d2);
   }
 }
 
@@ -208,20 +352,10 @@ static void small_offer(small_set *s, uint32_t id, float d2) {
 
 static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q[3],
                          small_set *s) {
-  while (hi > lo) {
-    if (hi - lo <= 8) { /* small ranges: a linear scan beats descending further */
-      for (uint32_t i = lo; i < hi; ++i) {
-        const float *p = &t->points[3 * (size_t)i];
-        float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-        float d2 = dx * dx + dy * dy + dz * dz;
-        if (d2 <= s->bound) small_offer(s, t->ids[i], d2);
-      }
-      return;
-    }
+  while (hi - lo > LEAF) {
     uint32_t m = lo + (hi - lo) / 2;
     const float *p = &t->points[3 * (size_t)m];
-    float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
-    float d2 = dx * dx + dy * dy + dz * dz;
+    float d2 = dist2(p, q);
     if (d2 <= s->bound) small_offer(s, t->ids[m], d2);
     int ax = t->axis[m];
     float diff = q[ax] - p[ax];
@@ -235,6 +369,23 @@ static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const f
       hi = m;
     }
   }
+  for (uint32_t i = lo; i < hi; ++i) { /* a leaf */
+    float d2 = dist2(&t->points[3 * (size_t)i], q);
+    if (d2 <= s->bound) small_offer(s, t->ids[i], d2);
+  }
+}
+
+static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h) {
+  float qq[3] = {q.x, q.y, q.z};
+  search(tree, 0, tree->count, qq, h);
+  /* Heap sort in place: ascending (d2, id). */
+  uint32_t n = h->n;
+  while (h->n > 1) {
+    heap_swap(h, 0, h->n - 1);
+    h->n--;
+    sift_down(h, 0);
+  }
+  return n;
 }
 
 uint32_t iris_kdtree_knn(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
@@ -259,15 +410,15 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
     }
     return s.n;
   }
-  knn_heap h = {k, 0, ids, d2, max_d2, accept, ctx};
-  float qq[3] = {q.x, q.y, q.z};
-  search(tree, 0, tree->count, qq, &h);
-  /* Heap sort in place: ascending (d2, id). */
-  uint32_t n = h.n;
-  while (h.n > 1) {
-    heap_swap(&h, 0, h.n - 1);
-    h.n--;
-    sift_down(&h, 0);
-  }
-  return n;
+  knn_heap h = {k, 0, ids, d2, max_d2, accept, NULL, NULL, 0, ctx};
+  return knn_heap_run(tree, q, &h);
+}
+
+uint32_t iris_kdtree_knn_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
+                                    bool (*accept)(void *ctx, const void *payload), void *ctx,
+                                    uint32_t *ids, float *d2) {
+  if (k == 0 || tree->count == 0) return 0;
+  if (!tree->payload) return 0;
+  knn_heap h = {k, 0, ids, d2, max_d2, NULL, accept, tree->payload, tree->payload_size, ctx};
+  return knn_heap_run(tree, q, &h);
 }
