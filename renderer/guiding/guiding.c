@@ -90,7 +90,7 @@ typedef struct fill_ctx {
   const iris_kdtree *photon_tree;
   uint32_t k;
   float **hist;     /* per thread, sphere-map sized */
-  uint32_t **ids;   /* per thread, k */
+  uint32_t **ids;   /* per thread, 2 * k: ids, then tree slots */
   float **d2;       /* per thread, k */
 } fill_ctx;
 
@@ -103,11 +103,12 @@ typedef struct photon_filter {
   bool sphere;
 } photon_filter;
 
-/* What the filter reads of a photon, kept in the photon tree's order next to
- * its position (iris_kdtree_set_payload): the photon's n and wi, adjacent in
- * iris_photon. */
+/* What the filter and the splatting read of a photon, kept in the photon
+ * tree's order next to its position (iris_kdtree_set_payload), so neither
+ * chases the photon array: its n, wi and energy, adjacent in iris_photon. */
 typedef struct photon_dirs {
   iris_vec3 n, wi;
+  float energy;
 } photon_dirs;
 
 static bool photon_usable(void *ctx, const void *payload) {
@@ -129,16 +130,19 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
     photon_filter f = {cache->frame.n, cache->sphere != 0};
-    uint32_t n = iris_kdtree_knn_payload_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
+    uint32_t *slots = ids + c->k;
+    uint32_t n = iris_kdtree_knn_payload_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2,
+                                            slots);
     uint32_t used = 0;
     double power = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
-      const iris_photon *ph = &c->photons->photons[ids[j]];
-      if (iris_dot(ph->n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
-      iris_vec3 wl = iris_frame_to_local(&cache->frame, ph->wi);
-      bool u = iris_cache_splat(map, hist, wl, ph->energy, g->params.splat);
+      photon_dirs ph;
+      memcpy(&ph, c->photon_tree->payload + (size_t)slots[j] * sizeof ph, sizeof ph);
+      if (iris_dot(ph.n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
+      iris_vec3 wl = iris_frame_to_local(&cache->frame, ph.wi);
+      bool u = iris_cache_splat(map, hist, wl, ph.energy, g->params.splat);
       used += u;
-      if (u) power += ph->energy;
+      if (u) power += ph.energy;
     }
     cache->photons = used;
     /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
@@ -309,8 +313,10 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   if (st == IRIS_OK)
     st = iris_kdtree_build_threads(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
                                    s->threads, err);
-  _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3),
-                 "photon_dirs mirrors iris_photon's n, wi");
+  _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3) &&
+                     offsetof(iris_photon, energy) == offsetof(iris_photon, wi) + sizeof(iris_vec3) &&
+                     sizeof(photon_dirs) == 2 * sizeof(iris_vec3) + sizeof(float),
+                 "photon_dirs mirrors iris_photon's n, wi, energy");
   if (st == IRIS_OK)
     st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), err);
   /* Fill in parallel with per-thread scratch. */
@@ -323,7 +329,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     bool ok = fc.hist && fc.ids && fc.d2;
     for (int t = 0; ok && t < threads; ++t) {
       fc.hist[t] = malloc(sizeof(float) * g->sphere.texel_count);
-      fc.ids[t] = malloc(sizeof(uint32_t) * (size_t)p->cache_k);
+      fc.ids[t] = malloc(sizeof(uint32_t) * 2 * (size_t)p->cache_k);
       fc.d2[t] = malloc(sizeof(float) * (size_t)p->cache_k);
       ok = fc.hist[t] && fc.ids[t] && fc.d2[t];
     }

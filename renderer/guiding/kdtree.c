@@ -232,11 +232,14 @@ void iris_kdtree_destroy(iris_kdtree *tree) {
 
 /* ---- search ----------------------------------------------------------------- */
 
+/* The heap holds tree positions ("slots"); ties in distance are broken by the
+ * caller's index, looked up only when two distances are equal. */
 typedef struct knn_heap {
   uint32_t k, n;
-  uint32_t *ids;
+  uint32_t *slots; /* the caller's ids array until the end */
   float *d2;
   float max_d2;
+  const uint32_t *tids; /* tree->ids */
   bool (*accept)(void *ctx, uint32_t id); /* by id; NULL: see accept_payload */
   bool (*accept_payload)(void *ctx, const void *payload); /* NULL with accept NULL: every point */
   const unsigned char *payload;
@@ -247,15 +250,15 @@ typedef struct knn_heap {
 /* Max-heap order on (d2, id): the root is the worst kept neighbour. */
 static int worse(const knn_heap *h, uint32_t a, uint32_t b) {
   if (h->d2[a] != h->d2[b]) return h->d2[a] > h->d2[b];
-  return h->ids[a] > h->ids[b];
+  return h->tids[h->slots[a]] > h->tids[h->slots[b]];
 }
 static void heap_swap(knn_heap *h, uint32_t a, uint32_t b) {
   float t = h->d2[a];
   h->d2[a] = h->d2[b];
   h->d2[b] = t;
-  uint32_t u = h->ids[a];
-  h->ids[a] = h->ids[b];
-  h->ids[b] = u;
+  uint32_t u = h->slots[a];
+  h->slots[a] = h->slots[b];
+  h->slots[b] = u;
 }
 static void sift_down(knn_heap *h, uint32_t i) {
   for (;;) {
@@ -271,13 +274,13 @@ static float heap_bound(const knn_heap *h) { return h->n < h->k ? h->max_d2 : h-
 
 /* Offers tree node i at squared distance d2 (already <= heap_bound). */
 static void heap_offer(knn_heap *h, const iris_kdtree *t, uint32_t i, float d2) {
-  uint32_t id = t->ids[i];
-  if (h->n == h->k && d2 == h->d2[0] && id > h->ids[0]) return;
-  if (h->accept && !h->accept(h->ctx, id)) return;
+  (void)t;
+  if (h->n == h->k && d2 == h->d2[0] && h->tids[i] > h->tids[h->slots[0]]) return;
+  if (h->accept && !h->accept(h->ctx, h->tids[i])) return;
   if (h->accept_payload && !h->accept_payload(h->ctx, h->payload + (size_t)i * h->payload_size)) return;
   if (h->n < h->k) {
     uint32_t j = h->n++;
-    h->ids[j] = id;
+    h->slots[j] = i;
     h->d2[j] = d2;
     while (j > 0) {
       uint32_t p = (j - 1) / 2;
@@ -287,7 +290,7 @@ static void heap_offer(knn_heap *h, const iris_kdtree *t, uint32_t i, float d2) 
     }
     return;
   }
-  h->ids[0] = id;
+  h->slots[0] = i;
   h->d2[0] = d2;
   sift_down(h, 0);
 }
@@ -375,7 +378,7 @@ static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const f
   }
 }
 
-static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h) {
+static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h, uint32_t *slots) {
   float qq[3] = {q.x, q.y, q.z};
   search(tree, 0, tree->count, qq, h);
   /* Heap sort in place: ascending (d2, id). */
@@ -384,6 +387,10 @@ static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h) 
     heap_swap(h, 0, h->n - 1);
     h->n--;
     sift_down(h, 0);
+  }
+  for (uint32_t j = 0; j < n; ++j) {
+    if (slots) slots[j] = h->slots[j];
+    h->slots[j] = tree->ids[h->slots[j]];
   }
   return n;
 }
@@ -410,15 +417,14 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
     }
     return s.n;
   }
-  knn_heap h = {k, 0, ids, d2, max_d2, accept, NULL, NULL, 0, ctx};
-  return knn_heap_run(tree, q, &h);
+  knn_heap h = {k, 0, ids, d2, max_d2, tree->ids, accept, NULL, NULL, 0, ctx};
+  return knn_heap_run(tree, q, &h, NULL);
 }
 
 uint32_t iris_kdtree_knn_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                                     bool (*accept)(void *ctx, const void *payload), void *ctx,
-                                    uint32_t *ids, float *d2) {
-  if (k == 0 || tree->count == 0) return 0;
-  if (!tree->payload) return 0;
-  knn_heap h = {k, 0, ids, d2, max_d2, NULL, accept, tree->payload, tree->payload_size, ctx};
-  return knn_heap_run(tree, q, &h);
+                                    uint32_t *ids, float *d2, uint32_t *slots) {
+  if (k == 0 || tree->count == 0 || !tree->payload) return 0;
+  knn_heap h = {k, 0, ids, d2, max_d2, tree->ids, NULL, accept, tree->payload, tree->payload_size, ctx};
+  return knn_heap_run(tree, q, &h, slots);
 }

@@ -60,10 +60,12 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
 
 /* The same with the filter reading the point's payload (requires
  * iris_kdtree_set_payload); same answers as iris_kdtree_knn_if with an
- * equivalent accept. */
+ * equivalent accept. slots (NULL: not wanted) receives each answer's tree
+ * position, so the caller reads its payload at
+ * tree->payload + slots[j] * tree->payload_size. */
 uint32_t iris_kdtree_knn_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                                     bool (*accept)(void *ctx, const void *payload), void *ctx,
-                                    uint32_t *ids, float *d2);
+                                    uint32_t *ids, float *d2, uint32_t *slots);
 
 #ifdef __cplusplus
 }
