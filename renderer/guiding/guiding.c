@@ -84,10 +84,103 @@ static void camera_rows(void *ctx, uint64_t begin, uint64_t end, int thread_inde
 
 /* ---- filling -------------------------------------------------------------- */
 
+/* Photon normal groups: the photon tree is a forest with one tree per cell of
+ * an octahedral grid over the photons' normals, and a cache searches only the
+ * groups whose normals can pass its filter, so it no longer wades through the
+ * photons of the surfaces around it (the door: 17 of 18 photons within a
+ * cache's k-th distance had the wrong normal). Each group's cone (axis, widest
+ * angle of its photons, from the data) decides conservatively; the filter
+ * still decides each photon, so the answer is the same as searching all. */
+#define NORMAL_GRID 6
+#define NORMAL_GROUPS (NORMAL_GRID * NORMAL_GRID + 1) /* the last: normals not unit, always searched */
+
+static uint32_t normal_group(iris_vec3 n) {
+  float l1 = fabsf(n.x) + fabsf(n.y) + fabsf(n.z), l2 = iris_dot(n, n);
+  if (!(fabsf(l2 - 1.0f) <= 1e-4f) || !(l1 > 0.0f)) return NORMAL_GROUPS - 1;
+  float u = n.x / l1, v = n.y / l1;
+  if (n.z < 0.0f) {
+    float fu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f), fv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+    u = fu;
+    v = fv;
+  }
+  int iu = (int)((u * 0.5f + 0.5f) * NORMAL_GRID), iv = (int)((v * 0.5f + 0.5f) * NORMAL_GRID);
+  iu = iu < 0 ? 0 : (iu >= NORMAL_GRID ? NORMAL_GRID - 1 : iu);
+  iv = iv < 0 ? 0 : (iv >= NORMAL_GRID ? NORMAL_GRID - 1 : iv);
+  return (uint32_t)(iv * NORMAL_GRID + iu);
+}
+
+typedef struct normal_cone {
+  double axis[3];
+  double min_dot; /* a cache normal with dot(n, axis) below this cannot use the group's photons */
+  uint32_t count;
+} normal_cone;
+
+/* Cones of the groups from the photons in them (after the tree is built). */
+static void build_normal_cones(const iris_photon *ph, size_t count, const uint32_t *group, normal_cone *cones) {
+  memset(cones, 0, sizeof(normal_cone) * NORMAL_GROUPS);
+  for (size_t i = 0; i < count; ++i) {
+    normal_cone *c = &cones[group[i]];
+    c->axis[0] += ph[i].n.x, c->axis[1] += ph[i].n.y, c->axis[2] += ph[i].n.z;
+    c->count++;
+  }
+  double cmin[NORMAL_GROUPS];
+  for (int g = 0; g < NORMAL_GROUPS; ++g) {
+    normal_cone *c = &cones[g];
+    double l = sqrt(c->axis[0] * c->axis[0] + c->axis[1] * c->axis[1] + c->axis[2] * c->axis[2]);
+    if (l > 1e-6 * (double)c->count && l > 0.0) {
+      for (int a = 0; a < 3; ++a) c->axis[a] /= l;
+    } else {
+      c->axis[0] = c->axis[1] = c->axis[2] = 0.0;
+    }
+    cmin[g] = 1.0;
+  }
+  for (size_t i = 0; i < count; ++i) {
+    const normal_cone *c = &cones[group[i]];
+    double nx = ph[i].n.x, ny = ph[i].n.y, nz = ph[i].n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
+    double d = nl > 0.0 ? (nx * c->axis[0] + ny * c->axis[1] + nz * c->axis[2]) / nl : -1.0;
+    if (d < cmin[group[i]]) cmin[group[i]] = d;
+  }
+  /* Usable: angle(cache n, photon n) <= acos(PHOTON_NORMAL_COS); so the cache
+   * normal lies within that + the group's widest angle (+ 1e-3 rad for float
+   * rounding and normals a hair off unit length) of the axis. */
+  const double pi = 3.14159265358979323846;
+  for (int g = 0; g < NORMAL_GROUPS; ++g) {
+    normal_cone *c = &cones[g];
+    double reach = acos((double)PHOTON_NORMAL_COS) + acos(fmax(-1.0, fmin(1.0, cmin[g]))) + 1e-3;
+    c->min_dot = (g == NORMAL_GROUPS - 1 || !(c->axis[0] || c->axis[1] || c->axis[2]) || reach >= pi)
+                     ? -INFINITY
+                     : cos(reach);
+  }
+}
+
+/* The groups a cache with normal n searches, best aligned first; how many. */
+static uint32_t select_groups(const normal_cone *cones, iris_vec3 n, uint32_t *out) {
+  double nx = n.x, ny = n.y, nz = n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
+  bool all = !(fabs(nl - 1.0) <= 1e-4); /* a normal off unit length: its filter is not the cone's */
+  double key[NORMAL_GROUPS];
+  uint32_t m = 0;
+  for (uint32_t g = 0; g < NORMAL_GROUPS; ++g) {
+    const normal_cone *c = &cones[g];
+    if (!c->count) continue;
+    double d = (nx * c->axis[0] + ny * c->axis[1] + nz * c->axis[2]) / nl;
+    if (!all && !(d >= c->min_dot)) continue;
+    uint32_t j = m++;
+    while (j > 0 && key[j - 1] < d) {
+      key[j] = key[j - 1];
+      out[j] = out[j - 1];
+      --j;
+    }
+    key[j] = d;
+    out[j] = g;
+  }
+  return m;
+}
+
 typedef struct fill_ctx {
   iris_guiding *g;
   const iris_photon_map *photons;
   const iris_kdtree *photon_tree;
+  const normal_cone *cones; /* NORMAL_GROUPS */
   uint32_t k;
   float **hist;     /* per thread, sphere-map sized */
   uint32_t **ids;   /* per thread, 2 * k: ids, then tree slots */
@@ -131,8 +224,10 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     memset(hist, 0, sizeof(float) * map->texel_count);
     photon_filter f = {cache->frame.n, cache->sphere != 0};
     uint32_t *slots = ids + c->k;
-    uint32_t n = iris_kdtree_knn_payload_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2,
-                                            slots);
+    uint32_t groups[NORMAL_GROUPS];
+    uint32_t ng = select_groups(c->cones, cache->frame.n, groups);
+    uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
+                                                   photon_usable, &f, ids, d2, slots);
     uint32_t used = 0;
     double power = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
@@ -310,9 +405,16 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (photons.photons[i].bounce > 0) photons.photons[n++] = photons.photons[i];
     photons.count = n;
   }
-  if (st == IRIS_OK)
-    st = iris_kdtree_build_threads(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
-                                   s->threads, err);
+  normal_cone cones[NORMAL_GROUPS];
+  uint32_t *group = st == IRIS_OK ? malloc(sizeof(uint32_t) * (photons.count ? photons.count : 1)) : NULL;
+  if (st == IRIS_OK && !group) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  if (st == IRIS_OK) {
+    for (size_t i = 0; i < photons.count; ++i) group[i] = normal_group(photons.photons[i].n);
+    build_normal_cones(photons.photons, photons.count, group, cones);
+    st = iris_kdtree_build_grouped(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
+                                   group, NORMAL_GROUPS, s->threads, err);
+  }
+  free(group);
   _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3) &&
                      offsetof(iris_photon, energy) == offsetof(iris_photon, wi) + sizeof(iris_vec3) &&
                      sizeof(photon_dirs) == 2 * sizeof(iris_vec3) + sizeof(float),
@@ -321,7 +423,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
-  fill_ctx fc = {g, &photons, &ptree, (uint32_t)p->cache_k, NULL, NULL, NULL};
+  fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL};
   if (st == IRIS_OK) {
     fc.hist = calloc((size_t)threads, sizeof(float *));
     fc.ids = calloc((size_t)threads, sizeof(uint32_t *));

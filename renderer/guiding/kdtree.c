@@ -159,37 +159,58 @@ static void build_tasks(void *ctx, uint64_t begin, uint64_t end, int thread_inde
   for (uint64_t t = begin; t < end; ++t) build_range(c->r, c->tmp, c->axis, c->tasks[t].lo, c->tasks[t].hi);
 }
 
-iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
-                                      int threads, iris_error *err) {
+/* Tasks for one group's range [lo, hi): subtrees of at least ~16k points per
+ * task are worth a thread; 2 tasks per thread balance the load. The layout
+ * does not depend on who builds what. */
+static int group_depth(uint32_t n, int threads) {
+  int depth = 0;
+  if (threads > 1)
+    while (depth < 8 && (1 << depth) < 2 * threads && (n >> (depth + 1)) >= 16384) ++depth;
+  return depth;
+}
+
+iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
+                                      const uint32_t *group, uint32_t group_count, int threads,
+                                      iris_error *err) {
   memset(tree, 0, sizeof(*tree));
   if (count == 0) return IRIS_OK;
   if (threads <= 0) threads = iris_parallel_default_threads();
-  /* Subtrees of at least ~16k points per task are worth a thread; 2 tasks per
-   * thread balance the load. The layout does not depend on who builds what. */
-  int depth = 0;
-  if (threads > 1)
-    while (depth < 8 && (1 << depth) < 2 * threads && (count >> (depth + 1)) >= 16384) ++depth;
+  uint32_t groups = group ? group_count : 1;
+  uint32_t *start = calloc((size_t)groups + 1, sizeof(uint32_t));
+  if (!start) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree");
+  for (uint32_t i = 0; i < count; ++i) start[(group ? group[i] : 0) + 1]++;
+  size_t max_tasks = 0;
+  for (uint32_t g = 0; g < groups; ++g) {
+    max_tasks += (size_t)1 << group_depth(start[g + 1], threads);
+    start[g + 1] += start[g];
+  }
   kd_rec *r = malloc(sizeof(kd_rec) * (size_t)count), *tmp = malloc(sizeof(kd_rec) * (size_t)count);
-  build_task *tasks = malloc(sizeof(build_task) << depth);
+  build_task *tasks = malloc(sizeof(build_task) * max_tasks);
+  uint32_t *at = malloc(sizeof(uint32_t) * groups);
   tree->points = malloc(sizeof(float) * 3 * (size_t)count);
   tree->ids = malloc(sizeof(uint32_t) * count);
   tree->axis = calloc(count, 1);
-  if (!r || !tmp || !tasks || !tree->points || !tree->ids || !tree->axis) {
+  if (!r || !tmp || !tasks || !at || !tree->points || !tree->ids || !tree->axis) {
     free(r);
     free(tmp);
     free(tasks);
+    free(at);
+    free(start);
     iris_kdtree_destroy(tree);
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree of %u points",
                           count);
   }
   tree->count = count;
+  memcpy(at, start, sizeof(uint32_t) * groups);
   const unsigned char *b = base;
-  for (uint32_t i = 0; i < count; ++i) {
-    memcpy(r[i].p, b + (size_t)i * stride, sizeof(float) * 3);
-    r[i].id = i;
+  for (uint32_t i = 0; i < count; ++i) { /* counting sort by group, index order within */
+    kd_rec *o = &r[at[group ? group[i] : 0]++];
+    memcpy(o->p, b + (size_t)i * stride, sizeof(float) * 3);
+    o->id = i;
   }
+  free(at);
   build_ctx c = {r, tmp, tree->axis, tasks, 0};
-  build_top(&c, 0, count, depth);
+  for (uint32_t g = 0; g < groups; ++g) build_top(&c, start[g], start[g + 1], group_depth(start[g + 1] - start[g], threads));
   if (c.task_count) iris_parallel_for(c.task_count, 1, threads, build_tasks, &c);
   for (uint32_t i = 0; i < count; ++i) {
     memcpy(&tree->points[3 * (size_t)i], r[i].p, sizeof(float) * 3);
@@ -198,7 +219,18 @@ iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_
   free(tasks);
   free(tmp);
   free(r);
+  if (group) {
+    tree->group_count = groups;
+    tree->group_start = start;
+  } else {
+    free(start);
+  }
   return IRIS_OK;
+}
+
+iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
+                                      int threads, iris_error *err) {
+  return iris_kdtree_build_grouped(tree, base, stride, count, NULL, 0, threads, err);
 }
 
 iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
@@ -227,6 +259,7 @@ void iris_kdtree_destroy(iris_kdtree *tree) {
   free(tree->ids);
   free(tree->axis);
   free(tree->payload);
+  free(tree->group_start);
   memset(tree, 0, sizeof(*tree));
 }
 
@@ -378,9 +411,20 @@ static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const f
   }
 }
 
-static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h, uint32_t *slots) {
+/* Searches the listed groups (NULL: every group; a tree without groups is one). */
+static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h, const uint32_t *groups,
+                             uint32_t ngroups, uint32_t *slots) {
   float qq[3] = {q.x, q.y, q.z};
-  search(tree, 0, tree->count, qq, h);
+  if (!tree->group_count) {
+    search(tree, 0, tree->count, qq, h);
+  } else if (!groups) {
+    for (uint32_t g = 0; g < tree->group_count; ++g) search(tree, tree->group_start[g], tree->group_start[g + 1], qq, h);
+  } else {
+    for (uint32_t j = 0; j < ngroups; ++j) {
+      uint32_t g = groups[j];
+      if (g < tree->group_count) search(tree, tree->group_start[g], tree->group_start[g + 1], qq, h);
+    }
+  }
   /* Heap sort in place: ascending (d2, id). */
   uint32_t n = h->n;
   while (h->n > 1) {
@@ -410,7 +454,9 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
     s.n = 0;
     s.bound = max_d2;
     float qq[3] = {q.x, q.y, q.z};
-    search_small(tree, 0, tree->count, qq, &s);
+    if (!tree->group_count) search_small(tree, 0, tree->count, qq, &s);
+    for (uint32_t g = 0; g < tree->group_count; ++g)
+      search_small(tree, tree->group_start[g], tree->group_start[g + 1], qq, &s);
     for (uint32_t i = 0; i < s.n; ++i) {
       ids[i] = s.ids[i];
       d2[i] = s.d2[i];
@@ -418,13 +464,20 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
     return s.n;
   }
   knn_heap h = {k, 0, ids, d2, max_d2, tree->ids, accept, NULL, NULL, 0, ctx};
-  return knn_heap_run(tree, q, &h, NULL);
+  return knn_heap_run(tree, q, &h, NULL, 0, NULL);
 }
 
 uint32_t iris_kdtree_knn_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                                     bool (*accept)(void *ctx, const void *payload), void *ctx,
                                     uint32_t *ids, float *d2, uint32_t *slots) {
+  return iris_kdtree_knn_groups_payload_if(tree, q, k, max_d2, NULL, 0, accept, ctx, ids, d2, slots);
+}
+
+uint32_t iris_kdtree_knn_groups_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
+                                           const uint32_t *groups, uint32_t group_count,
+                                           bool (*accept)(void *ctx, const void *payload), void *ctx,
+                                           uint32_t *ids, float *d2, uint32_t *slots) {
   if (k == 0 || tree->count == 0 || !tree->payload) return 0;
   knn_heap h = {k, 0, ids, d2, max_d2, tree->ids, NULL, accept, tree->payload, tree->payload_size, ctx};
-  return knn_heap_run(tree, q, &h, slots);
+  return knn_heap_run(tree, q, &h, groups, group_count, slots);
 }

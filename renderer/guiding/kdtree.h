@@ -28,6 +28,8 @@ typedef struct iris_kdtree {
   uint8_t *axis;  /* split axis of each node (ranges of <= IRIS_KDTREE_LEAF points: unused) */
   unsigned char *payload; /* optional per-point data in tree order (iris_kdtree_set_payload) */
   size_t payload_size;    /* bytes per point, 0 without payload */
+  uint32_t group_count;   /* 0: one tree over [0, count); else one implicit tree per group */
+  uint32_t *group_start;  /* group g is [group_start[g], group_start[g + 1]); group_count + 1 */
 } iris_kdtree;
 
 /* Builds over `count` positions read at `base + i * stride` bytes (so a field
@@ -38,6 +40,13 @@ iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride
  * threads (<= 0: all cores). */
 iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
                                       int threads, iris_error *err);
+/* A forest: point i goes to group[i] (< group_count), each group gets its own
+ * tree, and a query may search only some groups (the photons whose normals
+ * can pass a cache's filter). Queries over all groups answer exactly as one
+ * tree over all points. */
+iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
+                                      const uint32_t *group, uint32_t group_count, int threads,
+                                      iris_error *err);
 void iris_kdtree_destroy(iris_kdtree *tree);
 
 /* Copies `size` bytes per point, read at `base + id * stride`, into tree
@@ -66,6 +75,14 @@ uint32_t iris_kdtree_knn_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, fl
 uint32_t iris_kdtree_knn_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
                                     bool (*accept)(void *ctx, const void *payload), void *ctx,
                                     uint32_t *ids, float *d2, uint32_t *slots);
+
+/* The same among the points of the listed groups only (searched in this
+ * order: the most promising first tightens the bound sooner); the answer is
+ * the k smallest (d2, id) over those groups' accepted points. */
+uint32_t iris_kdtree_knn_groups_payload_if(const iris_kdtree *tree, iris_vec3 q, uint32_t k, float max_d2,
+                                           const uint32_t *groups, uint32_t group_count,
+                                           bool (*accept)(void *ctx, const void *payload), void *ctx,
+                                           uint32_t *ids, float *d2, uint32_t *slots);
 
 #ifdef __cplusplus
 }
