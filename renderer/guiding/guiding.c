@@ -110,47 +110,92 @@ static uint32_t normal_group(iris_vec3 n) {
 }
 
 typedef struct normal_cone {
-  double axis[3];
+  double axis[3]; /* the cell's centre direction */
   double min_dot; /* a cache normal with dot(n, axis) below this cannot use the group's photons */
   uint32_t count;
 } normal_cone;
 
-/* Cones of the groups from the photons in them (after the tree is built). */
-static void build_normal_cones(const iris_photon *ph, size_t count, const uint32_t *group, normal_cone *cones) {
-  memset(cones, 0, sizeof(normal_cone) * NORMAL_GROUPS);
-  for (size_t i = 0; i < count; ++i) {
-    normal_cone *c = &cones[group[i]];
-    c->axis[0] += ph[i].n.x, c->axis[1] += ph[i].n.y, c->axis[2] += ph[i].n.z;
-    c->count++;
-  }
-  double cmin[NORMAL_GROUPS];
-  for (int g = 0; g < NORMAL_GROUPS; ++g) {
-    normal_cone *c = &cones[g];
-    double l = sqrt(c->axis[0] * c->axis[0] + c->axis[1] * c->axis[1] + c->axis[2] * c->axis[2]);
-    if (l > 1e-6 * (double)c->count && l > 0.0) {
-      for (int a = 0; a < 3; ++a) c->axis[a] /= l;
-    } else {
-      c->axis[0] = c->axis[1] = c->axis[2] = 0.0;
+#define GROUP_EXCLUDED UINT32_MAX /* direct photons with light sampling: not in the tree */
+#define GROUP_CHUNK 16384u
+
+typedef struct group_ctx {
+  const iris_photon *ph;
+  size_t count;
+  bool direct;       /* keep bounce-0 photons */
+  uint32_t *group;   /* per photon */
+  double (*cmin)[NORMAL_GROUPS]; /* per chunk: min over its photons of cos(photon n, axis) */
+  uint32_t (*n)[NORMAL_GROUPS];  /* per chunk: photons per group */
+  const normal_cone *cones;
+} group_ctx;
+
+/* Groups and per-chunk cone data (a minimum and a count: the same for any
+ * split into threads). */
+static void group_chunks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  group_ctx *c = ctx;
+  for (uint64_t ch = begin; ch < end; ++ch) {
+    double *cmin = c->cmin[ch];
+    uint32_t *n = c->n[ch];
+    for (int g = 0; g < NORMAL_GROUPS; ++g) cmin[g] = 1.0, n[g] = 0;
+    size_t lo = ch * GROUP_CHUNK, hi = lo + GROUP_CHUNK < c->count ? lo + GROUP_CHUNK : c->count;
+    for (size_t i = lo; i < hi; ++i) {
+      const iris_photon *ph = &c->ph[i];
+      if (!c->direct && ph->bounce == 0) {
+        c->group[i] = GROUP_EXCLUDED;
+        continue;
+      }
+      uint32_t g = normal_group(ph->n);
+      c->group[i] = g;
+      n[g]++;
+      const double *ax = c->cones[g].axis;
+      double nx = ph->n.x, ny = ph->n.y, nz = ph->n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
+      double d = nl > 0.0 ? (nx * ax[0] + ny * ax[1] + nz * ax[2]) / nl : -1.0;
+      cmin[g] = d < cmin[g] ? d : cmin[g];
     }
-    cmin[g] = 1.0;
   }
-  for (size_t i = 0; i < count; ++i) {
-    const normal_cone *c = &cones[group[i]];
-    double nx = ph[i].n.x, ny = ph[i].n.y, nz = ph[i].n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
-    double d = nl > 0.0 ? (nx * c->axis[0] + ny * c->axis[1] + nz * c->axis[2]) / nl : -1.0;
-    if (d < cmin[group[i]]) cmin[group[i]] = d;
+}
+
+/* Assigns photons to groups (GROUP_EXCLUDED: left out) and builds the cones. */
+static bool group_photons(const iris_photon *ph, size_t count, bool direct, int threads, uint32_t *group,
+                          normal_cone *cones) {
+  memset(cones, 0, sizeof(normal_cone) * NORMAL_GROUPS);
+  for (int g = 0; g < NORMAL_GROUPS - 1; ++g) { /* the cell centre's direction */
+    double u = ((g % NORMAL_GRID) + 0.5) / NORMAL_GRID * 2.0 - 1.0, v = ((g / NORMAL_GRID) + 0.5) / NORMAL_GRID * 2.0 - 1.0;
+    double z = 1.0 - fabs(u) - fabs(v), x = u, y = v;
+    if (z < 0.0) {
+      x = (1.0 - fabs(v)) * (u >= 0.0 ? 1.0 : -1.0);
+      y = (1.0 - fabs(u)) * (v >= 0.0 ? 1.0 : -1.0);
+    }
+    double l = sqrt(x * x + y * y + z * z);
+    cones[g].axis[0] = x / l, cones[g].axis[1] = y / l, cones[g].axis[2] = z / l;
   }
+  size_t chunks = (count + GROUP_CHUNK - 1) / GROUP_CHUNK;
+  group_ctx c = {ph, count, direct, group, malloc(sizeof(double[NORMAL_GROUPS]) * (chunks ? chunks : 1)),
+                 malloc(sizeof(uint32_t[NORMAL_GROUPS]) * (chunks ? chunks : 1)), cones};
+  if (!c.cmin || !c.n) {
+    free(c.cmin);
+    free(c.n);
+    return false;
+  }
+  iris_parallel_for(chunks, 1, threads, group_chunks, &c);
+  double cmin[NORMAL_GROUPS];
+  for (int g = 0; g < NORMAL_GROUPS; ++g) cmin[g] = 1.0;
+  for (size_t ch = 0; ch < chunks; ++ch)
+    for (int g = 0; g < NORMAL_GROUPS; ++g) {
+      cones[g].count += c.n[ch][g];
+      cmin[g] = c.cmin[ch][g] < cmin[g] ? c.cmin[ch][g] : cmin[g];
+    }
+  free(c.cmin);
+  free(c.n);
   /* Usable: angle(cache n, photon n) <= acos(PHOTON_NORMAL_COS); so the cache
    * normal lies within that + the group's widest angle (+ 1e-3 rad for float
    * rounding and normals a hair off unit length) of the axis. */
   const double pi = 3.14159265358979323846;
   for (int g = 0; g < NORMAL_GROUPS; ++g) {
-    normal_cone *c = &cones[g];
     double reach = acos((double)PHOTON_NORMAL_COS) + acos(fmax(-1.0, fmin(1.0, cmin[g]))) + 1e-3;
-    c->min_dot = (g == NORMAL_GROUPS - 1 || !(c->axis[0] || c->axis[1] || c->axis[2]) || reach >= pi)
-                     ? -INFINITY
-                     : cos(reach);
+    cones[g].min_dot = g == NORMAL_GROUPS - 1 || reach >= pi ? -INFINITY : cos(reach);
   }
+  return true;
 }
 
 /* The groups a cache with normal n searches, best aligned first; how many. */
@@ -399,28 +444,21 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
    * from a light leave the photon tree, so every cache's k photons describe
    * the indirect light (measured in docs/guiding.md). */
   const bool direct = p->direct_photons > 0 || (p->direct_photons < 0 && !p->use_nee);
-  if (!direct) {
-    size_t n = 0;
-    for (size_t i = 0; i < photons.count; ++i)
-      if (photons.photons[i].bounce > 0) photons.photons[n++] = photons.photons[i];
-    photons.count = n;
-  }
   normal_cone cones[NORMAL_GROUPS];
   uint32_t *group = st == IRIS_OK ? malloc(sizeof(uint32_t) * (photons.count ? photons.count : 1)) : NULL;
-  if (st == IRIS_OK && !group) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
-  if (st == IRIS_OK) {
-    for (size_t i = 0; i < photons.count; ++i) group[i] = normal_group(photons.photons[i].n);
-    build_normal_cones(photons.photons, photons.count, group, cones);
+  if (st == IRIS_OK && (!group || !group_photons(photons.photons, photons.count, direct, s->threads, group, cones)))
+    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  if (st == IRIS_OK) /* photon ids stay indices into the whole photon array */
     st = iris_kdtree_build_grouped(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
                                    group, NORMAL_GROUPS, s->threads, err);
-  }
   free(group);
   _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3) &&
                      offsetof(iris_photon, energy) == offsetof(iris_photon, wi) + sizeof(iris_vec3) &&
                      sizeof(photon_dirs) == 2 * sizeof(iris_vec3) + sizeof(float),
                  "photon_dirs mirrors iris_photon's n, wi, energy");
   if (st == IRIS_OK)
-    st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), err);
+    st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), s->threads,
+                                 err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
   fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL};

@@ -19,75 +19,87 @@ typedef struct kd_rec {
   uint32_t id;
 } kd_rec;
 
-static void swap_rec(kd_rec *a, kd_rec *b) {
-  kd_rec t = *a;
-  *a = *b;
-  *b = t;
-}
 
-/* (coordinate ax, index) order: distinct keys, so equal coordinates cost
- * nothing special. Branch-free: the outcome is a coin flip on random points. */
-static inline uint32_t rec_less(const kd_rec *a, float v, uint32_t vid, int ax) {
-  float k = a->p[ax];
-  return (uint32_t)(k < v) | ((uint32_t)(k == v) & (uint32_t)(a->id < vid));
-}
-
-#define SAMPLE 31
-
-/* A pivot for finding rank m in [lo, hi): the element of about m's relative
- * rank among SAMPLE evenly spaced items (median of three for short ranges),
- * so each partition cuts close to m. */
-static inline uint32_t choose_pivot(const kd_rec *r, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
-  uint32_t n = hi - lo;
-  if (n < 1024) {
-    uint32_t a = lo, b = lo + n / 2, c = hi - 1;
-    if (rec_less(&r[b], r[a].p[ax], r[a].id, ax)) { uint32_t t = a; a = b; b = t; }
-    if (rec_less(&r[c], r[b].p[ax], r[b].id, ax)) {
-      b = c;
-      if (rec_less(&r[b], r[a].p[ax], r[a].id, ax)) b = a;
-    }
-    return b;
+/* One branch-free pass over [lo, hi) (the outcome of each comparison is a
+ * coin flip on random points): keys < a are compacted in place, keys in
+ * [a, b] and keys > b go through tmp[lo, hi) (upwards and downwards; never
+ * over a kept item, as fewer than hi - lo are kept) and are copied back
+ * after them, so no load waits for an earlier comparison. The middle part
+ * is [*mlo, *mhi). */
+static inline void partition3(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, float a, float b, int ax,
+                              uint32_t *mlo, uint32_t *mhi) {
+  uint32_t store = lo, mc = 0, rc = 0;
+  for (uint32_t i = lo; i < hi; ++i) {
+    const kd_rec *x = &r[i]; /* whole 16-byte copies (a struct copy gets split in fields) */
+    float k = x->p[ax];
+    uint32_t lt = k < a, gt = k > b;
+    memcpy(&tmp[lo + mc], x, sizeof *x);
+    memcpy(&tmp[hi - 1 - rc], x, sizeof *x);
+    memmove(&r[store], x, sizeof *x); /* store <= i: already read */
+    store += lt;
+    mc += (lt | gt) ^ 1u;
+    rc += gt;
   }
-  uint32_t idx[SAMPLE];
-  for (uint32_t j = 0; j < SAMPLE; ++j) { /* insertion sort of the sample by key */
-    uint32_t x = lo + (uint32_t)(((uint64_t)n * (2 * j + 1)) / (2 * SAMPLE)), i = j;
-    while (i > 0 && rec_less(&r[x], r[idx[i - 1]].p[ax], r[idx[i - 1]].id, ax)) {
-      idx[i] = idx[i - 1];
-      --i;
-    }
-    idx[i] = x;
-  }
-  return idx[(uint32_t)(((uint64_t)(m - lo) * SAMPLE) / n)];
+  memcpy(&r[store], &tmp[lo], sizeof(kd_rec) * mc);
+  memcpy(&r[store + mc], &tmp[hi - rc], sizeof(kd_rec) * rc);
+  *mlo = store;
+  *mhi = store + mc;
 }
 
-/* Quickselect: puts the element of rank m (by key) at m, smaller keys before,
- * larger after. Branch-free partitions: the smaller keys are compacted in
- * place, the others go to tmp[lo, hi) and are copied back after them, so no load
- * waits for the previous comparison. Short ranges by insertion. */
+/* Quickselect: puts an element of rank m (by coordinate ax) at m, keys <= it
+ * before and >= it after. Long ranges (Floyd-Rivest style): two pivots from
+ * a sorted sample bracket m's rank, so after one pass m almost always lies
+ * in the short middle part; short ranges: a median-of-three pivot with
+ * equal keys in the middle part (so runs of equal keys end the search
+ * instead of making it quadratic); the last few by insertion. */
+#define FR_MIN 4096u
 static inline void select_nth(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
+  bool sample = true;
   while (hi - lo > 16) {
-    uint32_t piv = choose_pivot(r, lo, hi, m, ax), last = hi - 1;
-    swap_rec(&r[piv], &r[last]);
-    const kd_rec pv = r[last];
-    uint32_t store = lo, right = 0;
-    for (uint32_t i = lo; i < last; ++i) {
-      kd_rec x = r[i];
-      uint32_t lt = rec_less(&x, pv.p[ax], pv.id, ax);
-      r[store] = x; /* store <= i: already read */
-      tmp[lo + right] = x;
-      store += lt;
-      right += lt ^ 1u;
+    const uint32_t n = hi - lo;
+    float a, b;
+    const bool used_sample = sample && n >= FR_MIN;
+    if (used_sample) {
+      enum { SMAX = 255 };
+      const uint32_t S = n >= 65536 ? 255u : 63u, delta = n >= 65536 ? 16u : 8u;
+      float key[SMAX];
+      for (uint32_t j = 0; j < S; ++j) { /* insertion sort of the sample */
+        float x = r[lo + (uint32_t)(((uint64_t)n * (2 * j + 1)) / (2 * S))].p[ax];
+        uint32_t i = j;
+        while (i > 0 && key[i - 1] > x) {
+          key[i] = key[i - 1];
+          --i;
+        }
+        key[i] = x;
+      }
+      uint32_t t = (uint32_t)(((uint64_t)(m - lo) * S) / n);
+      a = key[t > delta ? t - delta : 0];
+      b = key[t + delta < S ? t + delta : S - 1];
+    } else {
+      float x = r[lo].p[ax], y = r[lo + n / 2].p[ax], z = r[hi - 1].p[ax];
+      a = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+      b = a;
     }
-    r[store] = pv;
-    memcpy(&r[store + 1], &tmp[lo], sizeof(kd_rec) * right);
-    if (store == m) return;
-    if (m < store) hi = store;
-    else lo = store + 1;
+    uint32_t mlo, mhi;
+    partition3(r, tmp, lo, hi, a, b, ax, &mlo, &mhi);
+    if (m < mlo) {
+      hi = mlo;
+      sample = true;
+    } else if (m >= mhi) {
+      lo = mhi;
+      sample = true;
+    } else {
+      if (a == b) return; /* the middle part is one key */
+      if (mhi - mlo == n && !used_sample) return; /* only with NaN keys (positions must be finite) */
+      sample = mhi - mlo < n; /* no progress (the sample spanned all): one pivot next */
+      lo = mlo;
+      hi = mhi;
+    }
   }
   for (uint32_t i = lo + 1; i < hi; ++i) {
     kd_rec x = r[i];
     uint32_t j = i;
-    while (j > lo && rec_less(&x, r[j - 1].p[ax], r[j - 1].id, ax)) {
+    while (j > lo && r[j - 1].p[ax] > x.p[ax]) {
       r[j] = r[j - 1];
       --j;
     }
@@ -95,20 +107,28 @@ static inline void select_nth(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, 
   }
 }
 
-/* Splits [lo, hi) at its median along the widest extent of its points. */
-static uint32_t split_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi) {
+/* The bounds of [lo, hi): min in box[0..2], max in box[3..5]. */
+static void range_box(const kd_rec *r, uint32_t lo, uint32_t hi, float box[6]) {
   float mn[4] = {INFINITY, INFINITY, INFINITY, INFINITY}, mx[4] = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
   for (uint32_t i = lo; i < hi; ++i) {
-    float v[4]; /* all four lanes (the id's bits in the last, ignored): one vector min/max */
+    float v[4]; /* all four lanes (the id's bits in the last, ignored) */
     memcpy(v, &r[i], sizeof v);
     for (int k = 0; k < 4; ++k) { /* plain compares: fminf is a libm call here */
       mn[k] = v[k] < mn[k] ? v[k] : mn[k];
       mx[k] = v[k] > mx[k] ? v[k] : mx[k];
     }
   }
+  for (int k = 0; k < 3; ++k) box[k] = mn[k], box[3 + k] = mx[k];
+}
+
+/* Splits [lo, hi) at its median along the widest extent of its cell `box`
+ * (the group's bounds cut at the medians above: no pass over the points),
+ * and writes the children's cells. */
+static uint32_t split_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi, const float box[6],
+                            float lbox[6], float rbox[6]) {
   int ax = 0;
   for (int k = 1; k < 3; ++k)
-    if (mx[k] - mn[k] > mx[ax] - mn[ax]) ax = k;
+    if (box[3 + k] - box[k] > box[3 + ax] - box[ax]) ax = k;
   uint32_t m = lo + (hi - lo) / 2;
   switch (ax) { /* a constant axis in each copy: keys at fixed offsets */
   case 0: select_nth(r, tmp, lo, hi, m, 0); break;
@@ -116,20 +136,29 @@ static uint32_t split_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, 
   default: select_nth(r, tmp, lo, hi, m, 2); break;
   }
   axis[m] = (uint8_t)ax;
+  memcpy(lbox, box, sizeof(float) * 6);
+  memcpy(rbox, box, sizeof(float) * 6);
+  lbox[3 + ax] = r[m].p[ax];
+  rbox[ax] = r[m].p[ax];
   return m;
 }
 
 /* tmp: scratch records, [lo, hi) used. */
-static void build_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi) {
+static void build_range(kd_rec *r, kd_rec *tmp, uint8_t *axis, uint32_t lo, uint32_t hi, const float box[6]) {
+  float cur[6];
+  memcpy(cur, box, sizeof cur);
   while (hi - lo > LEAF) {
-    uint32_t m = split_range(r, tmp, axis, lo, hi);
-    build_range(r, tmp, axis, lo, m);
+    float lbox[6], rbox[6];
+    uint32_t m = split_range(r, tmp, axis, lo, hi, cur, lbox, rbox);
+    build_range(r, tmp, axis, lo, m, lbox);
     lo = m + 1; /* loop instead of recursing on the right half */
+    memcpy(cur, rbox, sizeof cur);
   }
 }
 
 typedef struct build_task {
   uint32_t lo, hi;
+  float box[6];
 } build_task;
 
 typedef struct build_ctx {
@@ -140,23 +169,42 @@ typedef struct build_ctx {
 } build_ctx;
 
 /* The top `depth` levels, serially; the ranges below become tasks. */
-static void build_top(build_ctx *c, uint32_t lo, uint32_t hi, int depth) {
+static void build_top(build_ctx *c, uint32_t lo, uint32_t hi, int depth, const float box[6]) {
   if (hi - lo <= LEAF) return;
   if (depth == 0) {
-    c->tasks[c->task_count].lo = lo;
-    c->tasks[c->task_count].hi = hi;
-    c->task_count++;
+    build_task *t = &c->tasks[c->task_count++];
+    t->lo = lo;
+    t->hi = hi;
+    memcpy(t->box, box, sizeof t->box);
     return;
   }
-  uint32_t m = split_range(c->r, c->tmp, c->axis, lo, hi);
-  build_top(c, lo, m, depth - 1);
-  build_top(c, m + 1, hi, depth - 1);
+  float lbox[6], rbox[6];
+  uint32_t m = split_range(c->r, c->tmp, c->axis, lo, hi, box, lbox, rbox);
+  build_top(c, lo, m, depth - 1, lbox);
+  build_top(c, m + 1, hi, depth - 1, rbox);
 }
 
 static void build_tasks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   (void)thread_index;
   build_ctx *c = ctx;
-  for (uint64_t t = begin; t < end; ++t) build_range(c->r, c->tmp, c->axis, c->tasks[t].lo, c->tasks[t].hi);
+  for (uint64_t t = begin; t < end; ++t) build_range(c->r, c->tmp, c->axis, c->tasks[t].lo, c->tasks[t].hi, c->tasks[t].box);
+}
+
+#define COPY_CHUNK 16384u
+typedef struct copy_ctx {
+  iris_kdtree *tree;
+  const kd_rec *r;
+} copy_ctx;
+
+static void copy_out(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  copy_ctx *c = ctx;
+  uint32_t lo = (uint32_t)begin * COPY_CHUNK, hi = (uint32_t)end * COPY_CHUNK;
+  if (hi > c->tree->count) hi = c->tree->count;
+  for (uint32_t i = lo; i < hi; ++i) {
+    memcpy(&c->tree->points[3 * (size_t)i], c->r[i].p, sizeof(float) * 3);
+    c->tree->ids[i] = c->r[i].id;
+  }
 }
 
 /* Tasks for one group's range [lo, hi): subtrees of at least ~16k points per
@@ -178,11 +226,18 @@ iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_
   uint32_t groups = group ? group_count : 1;
   uint32_t *start = calloc((size_t)groups + 1, sizeof(uint32_t));
   if (!start) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree");
-  for (uint32_t i = 0; i < count; ++i) start[(group ? group[i] : 0) + 1]++;
+  for (uint32_t i = 0; i < count; ++i)
+    if (!group || group[i] < groups) start[(group ? group[i] : 0) + 1]++;
   size_t max_tasks = 0;
   for (uint32_t g = 0; g < groups; ++g) {
     max_tasks += (size_t)1 << group_depth(start[g + 1], threads);
     start[g + 1] += start[g];
+  }
+  const uint32_t total = count;
+  count = start[groups]; /* points in some group */
+  if (count == 0) {
+    free(start);
+    return IRIS_OK;
   }
   kd_rec *r = malloc(sizeof(kd_rec) * (size_t)count), *tmp = malloc(sizeof(kd_rec) * (size_t)count);
   build_task *tasks = malloc(sizeof(build_task) * max_tasks);
@@ -203,19 +258,21 @@ iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_
   tree->count = count;
   memcpy(at, start, sizeof(uint32_t) * groups);
   const unsigned char *b = base;
-  for (uint32_t i = 0; i < count; ++i) { /* counting sort by group, index order within */
+  for (uint32_t i = 0; i < total; ++i) { /* counting sort by group, index order within */
+    if (group && group[i] >= groups) continue;
     kd_rec *o = &r[at[group ? group[i] : 0]++];
     memcpy(o->p, b + (size_t)i * stride, sizeof(float) * 3);
     o->id = i;
   }
   free(at);
   build_ctx c = {r, tmp, tree->axis, tasks, 0};
-  for (uint32_t g = 0; g < groups; ++g) build_top(&c, start[g], start[g + 1], group_depth(start[g + 1] - start[g], threads));
-  if (c.task_count) iris_parallel_for(c.task_count, 1, threads, build_tasks, &c);
-  for (uint32_t i = 0; i < count; ++i) {
-    memcpy(&tree->points[3 * (size_t)i], r[i].p, sizeof(float) * 3);
-    tree->ids[i] = r[i].id;
+  for (uint32_t g = 0; g < groups; ++g) {
+    float box[6];
+    range_box(r, start[g], start[g + 1], box);
+    build_top(&c, start[g], start[g + 1], group_depth(start[g + 1] - start[g], threads), box);
   }
+  if (c.task_count) iris_parallel_for(c.task_count, 1, threads, build_tasks, &c);
+  iris_parallel_for((count + COPY_CHUNK - 1) / COPY_CHUNK, 1, threads, copy_out, &(copy_ctx){tree, r});
   free(tasks);
   free(tmp);
   free(r);
@@ -238,7 +295,22 @@ iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride
   return iris_kdtree_build_threads(tree, base, stride, count, 1, err);
 }
 
-iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size,
+typedef struct payload_ctx {
+  iris_kdtree *tree;
+  const unsigned char *base;
+  size_t stride, size;
+} payload_ctx;
+
+static void gather_payload(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  payload_ctx *c = ctx;
+  uint32_t lo = (uint32_t)begin * COPY_CHUNK, hi = (uint32_t)end * COPY_CHUNK;
+  if (hi > c->tree->count) hi = c->tree->count;
+  for (uint32_t i = lo; i < hi; ++i)
+    memcpy(c->tree->payload + (size_t)i * c->size, c->base + (size_t)c->tree->ids[i] * c->stride, c->size);
+}
+
+iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size, int threads,
                                     iris_error *err) {
   free(tree->payload);
   tree->payload = NULL;
@@ -248,9 +320,8 @@ iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t 
   if (!tree->payload)
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree payload");
   tree->payload_size = size;
-  const unsigned char *b = base;
-  for (uint32_t i = 0; i < tree->count; ++i)
-    memcpy(tree->payload + (size_t)i * size, b + (size_t)tree->ids[i] * stride, size);
+  payload_ctx c = {tree, base, stride, size};
+  iris_parallel_for((tree->count + COPY_CHUNK - 1) / COPY_CHUNK, 1, threads, gather_payload, &c);
   return IRIS_OK;
 }
 
@@ -411,9 +482,169 @@ static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const f
   }
 }
 
+/* Large k (filling caches, k = 200): candidates better than the k-th best so
+ * far are appended to a buffer of 2k; when it is full, a selection keeps the
+ * k best and tightens the bound; at the end the k best are sorted. Keys are
+ * (d2 bits << 32 | id): squared distances are >= +0, so integer order is
+ * (distance, index) order, and every comparison is one integer compare. */
+#define BUF_K_MAX 512
+typedef struct kbuf_entry {
+  uint64_t key;
+  uint32_t slot;
+} kbuf_entry;
+
+typedef struct knn_buf {
+  uint32_t k, n;
+  kbuf_entry *e; /* 2k */
+  float bound;        /* squared distance of bound_key */
+  uint64_t bound_key; /* only keys below it can still be among the k best */
+  uint64_t max_key;   /* bound_key from max_d2 alone */
+  const uint32_t *tids;
+  bool (*accept)(void *ctx, uint32_t id);
+  bool (*accept_payload)(void *ctx, const void *payload);
+  const unsigned char *payload;
+  size_t payload_size;
+  void *ctx;
+} knn_buf;
+
+static inline uint64_t make_key(float d2, uint32_t id) {
+  uint32_t bits;
+  memcpy(&bits, &d2, sizeof bits);
+  return (uint64_t)bits << 32 | id;
+}
+
+/* Puts the k-th smallest key at e[k - 1], smaller ones before (k >= 1). */
+static void select_keys(kbuf_entry *e, uint32_t n, uint32_t k) {
+  uint32_t lo = 0, hi = n, m = k - 1;
+  while (hi - lo > 8) {
+    uint32_t mid = lo + (hi - lo) / 2;
+    uint64_t x = e[lo].key, y = e[mid].key, z = e[hi - 1].key;
+    uint64_t v = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
+    uint32_t i = lo, j = hi - 1; /* Hoare: keys are distinct, v is one of them */
+    for (;;) {
+      while (e[i].key < v) ++i;
+      while (e[j].key > v) --j;
+      if (i >= j) break;
+      kbuf_entry t = e[i];
+      e[i] = e[j];
+      e[j] = t;
+    }
+    /* now e[j] == v, [lo, j) < v < (j, hi) */
+    if (m == j) return;
+    if (m < j) hi = j;
+    else lo = j + 1;
+  }
+  for (uint32_t i = lo + 1; i < hi; ++i) {
+    kbuf_entry x = e[i];
+    uint32_t j = i;
+    while (j > lo && e[j - 1].key > x.key) {
+      e[j] = e[j - 1];
+      --j;
+    }
+    e[j] = x;
+  }
+}
+
+static void sort_keys(kbuf_entry *e, uint32_t n) {
+  while (n > 16) {
+    uint32_t mid = n / 2;
+    select_keys(e, n, mid + 1); /* median at mid, then sort both sides */
+    sort_keys(e + mid + 1, n - mid - 1);
+    n = mid;
+  }
+  for (uint32_t i = 1; i < n; ++i) {
+    kbuf_entry x = e[i];
+    uint32_t j = i;
+    while (j > 0 && e[j - 1].key > x.key) {
+      e[j] = e[j - 1];
+      --j;
+    }
+    e[j] = x;
+  }
+}
+
+static void buf_offer(knn_buf *b, uint32_t i, float d2) {
+  uint64_t key = make_key(d2, b->tids[i]);
+  if (key >= b->bound_key) return;
+  if (b->accept && !b->accept(b->ctx, b->tids[i])) return;
+  if (b->accept_payload && !b->accept_payload(b->ctx, b->payload + (size_t)i * b->payload_size)) return;
+  b->e[b->n].key = key;
+  b->e[b->n].slot = i;
+  if (++b->n == b->k && b->bound_key == b->max_key) { /* the first k: the worst bounds the rest */
+    uint64_t worst = 0;
+    for (uint32_t j = 0; j < b->k; ++j) worst = b->e[j].key > worst ? b->e[j].key : worst;
+    b->bound_key = worst; /* kept already: the next must be better */
+    uint32_t bits = (uint32_t)(worst >> 32);
+    memcpy(&b->bound, &bits, sizeof bits);
+  } else if (b->n == 2 * b->k) {
+    select_keys(b->e, b->n, b->k);
+    b->n = b->k;
+    b->bound_key = b->e[b->k - 1].key;
+    uint32_t bits = (uint32_t)(b->bound_key >> 32);
+    memcpy(&b->bound, &bits, sizeof bits);
+  }
+}
+
+static void search_buf(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q[3], knn_buf *b) {
+  while (hi - lo > LEAF) {
+    uint32_t m = lo + (hi - lo) / 2;
+    const float *p = &t->points[3 * (size_t)m];
+    float d2 = dist2(p, q);
+    if (d2 <= b->bound) buf_offer(b, m, d2);
+    int ax = t->axis[m];
+    float diff = q[ax] - p[ax];
+    /* <= keeps equal-distance points reachable for the index tie-break. */
+    if (diff < 0.0f) {
+      search_buf(t, lo, m, q, b);
+      if (!(diff * diff <= b->bound)) return;
+      lo = m + 1;
+    } else {
+      search_buf(t, m + 1, hi, q, b);
+      if (!(diff * diff <= b->bound)) return;
+      hi = m;
+    }
+  }
+  for (uint32_t i = lo; i < hi; ++i) {
+    float d2 = dist2(&t->points[3 * (size_t)i], q);
+    if (d2 <= b->bound) buf_offer(b, i, d2);
+  }
+}
+
+static uint32_t knn_buf_run(const iris_kdtree *tree, iris_vec3 q, const knn_heap *h, const uint32_t *groups,
+                            uint32_t ngroups, uint32_t *slots) {
+  kbuf_entry e[2 * BUF_K_MAX];
+  const uint64_t max_key = make_key(h->max_d2, UINT32_MAX);
+  knn_buf b = {h->k, 0, e, h->max_d2, max_key, max_key, tree->ids, h->accept, h->accept_payload,
+               h->payload, h->payload_size, h->ctx};
+  float qq[3] = {q.x, q.y, q.z};
+  if (!tree->group_count) {
+    search_buf(tree, 0, tree->count, qq, &b);
+  } else if (!groups) {
+    for (uint32_t g = 0; g < tree->group_count; ++g) search_buf(tree, tree->group_start[g], tree->group_start[g + 1], qq, &b);
+  } else {
+    for (uint32_t j = 0; j < ngroups; ++j) {
+      uint32_t g = groups[j];
+      if (g < tree->group_count) search_buf(tree, tree->group_start[g], tree->group_start[g + 1], qq, &b);
+    }
+  }
+  if (b.n > b.k) {
+    select_keys(b.e, b.n, b.k);
+    b.n = b.k;
+  }
+  sort_keys(b.e, b.n);
+  for (uint32_t j = 0; j < b.n; ++j) {
+    uint32_t bits = (uint32_t)(b.e[j].key >> 32);
+    memcpy(&h->d2[j], &bits, sizeof bits);
+    h->slots[j] = (uint32_t)b.e[j].key; /* the id */
+    if (slots) slots[j] = b.e[j].slot;
+  }
+  return b.n;
+}
+
 /* Searches the listed groups (NULL: every group; a tree without groups is one). */
 static uint32_t knn_heap_run(const iris_kdtree *tree, iris_vec3 q, knn_heap *h, const uint32_t *groups,
                              uint32_t ngroups, uint32_t *slots) {
+  if (h->k <= BUF_K_MAX) return knn_buf_run(tree, q, h, groups, ngroups, slots);
   float qq[3] = {q.x, q.y, q.z};
   if (!tree->group_count) {
     search(tree, 0, tree->count, qq, h);

@@ -19,7 +19,7 @@ extern "C" {
 #endif
 
 /* Index ranges of at most this many points are leaves: unordered, scanned. */
-#define IRIS_KDTREE_LEAF 8
+#define IRIS_KDTREE_LEAF 16
 
 typedef struct iris_kdtree {
   uint32_t count;
@@ -40,10 +40,11 @@ iris_status iris_kdtree_build(iris_kdtree *tree, const void *base, size_t stride
  * threads (<= 0: all cores). */
 iris_status iris_kdtree_build_threads(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
                                       int threads, iris_error *err);
-/* A forest: point i goes to group[i] (< group_count), each group gets its own
- * tree, and a query may search only some groups (the photons whose normals
- * can pass a cache's filter). Queries over all groups answer exactly as one
- * tree over all points. */
+/* A forest: point i goes to group[i] (>= group_count: left out of the tree),
+ * each group gets its own tree, and a query may search only some groups (the
+ * photons whose normals can pass a cache's filter). ids stay the caller's
+ * indices; queries over all groups answer exactly as one tree over the
+ * points in groups. */
 iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_t stride, uint32_t count,
                                       const uint32_t *group, uint32_t group_count, int threads,
                                       iris_error *err);
@@ -51,9 +52,9 @@ void iris_kdtree_destroy(iris_kdtree *tree);
 
 /* Copies `size` bytes per point, read at `base + id * stride`, into tree
  * order, so that a filter (iris_kdtree_knn_payload_if) reads them next to
- * the points instead of chasing the caller's array. Replaces any earlier
- * payload. */
-iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size,
+ * the points instead of chasing the caller's array (on `threads` threads,
+ * <= 0: all cores). Replaces any earlier payload. */
+iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size, int threads,
                                     iris_error *err);
 
 /* Up to k nearest points to q within squared distance max_d2 (INFINITY for

@@ -185,7 +185,7 @@ static void run_filtered(uint32_t n, int lattice, int threads, uint64_t seed) {
   }
   iris_kdtree t;
   if (iris_kdtree_build_threads(&t, pts, sizeof(filt_point), n, threads, NULL) != IRIS_OK ||
-      iris_kdtree_set_payload(&t, pts, sizeof(filt_point), sizeof(filt_point), NULL) != IRIS_OK) {
+      iris_kdtree_set_payload(&t, pts, sizeof(filt_point), sizeof(filt_point), threads, NULL) != IRIS_OK) {
     ++failures;
     return;
   }
