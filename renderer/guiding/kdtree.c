@@ -495,7 +495,8 @@ typedef struct kbuf_entry {
 
 typedef struct knn_buf {
   uint32_t k, n;
-  kbuf_entry *e; /* 2k */
+  kbuf_entry *e;   /* 2k */
+  kbuf_entry *tmp; /* 2k scratch */
   float bound;        /* squared distance of bound_key */
   uint64_t bound_key; /* only keys below it can still be among the k best */
   uint64_t max_key;   /* bound_key from max_d2 alone */
@@ -513,27 +514,30 @@ static inline uint64_t make_key(float d2, uint32_t id) {
   return (uint64_t)bits << 32 | id;
 }
 
-/* Puts the k-th smallest key at e[k - 1], smaller ones before (k >= 1). */
-static void select_keys(kbuf_entry *e, uint32_t n, uint32_t k) {
-  uint32_t lo = 0, hi = n, m = k - 1;
-  while (hi - lo > 8) {
-    uint32_t mid = lo + (hi - lo) / 2;
-    uint64_t x = e[lo].key, y = e[mid].key, z = e[hi - 1].key;
-    uint64_t v = x < y ? (y < z ? y : (x < z ? z : x)) : (x < z ? x : (y < z ? z : y));
-    uint32_t i = lo, j = hi - 1; /* Hoare: keys are distinct, v is one of them */
-    for (;;) {
-      while (e[i].key < v) ++i;
-      while (e[j].key > v) --j;
-      if (i >= j) break;
-      kbuf_entry t = e[i];
-      e[i] = e[j];
-      e[j] = t;
-    }
-    /* now e[j] == v, [lo, j) < v < (j, hi) */
-    if (m == j) return;
-    if (m < j) hi = j;
-    else lo = j + 1;
+/* Branch-free partition of e[lo, hi) around its median of three (keys are
+ * distinct): smaller keys compacted in place, then the pivot, then the
+ * larger ones (through tmp). Returns the pivot's position. */
+static uint32_t partition_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t lo, uint32_t hi) {
+  uint32_t a = lo, b = lo + (hi - lo) / 2, c = hi - 1;
+  uint64_t x = e[a].key, y = e[b].key, z = e[c].key;
+  uint32_t p = x < y ? (y < z ? b : (x < z ? c : a)) : (x < z ? a : (y < z ? c : b));
+  kbuf_entry pv = e[p];
+  e[p] = e[hi - 1];
+  uint32_t store = lo, right = 0;
+  for (uint32_t i = lo; i < hi - 1; ++i) {
+    kbuf_entry xe = e[i];
+    uint32_t lt = xe.key < pv.key;
+    e[store] = xe; /* store <= i: already read */
+    tmp[right] = xe;
+    store += lt;
+    right += lt ^ 1u;
   }
+  e[store] = pv;
+  memcpy(&e[store + 1], tmp, sizeof(kbuf_entry) * right);
+  return store;
+}
+
+static void insertion_sort_keys(kbuf_entry *e, uint32_t lo, uint32_t hi) {
   for (uint32_t i = lo + 1; i < hi; ++i) {
     kbuf_entry x = e[i];
     uint32_t j = i;
@@ -545,22 +549,30 @@ static void select_keys(kbuf_entry *e, uint32_t n, uint32_t k) {
   }
 }
 
-static void sort_keys(kbuf_entry *e, uint32_t n) {
-  while (n > 16) {
-    uint32_t mid = n / 2;
-    select_keys(e, n, mid + 1); /* median at mid, then sort both sides */
-    sort_keys(e + mid + 1, n - mid - 1);
-    n = mid;
+/* Puts the k-th smallest key at e[k - 1], smaller ones before (k >= 1). */
+static void select_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t n, uint32_t k) {
+  uint32_t lo = 0, hi = n, m = k - 1;
+  while (hi - lo > 12) {
+    uint32_t j = partition_keys(e, tmp, lo, hi);
+    if (m == j) return;
+    if (m < j) hi = j;
+    else lo = j + 1;
   }
-  for (uint32_t i = 1; i < n; ++i) {
-    kbuf_entry x = e[i];
-    uint32_t j = i;
-    while (j > 0 && e[j - 1].key > x.key) {
-      e[j] = e[j - 1];
-      --j;
+  insertion_sort_keys(e, lo, hi);
+}
+
+static void sort_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t lo, uint32_t hi) {
+  while (hi - lo > 12) {
+    uint32_t j = partition_keys(e, tmp, lo, hi);
+    if (j - lo < hi - j) { /* recurse into the smaller side */
+      sort_keys(e, tmp, lo, j);
+      lo = j + 1;
+    } else {
+      sort_keys(e, tmp, j + 1, hi);
+      hi = j;
     }
-    e[j] = x;
   }
+  insertion_sort_keys(e, lo, hi);
 }
 
 static void buf_offer(knn_buf *b, uint32_t i, float d2) {
@@ -577,7 +589,7 @@ static void buf_offer(knn_buf *b, uint32_t i, float d2) {
     uint32_t bits = (uint32_t)(worst >> 32);
     memcpy(&b->bound, &bits, sizeof bits);
   } else if (b->n == 2 * b->k) {
-    select_keys(b->e, b->n, b->k);
+    select_keys(b->e, b->tmp, b->n, b->k);
     b->n = b->k;
     b->bound_key = b->e[b->k - 1].key;
     uint32_t bits = (uint32_t)(b->bound_key >> 32);
@@ -612,9 +624,9 @@ static void search_buf(const iris_kdtree *t, uint32_t lo, uint32_t hi, const flo
 
 static uint32_t knn_buf_run(const iris_kdtree *tree, iris_vec3 q, const knn_heap *h, const uint32_t *groups,
                             uint32_t ngroups, uint32_t *slots) {
-  kbuf_entry e[2 * BUF_K_MAX];
+  kbuf_entry e[2 * BUF_K_MAX], tmp[2 * BUF_K_MAX];
   const uint64_t max_key = make_key(h->max_d2, UINT32_MAX);
-  knn_buf b = {h->k, 0, e, h->max_d2, max_key, max_key, tree->ids, h->accept, h->accept_payload,
+  knn_buf b = {h->k, 0, e, tmp, h->max_d2, max_key, max_key, tree->ids, h->accept, h->accept_payload,
                h->payload, h->payload_size, h->ctx};
   float qq[3] = {q.x, q.y, q.z};
   if (!tree->group_count) {
@@ -628,10 +640,10 @@ static uint32_t knn_buf_run(const iris_kdtree *tree, iris_vec3 q, const knn_heap
     }
   }
   if (b.n > b.k) {
-    select_keys(b.e, b.n, b.k);
+    select_keys(b.e, b.tmp, b.n, b.k);
     b.n = b.k;
   }
-  sort_keys(b.e, b.n);
+  sort_keys(b.e, b.tmp, 0, b.n);
   for (uint32_t j = 0; j < b.n; ++j) {
     uint32_t bits = (uint32_t)(b.e[j].key >> 32);
     memcpy(&h->d2[j], &bits, sizeof bits);
