@@ -28,18 +28,20 @@ typedef struct kd_rec {
  * is [*mlo, *mhi). */
 static inline void partition3(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, float a, float b, int ax,
                               uint32_t *mlo, uint32_t *mhi) {
-  uint32_t store = lo, mc = 0, rc = 0;
-  for (uint32_t i = lo; i < hi; ++i) {
-    const kd_rec *x = &r[i]; /* whole 16-byte copies (a struct copy gets split in fields) */
-    float k = x->p[ax];
-    uint32_t lt = k < a, gt = k > b;
-    memcpy(&tmp[lo + mc], x, sizeof *x);
-    memcpy(&tmp[hi - 1 - rc], x, sizeof *x);
-    memmove(&r[store], x, sizeof *x); /* store <= i: already read */
-    store += lt;
-    mc += (lt | gt) ^ 1u;
-    rc += gt;
+  kd_rec *out_l = r + lo, *out_m = tmp + lo, *out_r = tmp + hi - 1;
+  for (const kd_rec *x = r + lo, *end = r + hi; x < end; ++x) {
+    kd_rec v; /* whole 16-byte copies (a struct assignment gets split in fields) */
+    memcpy(&v, x, sizeof v);
+    float k = v.p[ax];
+    size_t lt = k < a, gt = k > b;
+    memcpy(out_m, &v, sizeof v);
+    memcpy(out_r, &v, sizeof v);
+    memcpy(out_l, &v, sizeof v); /* out_l <= x: already read (the same item at worst) */
+    out_l += lt;
+    out_m += (lt | gt) ^ 1u;
+    out_r -= gt;
   }
+  uint32_t store = (uint32_t)(out_l - r), mc = (uint32_t)(out_m - (tmp + lo)), rc = hi - store - mc;
   memcpy(&r[store], &tmp[lo], sizeof(kd_rec) * mc);
   memcpy(&r[store + mc], &tmp[hi - rc], sizeof(kd_rec) * rc);
   *mlo = store;
