@@ -54,7 +54,7 @@ static inline void partition3(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, 
  * in the short middle part; short ranges: a median-of-three pivot with
  * equal keys in the middle part (so runs of equal keys end the search
  * instead of making it quadratic); the last few by insertion. */
-#define FR_MIN 4096u
+#define FR_MIN 1024u
 static inline void select_nth(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, uint32_t m, int ax) {
   bool sample = true;
   while (hi - lo > 16) {
@@ -63,7 +63,7 @@ static inline void select_nth(kd_rec *r, kd_rec *tmp, uint32_t lo, uint32_t hi, 
     const bool used_sample = sample && n >= FR_MIN;
     if (used_sample) {
       enum { SMAX = 255 };
-      const uint32_t S = n >= 65536 ? 255u : 63u, delta = n >= 65536 ? 16u : 8u;
+      const uint32_t S = n >= 65536 ? 255u : (n >= 4096 ? 63u : 31u), delta = n >= 65536 ? 16u : (n >= 4096 ? 8u : 5u);
       float key[SMAX];
       for (uint32_t j = 0; j < S; ++j) { /* insertion sort of the sample */
         float x = r[lo + (uint32_t)(((uint64_t)n * (2 * j + 1)) / (2 * S))].p[ax];
@@ -308,8 +308,11 @@ static void gather_payload(void *ctx, uint64_t begin, uint64_t end, int thread_i
   payload_ctx *c = ctx;
   uint32_t lo = (uint32_t)begin * COPY_CHUNK, hi = (uint32_t)end * COPY_CHUNK;
   if (hi > c->tree->count) hi = c->tree->count;
-  for (uint32_t i = lo; i < hi; ++i)
-    memcpy(c->tree->payload + (size_t)i * c->size, c->base + (size_t)c->tree->ids[i] * c->stride, c->size);
+  const uint32_t *ids = c->tree->ids;
+  for (uint32_t i = lo; i < hi; ++i) { /* random reads: fetch a few items ahead */
+    if (i + 8 < hi) __builtin_prefetch(c->base + (size_t)ids[i + 8] * c->stride);
+    memcpy(c->tree->payload + (size_t)i * c->size, c->base + (size_t)ids[i] * c->stride, c->size);
+  }
 }
 
 iris_status iris_kdtree_set_payload(iris_kdtree *tree, const void *base, size_t stride, size_t size, int threads,
