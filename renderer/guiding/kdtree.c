@@ -487,12 +487,11 @@ static void search_small(const iris_kdtree *t, uint32_t lo, uint32_t hi, const f
   }
 }
 
-/* k up to BUF_K_MAX (filling caches, k = 200): a max-heap of keys
+/* Large k (filling caches, k = 200): candidates better than the k-th best so
+ * far are appended to a buffer of 2k; when it is full, a selection keeps the
+ * k best and tightens the bound; at the end the k best are sorted. Keys are
  * (d2 bits << 32 | id): squared distances are >= +0, so integer order is
- * (distance, index) order and every comparison is one integer compare (the
- * child choice compiles to a conditional move). The root is the worst kept,
- * so the bound is always the current k-th best; sifts move a hole. The k
- * best are sorted at the end with branch-free partitions. */
+ * (distance, index) order, and every comparison is one integer compare. */
 #define BUF_K_MAX 512
 typedef struct kbuf_entry {
   uint64_t key;
@@ -501,10 +500,11 @@ typedef struct kbuf_entry {
 
 typedef struct knn_buf {
   uint32_t k, n;
-  kbuf_entry *e;   /* the heap, k */
-  kbuf_entry *tmp; /* k scratch for the final sort */
+  kbuf_entry *e;   /* 2k */
+  kbuf_entry *tmp; /* 2k scratch */
   float bound;        /* squared distance of bound_key */
   uint64_t bound_key; /* only keys below it can still be among the k best */
+  uint64_t max_key;   /* bound_key from max_d2 alone */
   const uint32_t *tids;
   bool (*accept)(void *ctx, uint32_t id);
   bool (*accept_payload)(void *ctx, const void *payload);
@@ -554,6 +554,18 @@ static void insertion_sort_keys(kbuf_entry *e, uint32_t lo, uint32_t hi) {
   }
 }
 
+/* Puts the k-th smallest key at e[k - 1], smaller ones before (k >= 1). */
+static void select_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t n, uint32_t k) {
+  uint32_t lo = 0, hi = n, m = k - 1;
+  while (hi - lo > 12) {
+    uint32_t j = partition_keys(e, tmp, lo, hi);
+    if (m == j) return;
+    if (m < j) hi = j;
+    else lo = j + 1;
+  }
+  insertion_sort_keys(e, lo, hi);
+}
+
 static void sort_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t lo, uint32_t hi) {
   while (hi - lo > 12) {
     uint32_t j = partition_keys(e, tmp, lo, hi);
@@ -568,42 +580,26 @@ static void sort_keys(kbuf_entry *e, kbuf_entry *tmp, uint32_t lo, uint32_t hi) 
   insertion_sort_keys(e, lo, hi);
 }
 
-/* Offers tree node i at squared distance d2 (already <= b->bound). */
-static void kheap_offer(knn_buf *b, uint32_t i, float d2) {
+static void buf_offer(knn_buf *b, uint32_t i, float d2) {
   uint64_t key = make_key(d2, b->tids[i]);
   if (key >= b->bound_key) return;
   if (b->accept && !b->accept(b->ctx, b->tids[i])) return;
   if (b->accept_payload && !b->accept_payload(b->ctx, b->payload + (size_t)i * b->payload_size)) return;
-  kbuf_entry *e = b->e;
-  uint32_t j;
-  if (b->n < b->k) {
-    j = b->n++;
-    while (j > 0) {
-      uint32_t p = (j - 1) / 2;
-      if (e[p].key >= key) break;
-      e[j] = e[p];
-      j = p;
-    }
-    e[j].key = key;
-    e[j].slot = i;
-    if (b->n < b->k) return;
-  } else {
-    const uint32_t n = b->n;
-    j = 0;
-    for (;;) {
-      uint32_t l = 2 * j + 1;
-      if (l >= n) break;
-      uint32_t c = l + (uint32_t)(l + 1 < n && e[l + 1].key > e[l].key);
-      if (e[c].key <= key) break;
-      e[j] = e[c];
-      j = c;
-    }
-    e[j].key = key;
-    e[j].slot = i;
+  b->e[b->n].key = key;
+  b->e[b->n].slot = i;
+  if (++b->n == b->k && b->bound_key == b->max_key) { /* the first k: the worst bounds the rest */
+    uint64_t worst = 0;
+    for (uint32_t j = 0; j < b->k; ++j) worst = b->e[j].key > worst ? b->e[j].key : worst;
+    b->bound_key = worst; /* kept already: the next must be better */
+    uint32_t bits = (uint32_t)(worst >> 32);
+    memcpy(&b->bound, &bits, sizeof bits);
+  } else if (b->n == 2 * b->k) {
+    select_keys(b->e, b->tmp, b->n, b->k);
+    b->n = b->k;
+    b->bound_key = b->e[b->k - 1].key;
+    uint32_t bits = (uint32_t)(b->bound_key >> 32);
+    memcpy(&b->bound, &bits, sizeof bits);
   }
-  b->bound_key = e[0].key;
-  uint32_t bits = (uint32_t)(e[0].key >> 32);
-  memcpy(&b->bound, &bits, sizeof bits);
 }
 
 static void search_buf(const iris_kdtree *t, uint32_t lo, uint32_t hi, const float q[3], knn_buf *b) {
@@ -611,7 +607,7 @@ static void search_buf(const iris_kdtree *t, uint32_t lo, uint32_t hi, const flo
     uint32_t m = lo + (hi - lo) / 2;
     const float *p = &t->points[3 * (size_t)m];
     float d2 = dist2(p, q);
-    if (d2 <= b->bound) kheap_offer(b, m, d2);
+    if (d2 <= b->bound) buf_offer(b, m, d2);
     int ax = t->axis[m];
     float diff = q[ax] - p[ax];
     /* <= keeps equal-distance points reachable for the index tie-break. */
@@ -627,14 +623,15 @@ static void search_buf(const iris_kdtree *t, uint32_t lo, uint32_t hi, const flo
   }
   for (uint32_t i = lo; i < hi; ++i) {
     float d2 = dist2(&t->points[3 * (size_t)i], q);
-    if (d2 <= b->bound) kheap_offer(b, i, d2);
+    if (d2 <= b->bound) buf_offer(b, i, d2);
   }
 }
 
 static uint32_t knn_buf_run(const iris_kdtree *tree, iris_vec3 q, const knn_heap *h, const uint32_t *groups,
                             uint32_t ngroups, uint32_t *slots) {
-  kbuf_entry e[BUF_K_MAX], tmp[BUF_K_MAX];
-  knn_buf b = {h->k, 0, e, tmp, h->max_d2, make_key(h->max_d2, UINT32_MAX), tree->ids, h->accept, h->accept_payload,
+  kbuf_entry e[2 * BUF_K_MAX], tmp[2 * BUF_K_MAX];
+  const uint64_t max_key = make_key(h->max_d2, UINT32_MAX);
+  knn_buf b = {h->k, 0, e, tmp, h->max_d2, max_key, max_key, tree->ids, h->accept, h->accept_payload,
                h->payload, h->payload_size, h->ctx};
   float qq[3] = {q.x, q.y, q.z};
   if (!tree->group_count) {
@@ -646,6 +643,10 @@ static uint32_t knn_buf_run(const iris_kdtree *tree, iris_vec3 q, const knn_heap
       uint32_t g = groups[j];
       if (g < tree->group_count) search_buf(tree, tree->group_start[g], tree->group_start[g + 1], qq, &b);
     }
+  }
+  if (b.n > b.k) {
+    select_keys(b.e, b.tmp, b.n, b.k);
+    b.n = b.k;
   }
   sort_keys(b.e, b.tmp, 0, b.n);
   for (uint32_t j = 0; j < b.n; ++j) {
