@@ -189,7 +189,18 @@ static void build_top(build_ctx *c, uint32_t lo, uint32_t hi, int depth, const f
 static void build_tasks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   (void)thread_index;
   build_ctx *c = ctx;
-  for (uint64_t t = begin; t < end; ++t) build_range(c->r, c->tmp, c->axis, c->tasks[t].lo, c->tasks[t].hi, c->tasks[t].box);
+  for (uint64_t t = begin; t < end; ++t) {
+    build_task *k = &c->tasks[t];
+    if (isnan(k->box[0])) range_box(c->r, k->lo, k->hi, k->box);
+    build_range(c->r, c->tmp, c->axis, k->lo, k->hi, k->box);
+  }
+}
+
+static int task_larger_first(const void *a, const void *b) {
+  const build_task *x = a, *y = b;
+  uint32_t nx = x->hi - x->lo, ny = y->hi - y->lo;
+  if (nx != ny) return nx > ny ? -1 : 1;
+  return x->lo < y->lo ? -1 : (x->lo > y->lo); /* distinct ranges: a total order */
 }
 
 #define COPY_CHUNK 16384u
@@ -269,10 +280,23 @@ iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_
   free(at);
   build_ctx c = {r, tmp, tree->axis, tasks, 0};
   for (uint32_t g = 0; g < groups; ++g) {
+    /* Only a group too big to balance as one task has its top levels split
+     * here (serially); the others are whole tasks, their bounds found there. */
+    uint32_t n = start[g + 1] - start[g];
+    int depth = (uint64_t)n * 2u * (uint64_t)threads > count ? group_depth(n, threads) : 0;
+    if (depth == 0 && n > LEAF) {
+      build_task *t = &c.tasks[c.task_count++];
+      t->lo = start[g];
+      t->hi = start[g + 1];
+      t->box[0] = NAN; /* bounds not known yet */
+      continue;
+    }
     float box[6];
     range_box(r, start[g], start[g + 1], box);
-    build_top(&c, start[g], start[g + 1], group_depth(start[g + 1] - start[g], threads), box);
+    build_top(&c, start[g], start[g + 1], depth, box);
   }
+  /* Largest first: the last tasks to start are the short ones. */
+  qsort(c.tasks, c.task_count, sizeof(build_task), task_larger_first);
   if (c.task_count) iris_parallel_for(c.task_count, 1, threads, build_tasks, &c);
   iris_parallel_for((count + COPY_CHUNK - 1) / COPY_CHUNK, 1, threads, copy_out, &(copy_ctx){tree, r});
   free(tasks);
