@@ -220,6 +220,45 @@ static void copy_out(void *ctx, uint64_t begin, uint64_t end, int thread_index) 
   }
 }
 
+typedef struct scatter_ctx {
+  const uint32_t *group; /* NULL: all in group 0 */
+  uint32_t groups, total;
+  uint32_t *at;          /* [chunk][group]: counts, then where the chunk's next item goes */
+  const unsigned char *base;
+  size_t stride;
+  kd_rec *r;
+} scatter_ctx;
+
+static void count_chunks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  scatter_ctx *c = ctx;
+  for (uint64_t ch = begin; ch < end; ++ch) {
+    uint32_t *at = c->at + ch * c->groups;
+    memset(at, 0, sizeof(uint32_t) * c->groups);
+    uint32_t lo = (uint32_t)ch * COPY_CHUNK, hi = c->total - lo < COPY_CHUNK ? c->total : lo + COPY_CHUNK;
+    for (uint32_t i = lo; i < hi; ++i) {
+      uint32_t g = c->group ? c->group[i] : 0;
+      if (g < c->groups) at[g]++;
+    }
+  }
+}
+
+static void scatter_chunks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  scatter_ctx *c = ctx;
+  for (uint64_t ch = begin; ch < end; ++ch) {
+    uint32_t *at = c->at + ch * c->groups;
+    uint32_t lo = (uint32_t)ch * COPY_CHUNK, hi = c->total - lo < COPY_CHUNK ? c->total : lo + COPY_CHUNK;
+    for (uint32_t i = lo; i < hi; ++i) {
+      uint32_t g = c->group ? c->group[i] : 0;
+      if (g >= c->groups) continue;
+      kd_rec *o = &c->r[at[g]++];
+      memcpy(o->p, c->base + (size_t)i * c->stride, sizeof(float) * 3);
+      o->id = i;
+    }
+  }
+}
+
 /* Tasks for one group's range [lo, hi): subtrees of at least ~16k points per
  * task are worth a thread; 2 tasks per thread balance the load. The layout
  * does not depend on who builds what. */
@@ -237,28 +276,45 @@ iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_
   if (count == 0) return IRIS_OK;
   if (threads <= 0) threads = iris_parallel_default_threads();
   uint32_t groups = group ? group_count : 1;
+  /* Counting sort by group (index order within), in fixed chunks: counts per
+   * chunk in parallel, offsets, then each chunk scatters its points. */
+  const uint32_t total = count, chunks = (total + COPY_CHUNK - 1) / COPY_CHUNK;
   uint32_t *start = calloc((size_t)groups + 1, sizeof(uint32_t));
-  if (!start) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree");
-  for (uint32_t i = 0; i < count; ++i)
-    if (!group || group[i] < groups) start[(group ? group[i] : 0) + 1]++;
+  uint32_t *at = malloc(sizeof(uint32_t) * groups * (size_t)chunks);
+  if (!start || !at) {
+    free(start);
+    free(at);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for a kd-tree");
+  }
+  scatter_ctx sc = {group, groups, total, at, base, stride, NULL};
+  iris_parallel_for(chunks, 1, threads, count_chunks, &sc);
+  for (uint32_t ch = 0; ch < chunks; ++ch)
+    for (uint32_t g = 0; g < groups; ++g) start[g + 1] += at[(size_t)ch * groups + g];
   size_t max_tasks = 0;
   for (uint32_t g = 0; g < groups; ++g) {
     max_tasks += (size_t)1 << group_depth(start[g + 1], threads);
     start[g + 1] += start[g];
   }
-  const uint32_t total = count;
+  for (uint32_t g = 0; g < groups; ++g) { /* chunk offsets */
+    uint32_t o = start[g];
+    for (uint32_t ch = 0; ch < chunks; ++ch) {
+      uint32_t n = at[(size_t)ch * groups + g];
+      at[(size_t)ch * groups + g] = o;
+      o += n;
+    }
+  }
   count = start[groups]; /* points in some group */
   if (count == 0) {
     free(start);
+    free(at);
     return IRIS_OK;
   }
   kd_rec *r = malloc(sizeof(kd_rec) * (size_t)count), *tmp = malloc(sizeof(kd_rec) * (size_t)count);
   build_task *tasks = malloc(sizeof(build_task) * max_tasks);
-  uint32_t *at = malloc(sizeof(uint32_t) * groups);
   tree->points = malloc(sizeof(float) * 3 * (size_t)count);
   tree->ids = malloc(sizeof(uint32_t) * count);
   tree->axis = calloc(count, 1);
-  if (!r || !tmp || !tasks || !at || !tree->points || !tree->ids || !tree->axis) {
+  if (!r || !tmp || !tasks || !tree->points || !tree->ids || !tree->axis) {
     free(r);
     free(tmp);
     free(tasks);
@@ -269,14 +325,8 @@ iris_status iris_kdtree_build_grouped(iris_kdtree *tree, const void *base, size_
                           count);
   }
   tree->count = count;
-  memcpy(at, start, sizeof(uint32_t) * groups);
-  const unsigned char *b = base;
-  for (uint32_t i = 0; i < total; ++i) { /* counting sort by group, index order within */
-    if (group && group[i] >= groups) continue;
-    kd_rec *o = &r[at[group ? group[i] : 0]++];
-    memcpy(o->p, b + (size_t)i * stride, sizeof(float) * 3);
-    o->id = i;
-  }
+  sc.r = r;
+  iris_parallel_for(chunks, 1, threads, scatter_chunks, &sc);
   free(at);
   build_ctx c = {r, tmp, tree->axis, tasks, 0};
   for (uint32_t g = 0; g < groups; ++g) {
