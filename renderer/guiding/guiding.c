@@ -3,6 +3,7 @@
 #include "renderer/guiding/guiding.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -83,13 +84,151 @@ static void camera_rows(void *ctx, uint64_t begin, uint64_t end, int thread_inde
 
 /* ---- filling -------------------------------------------------------------- */
 
+/* Photon normal groups: the photon tree is a forest with one tree per cell of
+ * an octahedral grid over the photons' normals, and a cache searches only the
+ * groups whose normals can pass its filter, so it no longer wades through the
+ * photons of the surfaces around it (the door: 17 of 18 photons within a
+ * cache's k-th distance had the wrong normal). Each group's cone (axis, widest
+ * angle of its photons, from the data) decides conservatively; the filter
+ * still decides each photon, so the answer is the same as searching all. */
+#define NORMAL_GRID 6
+#define NORMAL_GROUPS (NORMAL_GRID * NORMAL_GRID + 1) /* the last: normals not unit, always searched */
+
+static uint32_t normal_group(iris_vec3 n) {
+  float l1 = fabsf(n.x) + fabsf(n.y) + fabsf(n.z), l2 = iris_dot(n, n);
+  if (!(fabsf(l2 - 1.0f) <= 1e-4f) || !(l1 > 0.0f)) return NORMAL_GROUPS - 1;
+  float u = n.x / l1, v = n.y / l1;
+  if (n.z < 0.0f) {
+    float fu = (1.0f - fabsf(v)) * (u >= 0.0f ? 1.0f : -1.0f), fv = (1.0f - fabsf(u)) * (v >= 0.0f ? 1.0f : -1.0f);
+    u = fu;
+    v = fv;
+  }
+  int iu = (int)((u * 0.5f + 0.5f) * NORMAL_GRID), iv = (int)((v * 0.5f + 0.5f) * NORMAL_GRID);
+  iu = iu < 0 ? 0 : (iu >= NORMAL_GRID ? NORMAL_GRID - 1 : iu);
+  iv = iv < 0 ? 0 : (iv >= NORMAL_GRID ? NORMAL_GRID - 1 : iv);
+  return (uint32_t)(iv * NORMAL_GRID + iu);
+}
+
+typedef struct normal_cone {
+  double axis[3]; /* the cell's centre direction */
+  double min_dot; /* a cache normal with dot(n, axis) below this cannot use the group's photons */
+  uint32_t count;
+} normal_cone;
+
+#define GROUP_EXCLUDED UINT32_MAX /* direct photons with light sampling: not in the tree */
+#define GROUP_CHUNK 16384u
+
+typedef struct group_ctx {
+  const iris_photon *ph;
+  size_t count;
+  bool direct;       /* keep bounce-0 photons */
+  uint32_t *group;   /* per photon */
+  double (*cmin)[NORMAL_GROUPS]; /* per chunk: min over its photons of cos(photon n, axis) */
+  uint32_t (*n)[NORMAL_GROUPS];  /* per chunk: photons per group */
+  const normal_cone *cones;
+} group_ctx;
+
+/* Groups and per-chunk cone data (a minimum and a count: the same for any
+ * split into threads). */
+static void group_chunks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  group_ctx *c = ctx;
+  for (uint64_t ch = begin; ch < end; ++ch) {
+    double *cmin = c->cmin[ch];
+    uint32_t *n = c->n[ch];
+    for (int g = 0; g < NORMAL_GROUPS; ++g) cmin[g] = 1.0, n[g] = 0;
+    size_t lo = ch * GROUP_CHUNK, hi = lo + GROUP_CHUNK < c->count ? lo + GROUP_CHUNK : c->count;
+    for (size_t i = lo; i < hi; ++i) {
+      const iris_photon *ph = &c->ph[i];
+      if (!c->direct && ph->bounce == 0) {
+        c->group[i] = GROUP_EXCLUDED;
+        continue;
+      }
+      uint32_t g = normal_group(ph->n);
+      c->group[i] = g;
+      n[g]++;
+      const double *ax = c->cones[g].axis;
+      double nx = ph->n.x, ny = ph->n.y, nz = ph->n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
+      double d = nl > 0.0 ? (nx * ax[0] + ny * ax[1] + nz * ax[2]) / nl : -1.0;
+      cmin[g] = d < cmin[g] ? d : cmin[g];
+    }
+  }
+}
+
+/* Assigns photons to groups (GROUP_EXCLUDED: left out) and builds the cones. */
+static bool group_photons(const iris_photon *ph, size_t count, bool direct, int threads, uint32_t *group,
+                          normal_cone *cones) {
+  memset(cones, 0, sizeof(normal_cone) * NORMAL_GROUPS);
+  for (int g = 0; g < NORMAL_GROUPS - 1; ++g) { /* the cell centre's direction */
+    double u = ((g % NORMAL_GRID) + 0.5) / NORMAL_GRID * 2.0 - 1.0, v = ((g / NORMAL_GRID) + 0.5) / NORMAL_GRID * 2.0 - 1.0;
+    double z = 1.0 - fabs(u) - fabs(v), x = u, y = v;
+    if (z < 0.0) {
+      x = (1.0 - fabs(v)) * (u >= 0.0 ? 1.0 : -1.0);
+      y = (1.0 - fabs(u)) * (v >= 0.0 ? 1.0 : -1.0);
+    }
+    double l = sqrt(x * x + y * y + z * z);
+    cones[g].axis[0] = x / l, cones[g].axis[1] = y / l, cones[g].axis[2] = z / l;
+  }
+  size_t chunks = (count + GROUP_CHUNK - 1) / GROUP_CHUNK;
+  group_ctx c = {ph, count, direct, group, malloc(sizeof(double[NORMAL_GROUPS]) * (chunks ? chunks : 1)),
+                 malloc(sizeof(uint32_t[NORMAL_GROUPS]) * (chunks ? chunks : 1)), cones};
+  if (!c.cmin || !c.n) {
+    free(c.cmin);
+    free(c.n);
+    return false;
+  }
+  iris_parallel_for(chunks, 1, threads, group_chunks, &c);
+  double cmin[NORMAL_GROUPS];
+  for (int g = 0; g < NORMAL_GROUPS; ++g) cmin[g] = 1.0;
+  for (size_t ch = 0; ch < chunks; ++ch)
+    for (int g = 0; g < NORMAL_GROUPS; ++g) {
+      cones[g].count += c.n[ch][g];
+      cmin[g] = c.cmin[ch][g] < cmin[g] ? c.cmin[ch][g] : cmin[g];
+    }
+  free(c.cmin);
+  free(c.n);
+  /* Usable: angle(cache n, photon n) <= acos(PHOTON_NORMAL_COS); so the cache
+   * normal lies within that + the group's widest angle (+ 1e-3 rad for float
+   * rounding and normals a hair off unit length) of the axis. */
+  const double pi = 3.14159265358979323846;
+  for (int g = 0; g < NORMAL_GROUPS; ++g) {
+    double reach = acos((double)PHOTON_NORMAL_COS) + acos(fmax(-1.0, fmin(1.0, cmin[g]))) + 1e-3;
+    cones[g].min_dot = g == NORMAL_GROUPS - 1 || reach >= pi ? -INFINITY : cos(reach);
+  }
+  return true;
+}
+
+/* The groups a cache with normal n searches, best aligned first; how many. */
+static uint32_t select_groups(const normal_cone *cones, iris_vec3 n, uint32_t *out) {
+  double nx = n.x, ny = n.y, nz = n.z, nl = sqrt(nx * nx + ny * ny + nz * nz);
+  bool all = !(fabs(nl - 1.0) <= 1e-4); /* a normal off unit length: its filter is not the cone's */
+  double key[NORMAL_GROUPS];
+  uint32_t m = 0;
+  for (uint32_t g = 0; g < NORMAL_GROUPS; ++g) {
+    const normal_cone *c = &cones[g];
+    if (!c->count) continue;
+    double d = (nx * c->axis[0] + ny * c->axis[1] + nz * c->axis[2]) / nl;
+    if (!all && !(d >= c->min_dot)) continue;
+    uint32_t j = m++;
+    while (j > 0 && key[j - 1] < d) {
+      key[j] = key[j - 1];
+      out[j] = out[j - 1];
+      --j;
+    }
+    key[j] = d;
+    out[j] = g;
+  }
+  return m;
+}
+
 typedef struct fill_ctx {
   iris_guiding *g;
   const iris_photon_map *photons;
   const iris_kdtree *photon_tree;
+  const normal_cone *cones; /* NORMAL_GROUPS */
   uint32_t k;
   float **hist;     /* per thread, sphere-map sized */
-  uint32_t **ids;   /* per thread, k */
+  uint32_t **ids;   /* per thread, 2 * k: ids, then tree slots */
   float **d2;       /* per thread, k */
 } fill_ctx;
 
@@ -98,16 +237,24 @@ typedef struct fill_ctx {
  * hemisphere caches, arriving from above. The k nearest are searched among
  * these only, so a cache next to a brightly lit thin wall still gets k. */
 typedef struct photon_filter {
-  const iris_photon *photons;
   iris_vec3 n;
   bool sphere;
 } photon_filter;
 
-static bool photon_usable(void *ctx, uint32_t id) {
+/* What the filter and the splatting read of a photon, kept in the photon
+ * tree's order next to its position (iris_kdtree_set_payload), so neither
+ * chases the photon array: its n, wi and energy, adjacent in iris_photon. */
+typedef struct photon_dirs {
+  iris_vec3 n, wi;
+  float energy;
+} photon_dirs;
+
+static bool photon_usable(void *ctx, const void *payload) {
   const photon_filter *f = ctx;
-  const iris_photon *ph = &f->photons[id];
-  if (iris_dot(ph->n, f->n) < PHOTON_NORMAL_COS) return false;
-  return f->sphere || iris_dot(ph->wi, f->n) > 0.0f;
+  photon_dirs ph;
+  memcpy(&ph, payload, sizeof ph);
+  if (iris_dot(ph.n, f->n) < PHOTON_NORMAL_COS) return false;
+  return f->sphere || iris_dot(ph.wi, f->n) > 0.0f;
 }
 
 static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
@@ -120,17 +267,22 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     iris_cache *cache = &g->caches[i];
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
-    photon_filter f = {c->photons->photons, cache->frame.n, cache->sphere != 0};
-    uint32_t n = iris_kdtree_knn_if(c->photon_tree, cache->p, c->k, INFINITY, photon_usable, &f, ids, d2);
+    photon_filter f = {cache->frame.n, cache->sphere != 0};
+    uint32_t *slots = ids + c->k;
+    uint32_t groups[NORMAL_GROUPS];
+    uint32_t ng = select_groups(c->cones, cache->frame.n, groups);
+    uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
+                                                   photon_usable, &f, ids, d2, slots);
     uint32_t used = 0;
     double power = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
-      const iris_photon *ph = &c->photons->photons[ids[j]];
-      if (iris_dot(ph->n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
-      iris_vec3 wl = iris_frame_to_local(&cache->frame, ph->wi);
-      bool u = iris_cache_splat(map, hist, wl, ph->energy, g->params.splat);
+      photon_dirs ph;
+      memcpy(&ph, c->photon_tree->payload + (size_t)slots[j] * sizeof ph, sizeof ph);
+      if (iris_dot(ph.n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
+      iris_vec3 wl = iris_frame_to_local(&cache->frame, ph.wi);
+      bool u = iris_cache_splat(map, hist, wl, ph.energy, g->params.splat);
       used += u;
-      if (u) power += ph->energy;
+      if (u) power += ph.energy;
     }
     cache->photons = used;
     /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
@@ -292,17 +444,24 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
    * from a light leave the photon tree, so every cache's k photons describe
    * the indirect light (measured in docs/guiding.md). */
   const bool direct = p->direct_photons > 0 || (p->direct_photons < 0 && !p->use_nee);
-  if (!direct) {
-    size_t n = 0;
-    for (size_t i = 0; i < photons.count; ++i)
-      if (photons.photons[i].bounce > 0) photons.photons[n++] = photons.photons[i];
-    photons.count = n;
-  }
+  normal_cone cones[NORMAL_GROUPS];
+  uint32_t *group = st == IRIS_OK ? malloc(sizeof(uint32_t) * (photons.count ? photons.count : 1)) : NULL;
+  if (st == IRIS_OK && (!group || !group_photons(photons.photons, photons.count, direct, s->threads, group, cones)))
+    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  if (st == IRIS_OK) /* photon ids stay indices into the whole photon array */
+    st = iris_kdtree_build_grouped(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
+                                   group, NORMAL_GROUPS, s->threads, err);
+  free(group);
+  _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3) &&
+                     offsetof(iris_photon, energy) == offsetof(iris_photon, wi) + sizeof(iris_vec3) &&
+                     sizeof(photon_dirs) == 2 * sizeof(iris_vec3) + sizeof(float),
+                 "photon_dirs mirrors iris_photon's n, wi, energy");
   if (st == IRIS_OK)
-    st = iris_kdtree_build(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count, err);
+    st = iris_kdtree_set_payload(&ptree, &photons.photons[0].n, sizeof(iris_photon), sizeof(photon_dirs), s->threads,
+                                 err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
-  fill_ctx fc = {g, &photons, &ptree, (uint32_t)p->cache_k, NULL, NULL, NULL};
+  fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL};
   if (st == IRIS_OK) {
     fc.hist = calloc((size_t)threads, sizeof(float *));
     fc.ids = calloc((size_t)threads, sizeof(uint32_t *));
@@ -310,7 +469,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     bool ok = fc.hist && fc.ids && fc.d2;
     for (int t = 0; ok && t < threads; ++t) {
       fc.hist[t] = malloc(sizeof(float) * g->sphere.texel_count);
-      fc.ids[t] = malloc(sizeof(uint32_t) * (size_t)p->cache_k);
+      fc.ids[t] = malloc(sizeof(uint32_t) * 2 * (size_t)p->cache_k);
       fc.d2[t] = malloc(sizeof(float) * (size_t)p->cache_k);
       ok = fc.hist[t] && fc.ids[t] && fc.d2[t];
     }

@@ -14,6 +14,8 @@
 typedef struct photon_block {
   iris_photon *items;
   size_t count, cap;
+  size_t at;       /* offset in the concatenated array */
+  uint64_t indirect;
   bool oom;
 } photon_block;
 
@@ -22,12 +24,15 @@ typedef struct trace_ctx {
   iris_emission_selection by;
   uint64_t paths;
   photon_block *blocks;
+  iris_photon *all; /* concatenation target */
 } trace_ctx;
 
 static void block_push(photon_block *b, const iris_photon *ph) {
   if (b->oom) return;
   if (b->count == b->cap) {
-    size_t cap = b->cap ? 2 * b->cap : 1024;
+    /* ~4 photons per path on the benchmark scenes: one allocation usually;
+     * pages never written are never touched. */
+    size_t cap = b->cap ? 2 * b->cap : 4 * (size_t)BLOCK_PATHS;
     iris_photon *n = realloc(b->items, cap * sizeof *n);
     if (!n) {
       b->oom = true;
@@ -91,6 +96,20 @@ static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_ind
     uint64_t lo = b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
     if (hi > c->paths) hi = c->paths;
     for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->by, i, &c->blocks[b]);
+    for (size_t i = 0; i < c->blocks[b].count; ++i) c->blocks[b].indirect += c->blocks[b].items[i].bounce > 0;
+  }
+}
+
+/* Copies blocks into their place in the concatenated array (in parallel: the
+ * array is the same for any thread count) and frees them. */
+static void copy_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  trace_ctx *c = ctx;
+  for (uint64_t b = begin; b < end; ++b) {
+    photon_block *blk = &c->blocks[b];
+    if (blk->count) memcpy(c->all + blk->at, blk->items, blk->count * sizeof *c->all);
+    free(blk->items);
+    blk->items = NULL;
   }
 }
 
@@ -101,21 +120,21 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
   uint64_t nblocks = (paths + BLOCK_PATHS - 1) / BLOCK_PATHS;
   photon_block *blocks = calloc(nblocks, sizeof *blocks);
   if (!blocks) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
-  trace_ctx c = {setup, by, paths, blocks};
+  trace_ctx c = {setup, by, paths, blocks, NULL};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
   size_t total = 0;
+  uint64_t indirect = 0;
   bool oom = false;
   for (uint64_t b = 0; b < nblocks; ++b) {
+    blocks[b].at = total;
     total += blocks[b].count;
+    indirect += blocks[b].indirect;
     oom |= blocks[b].oom;
   }
   iris_photon *all = oom ? NULL : malloc((total ? total : 1) * sizeof *all);
   if (all) {
-    size_t at = 0;
-    for (uint64_t b = 0; b < nblocks; ++b) {
-      if (blocks[b].count) memcpy(all + at, blocks[b].items, blocks[b].count * sizeof *all);
-      at += blocks[b].count;
-    }
+    c.all = all;
+    iris_parallel_for(nblocks, 1, setup->threads, copy_blocks, &c);
   }
   for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items);
   free(blocks);
@@ -124,7 +143,7 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
   out->photons = all;
   out->count = total;
   out->paths = paths;
-  for (size_t i = 0; i < total; ++i) out->indirect += all[i].bounce > 0;
+  out->indirect = indirect;
   return IRIS_OK;
 }
 
