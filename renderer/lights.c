@@ -428,17 +428,6 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     }
     out->total_power = total;
     iris_status st = iris_distrib1d_create(&out->select, w, n, err);
-    /* By area: the triangles keep their total share of the power, split by area. */
-    double tri_power = 0.0, tri_area = 0.0;
-    for (size_t i = 0; i < n; i++)
-      if (out->entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE) {
-        tri_power += out->entries[i].power;
-        tri_area += out->entries[i].area;
-      }
-    for (size_t i = 0; i < n; i++)
-      if (out->entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE)
-        w[i] = tri_area > 0.0 ? (float)(tri_power * out->entries[i].area / tri_area) : 0.0f;
-    if (st == IRIS_OK) st = iris_distrib1d_create(&out->select_area, w, n, err);
     free(w);
     if (st != IRIS_OK) {
       iris_lights_destroy(out);
@@ -460,7 +449,6 @@ void iris_lights_destroy(iris_lights *lights) {
   lights->tri_count = 0;
   free(lights->light_of_prim);
   iris_distrib1d_destroy(&lights->select);
-  iris_distrib1d_destroy(&lights->select_area);
   lights->entries = NULL;
   lights->light_of_prim = NULL;
   lights->count = 0;
@@ -629,18 +617,42 @@ float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris
          iris_sample_uniform_sphere_pdf();
 }
 
-bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
-                                 float u2, float u3, iris_photon_emission *e) {
-  return iris_lights_sample_emission_by(lights, IRIS_EMIT_BY_POWER, u_select, u0, u1, u2, u3, e);
+iris_status iris_lights_emission_selection(const iris_lights *lights, iris_emission_selection by,
+                                          iris_distrib1d *out, iris_error *err) {
+  memset(out, 0, sizeof *out);
+  const size_t n = lights->count;
+  if (n == 0) return IRIS_OK;
+  float *w = malloc(sizeof(float) * n);
+  if (!w) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+  /* By area: the triangles keep their total share of the power, split by area. */
+  double tri_power = 0.0, tri_area = 0.0;
+  for (size_t i = 0; i < n; i++)
+    if (lights->entries[i].kind == IRIS_LIGHT_KIND_TRIANGLE) {
+      tri_power += lights->entries[i].power;
+      tri_area += lights->entries[i].area;
+    }
+  for (size_t i = 0; i < n; i++) {
+    const iris_light_entry *e = &lights->entries[i];
+    w[i] = by == IRIS_EMIT_BY_AREA && e->kind == IRIS_LIGHT_KIND_TRIANGLE
+               ? (tri_area > 0.0 ? (float)(tri_power * e->area / tri_area) : 0.0f)
+               : e->power;
+  }
+  iris_status st = iris_distrib1d_create(out, w, n, err);
+  free(w);
+  return st;
 }
 
-bool iris_lights_sample_emission_by(const iris_lights *lights, iris_emission_selection by,
-                                    float u_select, float u0, float u1, float u2, float u3,
-                                    iris_photon_emission *e) {
-  if (lights->count == 0) return false;
+bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
+                                 float u2, float u3, iris_photon_emission *e) {
+  return iris_lights_sample_emission_with(lights, &lights->select, u_select, u0, u1, u2, u3, e);
+}
+
+bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_distrib1d *select,
+                                      float u_select, float u0, float u1, float u2, float u3,
+                                      iris_photon_emission *e) {
+  if (lights->count == 0 || select->count != lights->count) return false;
   float pmf, u_side;
-  const iris_distrib1d *d = by == IRIS_EMIT_BY_AREA ? &lights->select_area : &lights->select;
-  uint32_t i = (uint32_t)iris_distrib1d_sample(d, u_select, &pmf, &u_side);
+  uint32_t i = (uint32_t)iris_distrib1d_sample(select, u_select, &pmf, &u_side);
   if (!(pmf > 0.0f)) return false;
   const iris_light_entry *le = &lights->entries[i];
   memset(e, 0, sizeof *e);

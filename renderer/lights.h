@@ -96,8 +96,6 @@ typedef struct iris_lights {
   iris_light_tri *tris;   /* entries [0, tri_count) are the triangles (64-byte aligned) */
   size_t tri_count;
   iris_distrib1d select;  /* over entries, in proportion to power (photon emission) */
-  iris_distrib1d select_area; /* photon emission "by area": emissive triangles in proportion to
-                                 area (sharing the triangles' total power share), others by power */
   iris_light_group *groups;
   size_t group_count;
   uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
@@ -200,10 +198,18 @@ typedef enum iris_emission_selection {
  * covering the scene for directional/environment) from five uniform numbers. */
 bool iris_lights_sample_emission(const iris_lights *lights, float u_select, float u0, float u1,
                                  float u2, float u3, iris_photon_emission *e);
-/* The same with the light chosen as `by` says. */
-bool iris_lights_sample_emission_by(const iris_lights *lights, iris_emission_selection by,
-                                    float u_select, float u0, float u1, float u2, float u3,
-                                    iris_photon_emission *e);
+/* A light choice over the entries for photon emission: by power (equal to
+ * lights->select) or by area (emissive triangles in proportion to area,
+ * sharing the triangles' total power share; other lights by power). Built on
+ * demand, so scenes that do not ask for it carry none; free with
+ * iris_distrib1d_destroy. */
+iris_status iris_lights_emission_selection(const iris_lights *lights, iris_emission_selection by,
+                                          iris_distrib1d *out, iris_error *err);
+/* iris_lights_sample_emission with the light drawn from `select` (one of the
+ * above); false when select does not cover the lights. */
+bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_distrib1d *select,
+                                      float u_select, float u0, float u1, float u2, float u3,
+                                      iris_photon_emission *e);
 
 #ifdef __cplusplus
 }

@@ -21,7 +21,7 @@ typedef struct photon_block {
 
 typedef struct trace_ctx {
   const iris_guide_setup *setup;
-  iris_emission_selection by;
+  const iris_distrib1d *select; /* light choice (lights->select, or the area one) */
   uint64_t paths;
   photon_block *blocks;
   iris_photon *all; /* concatenation target */
@@ -44,13 +44,13 @@ static void block_push(photon_block *b, const iris_photon *ph) {
   b->items[b->count++] = *ph;
 }
 
-static void trace_path(const iris_guide_setup *s, iris_emission_selection by, uint64_t index,
+static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, uint64_t index,
                        photon_block *out) {
   iris_sampler rng = iris_sampler_start(s->seed, index, PHOTON_SAMPLE_INDEX);
   float us = iris_sampler_next(&rng), u0 = iris_sampler_next(&rng), u1 = iris_sampler_next(&rng),
         u2 = iris_sampler_next(&rng), u3 = iris_sampler_next(&rng);
   iris_photon_emission e;
-  if (!iris_lights_sample_emission_by(s->lights, by, us, u0, u1, u2, u3, &e)) return;
+  if (!iris_lights_sample_emission_with(s->lights, select, us, u0, u1, u2, u3, &e)) return;
   iris_vec3 beta = e.power;
   if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;
   iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
@@ -95,7 +95,7 @@ static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   for (uint64_t b = begin; b < end; ++b) {
     uint64_t lo = b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
     if (hi > c->paths) hi = c->paths;
-    for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->by, i, &c->blocks[b]);
+    for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->select, i, &c->blocks[b]);
     for (size_t i = 0; i < c->blocks[b].count; ++i) c->blocks[b].indirect += c->blocks[b].items[i].bounce > 0;
   }
 }
@@ -118,10 +118,21 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
   memset(out, 0, sizeof *out);
   if (paths == 0 || setup->lights->count == 0) return IRIS_OK;
   uint64_t nblocks = (paths + BLOCK_PATHS - 1) / BLOCK_PATHS;
+  /* By power: the lights' own selection; by area: one built for this pass only. */
+  iris_distrib1d area_select;
+  memset(&area_select, 0, sizeof area_select);
+  if (by == IRIS_EMIT_BY_AREA) {
+    iris_status st = iris_lights_emission_selection(setup->lights, by, &area_select, err);
+    if (st != IRIS_OK) return st;
+  }
   photon_block *blocks = calloc(nblocks, sizeof *blocks);
-  if (!blocks) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
-  trace_ctx c = {setup, by, paths, blocks, NULL};
+  if (!blocks) {
+    iris_distrib1d_destroy(&area_select);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
+  }
+  trace_ctx c = {setup, by == IRIS_EMIT_BY_AREA ? &area_select : &setup->lights->select, paths, blocks, NULL};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
+  iris_distrib1d_destroy(&area_select);
   size_t total = 0;
   uint64_t indirect = 0;
   bool oom = false;

@@ -99,6 +99,8 @@ int main(void) {
   }
   /* Both photon light choices (by power, by area) must give the same total. */
   for (int by = 0; by < 2; by++) {
+    iris_distrib1d select;
+    CHECK(iris_lights_emission_selection(&lights, (iris_emission_selection)by, &select, &err) == IRIS_OK);
     uint64_t st = 99;
     double sum = 0.0, sum2 = 0.0;
     const int n = 400000;
@@ -116,8 +118,8 @@ int main(void) {
       for (int k = 0; k < 5; k++) u[k] = chi2_uniform(&st);
       iris_photon_emission e;
       double v = 0.0;
-      if (iris_lights_sample_emission_by(&lights, (iris_emission_selection)by, (float)u[0], (float)u[1],
-                                         (float)u[2], (float)u[3], (float)u[4], &e)) {
+      if (iris_lights_sample_emission_with(&lights, &select, (float)u[0], (float)u[1], (float)u[2],
+                                           (float)u[3], (float)u[4], &e)) {
         v = e.power.y;
         if (!(fabsf(iris_length(e.dir) - 1.0f) < 1e-4f)) bad_dirs++;
         if (lights.entries[e.light].kind == IRIS_LIGHT_KIND_TRIANGLE) {
@@ -141,6 +143,7 @@ int main(void) {
       iris_check_record(fabs(f - want) <= 4.0 * sf + 1e-6, __FILE__, __LINE__,
                         "by area: largest triangle picked %.5f of the time, its area share %.5f", f, want);
     }
+    iris_distrib1d_destroy(&select);
   }
 
   iris_lights_destroy(&lights);
