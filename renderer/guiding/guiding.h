@@ -42,7 +42,8 @@ typedef struct iris_guiding_params {
   int cache_res;        /* octahedral map texels per side (--cache-res) */
   int cache_k;          /* photons per cache (--cache-k) */
   float pdf_floor;      /* minimum texel probability before renormalising (--pdf-floor) */
-  float alpha_max;      /* cap on the cache-sampling probability (--alpha-max), default 0.5 (thesis 0.9) */
+  float alpha_max;      /* cap on the cache-sampling probability (--alpha-max); < 0: 0.5 with
+                           light sampling, 0.7 without (thesis 0.9) */
   float cos_min;        /* Algorithm 1 threshold (--cos-min), default 0.9 */
   iris_splat_mode splat;/* nearest (thesis) or bilinear */
   bool force;           /* build caches even where the budget would skip guiding */
