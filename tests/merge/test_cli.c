@@ -8,9 +8,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 
 #include "check.h"
+#include "cli_run.h"
 #include "core/fileio.h"
 #include "core/image.h"
 
@@ -18,29 +18,13 @@ static const char *iris_bin;
 static char dir[512];
 static char out_text[1 << 16], err_text[1 << 16];
 
-static void slurp(const char *path, char *buf, size_t size) {
-  FILE *fp = fopen(path, "rb");
-  size_t n = fp ? fread(buf, 1, size - 1, fp) : 0;
-  if (fp) fclose(fp);
-  buf[n] = '\0';
-}
-
+/* Runs `iris ARGS` in the test folder; returns the exit code and fills
+ * out_text/err_text. */
 static int run(const char *args) {
-  char cmd[4096], o[700], e[700];
-  snprintf(o, sizeof o, "%s/stdout.txt", dir);
-  snprintf(e, sizeof e, "%s/stderr.txt", dir);
-  snprintf(cmd, sizeof cmd, "cd '%s' && '%s' %s >'%s' 2>'%s'", dir, iris_bin, args, o, e);
-  int status = system(cmd);
-  slurp(o, out_text, sizeof out_text);
-  slurp(e, err_text, sizeof err_text);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return iris_test_run_cli(dir, iris_bin, args, out_text, sizeof out_text, err_text, sizeof err_text);
 }
 
-static bool exists(const char *name) {
-  char p[800];
-  snprintf(p, sizeof p, "%s/%s", dir, name);
-  return iris_path_exists(p);
-}
+static bool exists(const char *name) { return iris_test_file_exists(dir, name); }
 
 #define EXPECT_RUN(args, code, needle)                                                           \
   do {                                                                                           \
