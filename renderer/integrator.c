@@ -39,6 +39,7 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
   it.lights = lights;
   it.textures = textures;
   it.method = IRIS_METHOD_MIS;
+  it.sampler = IRIS_SAMPLER_SOBOL;
   it.max_depth = IRIS_DEFAULT_MAX_DEPTH;
   it.rr_depth = IRIS_DEFAULT_RR_DEPTH;
   it.default_material = iris_material_default(IRIS_MATERIAL_DIFFUSE);
@@ -90,9 +91,9 @@ static bool direction_allowed(const iris_shading_point *sp, iris_vec3 wi) {
 
 bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
                                  iris_direction_sample *out) {
-  float u_lobe = iris_sampler_next(rng);
-  float u0 = iris_sampler_next(rng);
-  float u1 = iris_sampler_next(rng);
+  float u_lobe = iris_sampler_slot(rng, IRIS_SLOT_LOBE);
+  float u0, u1;
+  iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u0, &u1);
   struct iris_bsdf_sample bs;
   if (!iris_bsdf_sample(&sp->bsdf, sp->wo_local, u_lobe, u0, u1, &bs)) return false;
   if (!(bs.pdf > 0.0f)) return false;
@@ -141,13 +142,12 @@ static float power_heuristic(float pa, float pb) {
 
 /* Direct light at a shading point by light sampling (NEE), MIS-weighted
  * against the path's direction sampler when `mis`. The light was chosen at
- * the hit with this vertex's first number (`choice`, see the path loop). */
+ * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
-                               const iris_light_choice *choice, iris_sampler *rng, bool mis,
+                               const iris_light_choice *choice, const iris_sampler *rng, bool mis,
                                iris_path_stats *stats) {
-  (void)iris_sampler_next(rng); /* u_select, already used by the choice */
-  float u0 = iris_sampler_next(rng);
-  float u1 = iris_sampler_next(rng);
+  float u0, u1;
+  iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
   if (!iris_lights_sample_choice(it->lights, sp->si.p, choice, u0, u1, &ls)) return iris_v3(0, 0, 0);
   if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
@@ -180,6 +180,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
   iris_vec3 prev_p = ray.o;
   stats->paths++;
   for (int bounce = 0;; bounce++) {
+    iris_sampler_set_bounce(rng, bounce);
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
@@ -197,7 +198,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the point is shaded. */
     iris_light_choice choice = {0, 0.0f};
-    if (nee) iris_lights_choose(it->lights, si.p, iris_sampler_get(rng, rng->dimension), &choice);
+    if (nee) iris_lights_choose(it->lights, si.p, iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
     iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
       float w = 1.0f;
@@ -243,7 +244,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
       float q = fminf(0.95f, iris_max3(beta));
       if (est >= 0.0f && pixel_estimate > 0.0f)
         q = iris_clampf(RR_WINDOW * iris_max3(beta_before) * est / pixel_estimate, 0.1f * q, 1.0f);
-      if (iris_sampler_next(rng) >= q) break;
+      if (iris_sampler_slot(rng, IRIS_SLOT_RR) >= q) break;
       beta = iris_scale(beta, 1.0f / q);
     }
   }

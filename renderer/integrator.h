@@ -42,6 +42,31 @@ bool iris_method_parse(const char *name, iris_method *out);
 bool iris_method_uses_nee(iris_method method);
 bool iris_method_uses_guiding(iris_method method);
 
+/* Dimension layout of a path (docs/rendering.md, "Dimension layout"): the
+ * sampler pairs dimensions (2k, 2k+1), so every 2D decision starts at an even
+ * dimension and gets a well-stratified pair; each 1D decision gets the first
+ * dimension of a pair of its own (cheaper with the sobol sampler, and no
+ * decision shares a pair). Dimensions 0-1 are the position in the pixel;
+ * bounce b (0 at the first hit) draws dimension
+ * IRIS_DIM_BOUNCE0 + b * IRIS_DIMS_PER_BOUNCE + slot, the slots below. */
+enum {
+  IRIS_DIM_PIXEL = 0,          /* 2D: position in the pixel */
+  IRIS_DIM_BOUNCE0 = 2,
+  IRIS_SLOT_LIGHT_CHOICE = 0,  /* NEE: which light */
+  IRIS_SLOT_LOBE = 2,          /* BSDF: which lobe */
+  IRIS_SLOT_LIGHT_POS = 4,     /* 2D: NEE point on the light */
+  IRIS_SLOT_DIRECTION = 6,     /* 2D: BSDF direction, or the position in the guide's texel */
+  IRIS_SLOT_RR = 8,            /* Russian roulette */
+  IRIS_SLOT_GUIDE_SELECT = 10, /* guided: BSDF or cache */
+  IRIS_SLOT_GUIDE_CACHE = 12,  /* 2D: guided: which of the tied caches, and the texel (alias table) */
+  IRIS_SLOT_GUIDE_TEXEL = 13,
+  IRIS_DIMS_PER_BOUNCE = 14
+};
+/* Positions the sampler's base at bounce `bounce` of the layout. */
+static inline void iris_sampler_set_bounce(iris_sampler *rng, int bounce) {
+  rng->dimension = IRIS_DIM_BOUNCE0 + (uint32_t)bounce * IRIS_DIMS_PER_BOUNCE;
+}
+
 /* Per-vertex scratch of a direction sampler: written once per shading point
  * by iris_direction_sampler.prepare, read by its sample and pdf at that
  * vertex (guiding keeps the caches it picked for the point here, so the
@@ -105,6 +130,7 @@ typedef struct iris_integrator {
   const iris_lights *lights;
   const iris_textures *textures;
   iris_method method;
+  iris_sampler_kind sampler; /* the camera paths' and the photon pass's sampler */
   int max_depth;      /* Cycles' bounces: 0 = direct light only, B = B+1 surface hits */
   int rr_depth;       /* Russian roulette from this bounce on (default 3) */
   iris_direction_sampler guide; /* used by the guided methods; sample == NULL: BSDF */
@@ -139,7 +165,8 @@ void iris_integrator_prepare_direction(const iris_integrator *it, iris_shading_p
  * guided methods. False ends the path. */
 bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shading_point *sp,
                                       iris_sampler *rng, iris_direction_sample *out);
-/* BSDF sampling alone (what the non-guided methods use; guides mix it in). */
+/* BSDF sampling alone (what the non-guided methods use; guides mix it in).
+ * Draws the slots IRIS_SLOT_LOBE and IRIS_SLOT_DIRECTION of rng's base. */
 bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
                                  iris_direction_sample *out);
 float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi);

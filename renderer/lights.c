@@ -496,6 +496,77 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select
   if (c->light < lights->tri_count) __builtin_prefetch(&lights->tris[c->light]);
 }
 
+/* Solid-angle or area sampling of an emitter triangle seen from ref
+ * (docs/rendering.md, "Emitter triangles"): by solid angle when ref is
+ * closer to the triangle's plane than its longest edge is long (Cycles'
+ * rule: there the area density d^2 / cos varies most over the triangle)
+ * and the solid angle is within pbrt-v4's bounds for accurate spherical
+ * sampling (3e-4 to 6.22 sr), by area otherwise. Returns the solid angle
+ * when it is to be used, else 0; the sampler and the pdf both ask this one
+ * function. */
+#define IRIS_SOLID_ANGLE_MIN 3e-4f
+#define IRIS_SOLID_ANGLE_MAX 6.22f
+float iris_lights_triangle_solid_angle(const iris_light_tri *t, iris_vec3 ref) {
+  if (t->flags & IRIS_LIGHT_TRI_AREA_ONLY) return 0.0f;
+  iris_vec3 e1 = iris_v3_load(t->e1), e2 = iris_v3_load(t->e2);
+  iris_vec3 a = iris_sub(iris_v3_load(t->v0), ref);
+  iris_vec3 n = iris_cross(e1, e2);
+  float nn = iris_dot(n, n);
+  float plane = iris_dot(n, a); /* |n| times the signed distance of ref to the plane (front < 0) */
+  if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && plane >= 0.0f) return 0.0f; /* behind: area path refuses */
+  iris_vec3 e3 = iris_sub(e2, e1);
+  float longest2 = fmaxf(iris_dot(e1, e1), fmaxf(iris_dot(e2, e2), iris_dot(e3, e3)));
+  if (!(longest2 * nn > plane * plane)) return 0.0f;
+  float omega = iris_spherical_triangle_area(a, iris_add(a, e1), iris_add(a, e2));
+  return omega >= IRIS_SOLID_ANGLE_MIN && omega <= IRIS_SOLID_ANGLE_MAX ? omega : 0.0f;
+}
+#define tri_solid_angle iris_lights_triangle_solid_angle
+
+const char *iris_triangle_sampling_name(iris_triangle_sampling m) {
+  return m == IRIS_TRIANGLE_SAMPLING_AREA ? "area" : "solid-angle";
+}
+bool iris_triangle_sampling_parse(const char *name, iris_triangle_sampling *out) {
+  for (int m = 0; m < IRIS_TRIANGLE_SAMPLING_COUNT; m++)
+    if (strcmp(name, iris_triangle_sampling_name((iris_triangle_sampling)m)) == 0) {
+      *out = (iris_triangle_sampling)m;
+      return true;
+    }
+  return false;
+}
+void iris_lights_set_triangle_sampling(iris_lights *lights, iris_triangle_sampling m) {
+  for (size_t i = 0; i < lights->tri_count; i++) {
+    if (m == IRIS_TRIANGLE_SAMPLING_AREA)
+      lights->tris[i].flags |= IRIS_LIGHT_TRI_AREA_ONLY;
+    else
+      lights->tris[i].flags &= ~IRIS_LIGHT_TRI_AREA_ONLY;
+  }
+}
+
+/* Where the ray o + t w (o relative to v0 = a) meets the triangle's plane, as
+ * coefficients of its edges (Moller-Trumbore), clamped into the triangle. */
+static bool ray_triangle(iris_vec3 a, iris_vec3 e1, iris_vec3 e2, iris_vec3 w, float *b1, float *b2) {
+  /* the ray starts at -a relative to v0 */
+  iris_vec3 o = iris_neg(a);
+  iris_vec3 pv = iris_cross(w, e2);
+  float det = iris_dot(e1, pv);
+  if (!(fabsf(det) > 0.0f)) return false;
+  float inv = 1.0f / det;
+  float u = iris_dot(o, pv) * inv;
+  iris_vec3 qv = iris_cross(o, e1);
+  float v = iris_dot(w, qv) * inv;
+  if (!isfinite(u) || !isfinite(v)) return false;
+  u = iris_clampf(u, 0.0f, 1.0f);
+  v = iris_clampf(v, 0.0f, 1.0f);
+  if (u + v > 1.0f) {
+    float k = 1.0f / (u + v);
+    u *= k;
+    v *= k;
+  }
+  *b1 = u;
+  *b2 = v;
+  return true;
+}
+
 bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
                         float u1, iris_light_sample *s) {
   iris_light_choice c;
@@ -514,15 +585,26 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
   if (i < lights->tri_count) { /* a triangle: only its cache line is read */
     const iris_light_tri *t = &lights->tris[i];
     s->delta = false;
-    float b0, b1;
-    iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+    float omega = tri_solid_angle(t, ref);
+    float b1, b2; /* p = v0 + b1 e1 + b2 e2 */
     iris_interaction si;
+    if (omega > 0.0f) {
+      iris_vec3 v0 = iris_v3_load(t->v0), e1 = iris_v3_load(t->e1), e2 = iris_v3_load(t->e2);
+      iris_vec3 a = iris_sub(v0, ref), wi;
+      if (!iris_sample_spherical_triangle(a, iris_add(a, e1), iris_add(a, e2), u0, u1, &wi))
+        return false;
+      if (!ray_triangle(a, e1, e2, wi, &b1, &b2)) return false;
+    } else {
+      float b0;
+      iris_sample_uniform_triangle(u0, u1, &b0, &b1);
+      b2 = 1.0f - b0 - b1;
+    }
     if (t->flags & IRIS_LIGHT_TRI_TEXTURED) {
-      iris_accel_surface_at(lights->accel, lights->entries[i].prim, b1, 1.0f - b0 - b1, &si);
+      iris_accel_surface_at(lights->accel, lights->entries[i].prim, b1, b2, &si);
     } else { /* position and normal are all an untextured emitter needs */
       si.ng = iris_normalize(iris_cross(iris_v3_load(t->e1), iris_v3_load(t->e2)));
       si.p = iris_add(iris_v3_load(t->v0), iris_add(iris_scale(iris_v3_load(t->e1), b1),
-                                                    iris_scale(iris_v3_load(t->e2), 1.0f - b0 - b1)));
+                                                    iris_scale(iris_v3_load(t->e2), b2)));
     }
     iris_vec3 to = iris_sub(si.p, ref);
     float d2 = iris_dot(to, to);
@@ -540,7 +622,7 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     const iris_material *m = material_of(lights->scene, t->material);
     s->L = (t->flags & IRIS_LIGHT_TRI_TEXTURED) ? surface_emission(lights, m, &si)
                                                 : iris_v3_load(m->emission);
-    s->pdf = pmf * d2 / (cos_l * t->area);
+    s->pdf = omega > 0.0f ? pmf / omega : pmf * d2 / (cos_l * t->area);
     return isfinite(s->pdf) && s->pdf > 0.0f;
   }
   const iris_light_entry *e = &lights->entries[i];
@@ -598,10 +680,13 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
   iris_vec3 to = iris_sub(si->p, ref);
   if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && iris_dot(to, si->ng) >= 0.0f)
     return 0.0f; /* never sampled from behind */
+  float pmf = select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group);
+  float omega = tri_solid_angle(t, ref);
+  if (omega > 0.0f) return pmf / omega;
   float d2 = iris_dot(to, to);
   float cos_l = fabsf(iris_dot(to, si->ng)) / sqrtf(d2);
   if (!(cos_l > 0.0f) || !(d2 > 0.0f)) return 0.0f;
-  return select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group) * d2 / (cos_l * t->area);
+  return pmf * d2 / (cos_l * t->area);
 }
 
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {

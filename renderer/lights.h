@@ -1,5 +1,5 @@
 /* Everything that emits: emissive triangles (chosen in proportion to their
- * power, sampled uniformly by area), KHR_lights_punctual point, spot and
+ * power, sampled uniformly in solid angle when close, else by area), KHR_lights_punctual point, spot and
  * directional lights, and the constant environment ("world"). One discrete
  * distribution over all of them serves next-event estimation (with the pdfs
  * MIS needs when a BSDF-sampled ray hits an emitter) and photon emission for
@@ -86,6 +86,7 @@ typedef struct iris_light_tri {
 } iris_light_tri;
 #define IRIS_LIGHT_TRI_TWO_SIDED 1u
 #define IRIS_LIGHT_TRI_TEXTURED 2u
+#define IRIS_LIGHT_TRI_AREA_ONLY 4u /* never by solid angle (iris_lights_set_triangle_sampling) */
 
 typedef struct iris_lights {
   const iris_scene *scene;
@@ -157,6 +158,23 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select
 bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
                                const iris_light_choice *c, float u0, float u1,
                                iris_light_sample *s);
+
+/* How next-event estimation samples emitter triangles: by solid angle where
+ * that lowers variance and by area elsewhere (the default), or always by area
+ * (for comparison: --light-sampling area). */
+typedef enum iris_triangle_sampling {
+  IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE = 0,
+  IRIS_TRIANGLE_SAMPLING_AREA = 1,
+  IRIS_TRIANGLE_SAMPLING_COUNT
+} iris_triangle_sampling;
+const char *iris_triangle_sampling_name(iris_triangle_sampling m); /* "solid-angle", "area" */
+bool iris_triangle_sampling_parse(const char *name, iris_triangle_sampling *out);
+void iris_lights_set_triangle_sampling(iris_lights *lights, iris_triangle_sampling m);
+
+/* The solid angle of emitter triangle t seen from ref when next-event
+ * estimation samples it by solid angle there, else 0 (it samples by area).
+ * docs/rendering.md, "Emitter triangles". */
+float iris_lights_triangle_solid_angle(const iris_light_tri *t, iris_vec3 ref);
 
 /* Radiance leaving surface point `si` towards -d (the direction of the ray
  * that hit it); zero for non-emissive materials and for the back face of

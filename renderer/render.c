@@ -61,9 +61,10 @@ static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
       for (int x = tx; x < tx + TILE && x < c->x1; x++) {
         uint64_t pixel = (uint64_t)y * (uint64_t)c->frame_width + (uint64_t)x;
         for (uint64_t s = c->s0; s < c->s1; s++) {
-          iris_sampler rng = iris_sampler_start(c->seed, pixel, s);
-          float fx = (float)x + iris_sampler_next(&rng);
-          float fy = (float)y + iris_sampler_next(&rng);
+          iris_sampler rng = iris_sampler_start_kind(c->it->sampler, c->seed, pixel, s);
+          float ux, uy;
+          iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
+          float fx = (float)x + ux, fy = (float)y + uy;
           iris_ray ray = iris_pinhole_ray(c->cam, fx, fy);
           iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, st);
           iris_film_add(c->film, x - c->x0, y - c->y0, L);
@@ -112,7 +113,10 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     uint64_t h = iris_hash4((uint64_t)res->camera.width, (uint64_t)res->camera.height,
                             (uint64_t)p.max_depth, (uint64_t)p.rr_depth);
     for (const char *c = res->camera.name; *c; c++) h = iris_mix64(h ^ (unsigned char)*c);
+    /* the independent sampler keeps the hash parts had before samplers existed */
     res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
+    if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
   }
   iris_accel *accel = NULL;
   iris_textures textures;
@@ -124,10 +128,12 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   st = iris_accel_build(scene, &accel, err);
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
+  if (st == IRIS_OK) iris_lights_set_triangle_sampling(&lights, p.light_sampling);
   iris_integrator it;
   if (st == IRIS_OK) {
     it = iris_integrator_default(scene, accel, &lights, &textures);
     it.method = p.method;
+    it.sampler = p.sampler;
     it.max_depth = p.max_depth;
     it.rr_depth = p.rr_depth;
   }
@@ -142,6 +148,8 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     if (!stats) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
   }
   res->method = p.method;
+  res->sampler = p.sampler;
+  res->light_sampling = p.light_sampling;
   res->seed = p.seed;
   res->threads = p.threads;
   double t1 = iris_time_now();
@@ -236,7 +244,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   iris_image img;
   iris_status st = iris_film_to_image(&r->film, variance, &img, err);
   if (st != IRIS_OK) return st;
-  iris_image_meta meta[20];
+  iris_image_meta meta[32];
   size_t n = 0;
 #define META(k, ...) \
   do { \
@@ -247,6 +255,8 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("version", "%s", IRIS_VERSION_STRING);
   META("scene", "%s", scene_name ? scene_name : "");
   META("method", "%s", iris_method_name(r->method));
+  META("sampler", "%s", iris_sampler_kind_name(r->sampler));
+  META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
   META("spp", "%d", r->spp);
   META("seed", "%llu", (unsigned long long)r->seed);
   META("render_seconds", "%.3f", r->seconds);

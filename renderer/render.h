@@ -54,6 +54,8 @@ typedef struct iris_render_params {
   uint64_t seed;
   int threads;              /* <= 0: all cores */
   iris_method method;       /* IRIS_METHOD_COUNT: the scene's, else mis */
+  iris_sampler_kind sampler; /* default sobol (docs/rendering.md, "Samplers") */
+  iris_triangle_sampling light_sampling; /* emitter triangles: default solid angle where it helps */
   int max_depth;            /* Cycles' bounce count; < 0: the scene's, else 64 */
   int rr_depth;             /* first bounce with Russian roulette */
   const char *camera_name;  /* NULL: the scene's first camera */
@@ -87,6 +89,8 @@ typedef struct iris_render_result {
   iris_film film;
   iris_pinhole camera;
   iris_method method;
+  iris_sampler_kind sampler;
+  iris_triangle_sampling light_sampling;
   int spp;               /* samples per pixel completed */
   uint64_t seed;
   int threads;

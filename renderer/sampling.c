@@ -172,3 +172,91 @@ size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float
   }
   return lo;
 }
+
+float iris_spherical_triangle_area(iris_vec3 a, iris_vec3 b, iris_vec3 c) {
+  /* In double, and the triple product from the edges (a . (b x c) = a . ((b - a) x (c - a))):
+   * for a small, distant triangle a, b and c are nearly parallel and the direct
+   * triple product cancels catastrophically in float. */
+  double ax = a.x, ay = a.y, az = a.z, bx = b.x, by = b.y, bz = b.z, cx = c.x, cy = c.y, cz = c.z;
+  double la = sqrt(ax * ax + ay * ay + az * az), lb = sqrt(bx * bx + by * by + bz * bz),
+         lc = sqrt(cx * cx + cy * cy + cz * cz);
+  if (!(la > 0.0) || !(lb > 0.0) || !(lc > 0.0)) return 0.0f;
+  double e1x = bx - ax, e1y = by - ay, e1z = bz - az, e2x = cx - ax, e2y = cy - ay, e2z = cz - az;
+  double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+  /* tan(omega / 2) = |a . (b x c)| / (|a||b||c| + (a.b)|c| + (a.c)|b| + (b.c)|a|) */
+  double num = fabs(ax * nx + ay * ny + az * nz);
+  double den = la * lb * lc + (ax * bx + ay * by + az * bz) * lc + (ax * cx + ay * cy + az * cz) * lb +
+               (bx * cx + by * cy + bz * cz) * la;
+  double omega = 2.0 * atan2(num, den);
+  if (omega < 0.0) omega += 2.0 * IRIS_PI;
+  return (float)omega;
+}
+
+/* Arvo's construction loses accuracy in float for slivers and for triangles
+ * seen at grazing angles (directions land outside the triangle), so it runs
+ * in double. */
+typedef struct dvec3 {
+  double x, y, z;
+} dvec3;
+static dvec3 dv(iris_vec3 v) { return (dvec3){v.x, v.y, v.z}; }
+static double ddot(dvec3 a, dvec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static dvec3 dcross(dvec3 a, dvec3 b) {
+  return (dvec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+static dvec3 dscale(dvec3 a, double s) { return (dvec3){a.x * s, a.y * s, a.z * s}; }
+static dvec3 dadd(dvec3 a, dvec3 b) { return (dvec3){a.x + b.x, a.y + b.y, a.z + b.z}; }
+static dvec3 dsub(dvec3 a, dvec3 b) { return (dvec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static double dlen(dvec3 a) { return sqrt(ddot(a, a)); }
+static dvec3 dnorm(dvec3 a) { return dscale(a, 1.0 / dlen(a)); }
+
+/* angle between unit vectors, accurate near 0 and pi (pbrt-v4's AngleBetween) */
+static double angle_between(dvec3 v1, dvec3 v2) {
+  if (ddot(v1, v2) < 0.0) return IRIS_PI - 2.0 * asin(fmin(1.0, 0.5 * dlen(dadd(v1, v2))));
+  return 2.0 * asin(fmin(1.0, 0.5 * dlen(dsub(v2, v1))));
+}
+
+/* v - (v . w) w, normalised: the component of v orthogonal to unit w. */
+static dvec3 orthogonal_unit(dvec3 v, dvec3 w) { return dnorm(dsub(v, dscale(w, ddot(v, w)))); }
+
+bool iris_sample_spherical_triangle(iris_vec3 a_in, iris_vec3 b_in, iris_vec3 c_in, float u0,
+                                    float u1, iris_vec3 *wi) {
+  dvec3 a = dv(a_in), b = dv(b_in), c = dv(c_in);
+  if (!(dlen(a) > 0.0) || !(dlen(b) > 0.0) || !(dlen(c) > 0.0)) return false;
+  a = dnorm(a);
+  b = dnorm(b);
+  c = dnorm(c);
+  dvec3 n_ab = dcross(a, b), n_bc = dcross(b, c), n_ca = dcross(c, a);
+  double l_ab = dlen(n_ab), l_bc = dlen(n_bc), l_ca = dlen(n_ca);
+  if (!(l_ab > 1e-14) || !(l_bc > 1e-14) || !(l_ca > 1e-14)) return false;
+  n_ab = dscale(n_ab, 1.0 / l_ab);
+  n_bc = dscale(n_bc, 1.0 / l_bc);
+  n_ca = dscale(n_ca, 1.0 / l_ca);
+  /* the spherical triangle's interior angles at a, b, c */
+  double alpha = angle_between(n_ab, dscale(n_ca, -1.0));
+  double beta = angle_between(n_bc, dscale(n_ab, -1.0));
+  double gamma = angle_between(n_ca, dscale(n_bc, -1.0));
+  /* A' + pi: the area of the sub-triangle (a, b, c') chosen by u0, plus pi */
+  double a_pi = alpha + beta + gamma;
+  if (!(a_pi - IRIS_PI > 0.0)) return false;
+  double ap_pi = IRIS_PI + (double)u0 * (a_pi - IRIS_PI);
+  double cos_alpha = cos(alpha), sin_alpha = sin(alpha);
+  double sin_phi = sin(ap_pi) * cos_alpha - cos(ap_pi) * sin_alpha;
+  double cos_phi = cos(ap_pi) * cos_alpha + sin(ap_pi) * sin_alpha;
+  double k1 = cos_phi + cos_alpha;
+  double k2 = sin_phi - sin_alpha * ddot(a, b); /* dot(a, b) = cos of the side c */
+  double den = (k2 * sin_phi + k1 * cos_phi) * sin_alpha;
+  double cos_bp = den != 0.0 ? (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / den : 1.0;
+  cos_bp = fmin(1.0, fmax(-1.0, cos_bp));
+  double sin_bp = sqrt(fmax(0.0, 1.0 - cos_bp * cos_bp));
+  /* c' on the arc from a to c, then the point on the arc from b to c' */
+  dvec3 cp = dadd(dscale(a, cos_bp), dscale(orthogonal_unit(c, a), sin_bp));
+  double cos_theta = 1.0 - (double)u1 * (1.0 - ddot(cp, b));
+  double sin_theta = sqrt(fmax(0.0, 1.0 - cos_theta * cos_theta));
+  dvec3 w = b;
+  if (sin_theta > 0.0) w = dadd(dscale(b, cos_theta), dscale(orthogonal_unit(cp, b), sin_theta));
+  w = dnorm(w);
+  iris_vec3 out = iris_v3((float)w.x, (float)w.y, (float)w.z);
+  if (!iris_isfinite3(out)) return false;
+  *wi = out;
+  return true;
+}

@@ -6,6 +6,7 @@
 #ifndef IRIS_RENDERER_SAMPLING_H
 #define IRIS_RENDERER_SAMPLING_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -44,6 +45,18 @@ float iris_sample_uniform_cone_pdf(float cos_theta, float cos_max);
 /* Uniform point on a triangle as barycentrics (b0, b1), b2 = 1 - b0 - b1
  * (Heitz 2019 low-distortion map); area density 1 / triangle area. */
 void iris_sample_uniform_triangle(float u0, float u1, float *b0, float *b1);
+
+/* Solid angle subtended from the origin by the triangle with vertices at a,
+ * b, c relative to it (Van Oosterom and Strackee 1983), in [0, 2 pi]. */
+float iris_spherical_triangle_area(iris_vec3 a, iris_vec3 b, iris_vec3 c);
+/* Direction uniform in the solid angle of that triangle (Arvo 1995, "Stratified
+ * sampling of spherical triangles"; the formulation of pbrt-v4), density
+ * 1 / iris_spherical_triangle_area. a, b, c need not be unit. False when the
+ * triangle is degenerate as seen from the origin. u0 picks the sub-triangle
+ * by area, u1 the point along its arc, so a stratified (u0, u1) gives
+ * stratified directions. */
+bool iris_sample_spherical_triangle(iris_vec3 a, iris_vec3 b, iris_vec3 c, float u0, float u1,
+                                    iris_vec3 *wi);
 
 /* Discrete distribution over n weights (a tabulated CDF). Negative and
  * non-finite weights count as 0; if all are 0 the choice is uniform.

@@ -29,6 +29,8 @@ static void print_help(void) {
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
+      "      --sampler S      sobol (default) | independent (the reference's is fixed: docs/benchmarks.md)\n"
+      "      --light-sampling M  solid-angle (default) | area (the timed runs' emitter triangles)\n"
       "      --width W, --height H   image size (default: the reference's, else the\n"
       "                       scene's; one of them: the other keeps the scene's aspect)\n"
       "      --max-depth B    bounces as Cycles counts them (default: the scene's, else 64)\n"
@@ -124,6 +126,14 @@ int iris_cmd_bench(int argc, char **argv) {
       NEED_VALUE();
       if (!iris_cli_parse_int(CMD, a, val, 1, IRIS_BENCH_MAX_SEEDS, &lv)) return IRIS_EXIT_USAGE;
       p.seeds = (int)lv;
+    } else if (strcmp(a, "--light-sampling") == 0) {
+      NEED_VALUE();
+      if (!iris_triangle_sampling_parse(val, &p.light_sampling))
+        return iris_cli_usage_error(CMD, "unknown light sampling '%s' (solid-angle, area)", val);
+    } else if (strcmp(a, "--sampler") == 0) {
+      NEED_VALUE();
+      if (!iris_sampler_kind_parse(val, &p.sampler))
+        return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", val);
     } else if (strcmp(a, "--threads") == 0) {
       NEED_VALUE();
       if (!iris_cli_parse_int(CMD, a, val, 1, 4096, &lv)) return IRIS_EXIT_USAGE;

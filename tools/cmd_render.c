@@ -47,6 +47,8 @@ static void print_help(void) {
       "      --time SECONDS  whole passes until SECONDS have passed (not with --spp)\n"
       "      --seed N        random seed (default: the scene's, else 0)\n"
       "      --method M      bsdf | nee | mis (default) | guided | guided-nee\n"
+      "      --sampler S     sobol (default: Owen-scrambled Sobol) | independent\n"
+      "      --light-sampling M  emitter triangles: solid-angle (default, where it helps) | area\n"
       "      --max-depth B   bounces as Cycles counts them, 0 = direct light (default 64)\n"
       "      --threads N     worker threads (default: all cores); same image for any N\n"
       "Partitioned renders (merge the parts with iris merge; docs/distributed.md):\n"
@@ -237,6 +239,14 @@ int iris_cmd_render(int argc, char **argv) {
       NEED_VALUE();
       if (!iris_method_parse(val, &p.method))
         return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", val);
+    } else if (strcmp(a, "--light-sampling") == 0) {
+      NEED_VALUE();
+      if (!iris_triangle_sampling_parse(val, &p.light_sampling))
+        return iris_cli_usage_error(CMD, "unknown light sampling '%s' (solid-angle, area)", val);
+    } else if (strcmp(a, "--sampler") == 0) {
+      NEED_VALUE();
+      if (!iris_sampler_kind_parse(val, &p.sampler))
+        return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", val);
     } else if (strcmp(a, "--max-depth") == 0) {
       NEED_VALUE();
       if (!iris_cli_parse_int(CMD, a, val, 0, 1000000, &lv)) return IRIS_EXIT_USAGE;
@@ -416,6 +426,8 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_AddNumberToObject(o, "height", res.film.height);
     cJSON_AddStringToObject(o, "camera", res.camera.name);
     cJSON_AddStringToObject(o, "method", iris_method_name(res.method));
+    cJSON_AddStringToObject(o, "sampler", iris_sampler_kind_name(res.sampler));
+    cJSON_AddStringToObject(o, "light_sampling", iris_triangle_sampling_name(res.light_sampling));
     cJSON_AddNumberToObject(o, "spp", res.spp);
     cJSON_AddNumberToObject(o, "sample_offset", (double)res.sample_offset);
     cJSON *win = cJSON_AddArrayToObject(o, "pixel_bounds");

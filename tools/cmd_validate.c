@@ -37,6 +37,7 @@ static void print_help(void) {
       "      --spp N               iris samples per pixel (default %d)\n"
       "      --seed N              seed of iris and Cycles (default 0)\n"
       "      --threads N           threads of iris and Cycles (default: all cores)\n"
+      "      --sampler S           iris's sampler: sobol (default) | independent\n"
       "      --width W --height H  image size (must match a given reference)\n"
       "      --max-depth B         bounces as Cycles counts them (default: scene's, else 64)\n"
       "      --camera NAME         scene camera to use\n"
@@ -102,7 +103,7 @@ int iris_cmd_validate(int argc, char **argv) {
   enum {
     OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
     OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
-    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT
+    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER
   };
   static const struct option longopts[] = {
       {"method", required_argument, NULL, OPT_METHOD},
@@ -123,6 +124,7 @@ int iris_cmd_validate(int argc, char **argv) {
       {"alpha", required_argument, NULL, OPT_ALPHA},
       {"blender-exe", required_argument, NULL, OPT_BLENDER_EXE},
       {"strict-pixels", no_argument, NULL, OPT_STRICT},
+      {"sampler", required_argument, NULL, OPT_SAMPLER},
       {"quiet", no_argument, NULL, 'q'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
@@ -138,6 +140,10 @@ int iris_cmd_validate(int argc, char **argv) {
     switch (c) {
       case OPT_METHOD:
         if (!add_methods(&p, optarg)) return IRIS_EXIT_USAGE;
+        break;
+      case OPT_SAMPLER:
+        if (!iris_sampler_kind_parse(optarg, &p.sampler))
+          return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", optarg);
         break;
       case OPT_SPP:
         if (!iris_cli_parse_int(CMD, "--spp", optarg, 1, 1 << 24, &v)) return IRIS_EXIT_USAGE;

@@ -42,6 +42,8 @@ typedef struct iris_bench_params {
   int input_count;
   iris_method methods[IRIS_METHOD_COUNT];
   int method_count;
+  iris_sampler_kind sampler;  /* of the timed iris runs (the reference's is fixed) */
+  iris_triangle_sampling light_sampling; /* of the timed iris runs */
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
   int seeds;                  /* seeds 0 .. seeds-1 (default 1) */

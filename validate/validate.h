@@ -44,6 +44,7 @@ typedef struct iris_validate_params {
   const char *input;
   iris_method methods[IRIS_METHOD_COUNT];
   int method_count;         /* 0: mis */
+  iris_sampler_kind sampler; /* iris's sampler (default sobol) */
   int spp;                  /* iris samples per pixel (0: IRIS_VALIDATE_DEFAULT_SPP) */
   uint64_t seed;
   int threads;              /* <= 0: all cores (iris and Blender) */
@@ -92,7 +93,7 @@ typedef struct iris_validate_method {
   double relmse, mape;
   iris_block_stats blocks;
   iris_pixel_ztest pixels;
-  char ref_variance[160];   /* how the reference variance was obtained */
+  char ref_variance[256];   /* how the reference variance was obtained */
   bool energy_passed, z_passed, passed;
 } iris_validate_method;
 

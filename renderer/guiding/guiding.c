@@ -61,6 +61,7 @@ static void camera_rows(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       iris_ray ray = iris_pinhole_ray(s->camera, fx, fy);
       /* Follow specular chains to the first non-specular hit (thesis 4.2.2). */
       for (int depth = 0; depth <= MAX_SPECULAR_CHAIN; ++depth) {
+        iris_sampler_set_bounce(&rng, depth);
         iris_hit hit;
         if (!iris_accel_intersect(s->accel, &ray, &hit)) break;
         iris_interaction si;
@@ -683,7 +684,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   const float alpha = v->alpha;
   /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
   if (!(alpha > 0.0f)) return iris_integrator_sample_bsdf(sp, rng, out);
-  float u = iris_sampler_next(rng);
+  float u = iris_sampler_slot(rng, IRIS_SLOT_GUIDE_SELECT);
   if (u >= alpha) {
     if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;
     if (out->delta) { /* only the BSDF strategy reaches a delta lobe */
@@ -694,8 +695,9 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
     return out->pdf > 0.0f;
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
-  float uc = iris_sampler_next(rng), u0 = iris_sampler_next(rng), u1 = iris_sampler_next(rng),
-        u2 = iris_sampler_next(rng);
+  float uc, u0, u1, u2;
+  iris_sampler_slot2(rng, IRIS_SLOT_GUIDE_CACHE, &uc, &u0); /* cache, texel */
+  iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);   /* position in the texel */
   int m = v->m;
   int j = (int)(uc * (float)m);
   const iris_cache *c = &g->caches[v->ids[j < m ? j : m - 1]];

@@ -62,6 +62,7 @@ static bool first_diffuse_hit(const iris_guide_setup *s, int px, int py, iris_sh
   iris_ray ray = iris_pinhole_ray(s->camera, (float)px + 0.5f, (float)py + 0.5f);
   iris_sampler rng = iris_sampler_start(s->seed, (uint64_t)py * (uint64_t)s->camera->width + (uint64_t)px, 0x64756d70ULL);
   for (int depth = 0; depth <= 8; ++depth) {
+    iris_sampler_set_bounce(&rng, depth);
     iris_hit hit;
     if (!iris_accel_intersect(s->accel, &ray, &hit)) return false;
     iris_interaction si;

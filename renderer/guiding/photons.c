@@ -46,15 +46,39 @@ static void block_push(photon_block *b, const iris_photon *ph) {
 
 static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, uint64_t index,
                        photon_block *out) {
-  iris_sampler rng = iris_sampler_start(s->seed, index, PHOTON_SAMPLE_INDEX);
-  float us = iris_sampler_next(&rng), u0 = iris_sampler_next(&rng), u1 = iris_sampler_next(&rng),
-        u2 = iris_sampler_next(&rng), u3 = iris_sampler_next(&rng);
+  const iris_sampler_kind kind = s->integrator ? s->integrator->sampler : IRIS_SAMPLER_SOBOL;
+  float us, u0, u1, u2, u3;
+  iris_sampler rng;
+  if (kind == IRIS_SAMPLER_SOBOL && index <= UINT32_MAX) {
+    /* Quasi-random photons (docs/guiding.md, "Preprocessing"): the emission is
+     * one 5D Owen-scrambled Sobol point of the photon index (position on the
+     * light from the (0,2)-sequence pair, then direction, then the light
+     * choice), the bounces padded pairs of the same index. */
+    uint32_t i = (uint32_t)index;
+    uint64_t h = iris_hash4(s->seed, PHOTON_SAMPLE_INDEX, 0x9e0705ULL, 5);
+    u0 = iris_sobol_owen(i, 0, (uint32_t)h);
+    u1 = iris_sobol_owen(i, 1, (uint32_t)(h >> 32));
+    h = iris_mix64(h);
+    u2 = iris_sobol_owen(i, 2, (uint32_t)h);
+    u3 = iris_sobol_owen(i, 3, (uint32_t)(h >> 32));
+    us = iris_sobol_owen(i, 4, (uint32_t)iris_mix64(h));
+    rng = iris_sampler_start_kind(IRIS_SAMPLER_SOBOL, s->seed, PHOTON_SAMPLE_INDEX, index);
+  } else {
+    rng = iris_sampler_start(s->seed, index, PHOTON_SAMPLE_INDEX);
+    us = iris_sampler_get(&rng, 0);
+    u0 = iris_sampler_get(&rng, 1);
+    u1 = iris_sampler_get(&rng, 2);
+    u2 = iris_sampler_get(&rng, 3);
+    u3 = iris_sampler_get(&rng, 4);
+  }
   iris_photon_emission e;
   if (!iris_lights_sample_emission_with(s->lights, select, us, u0, u1, u2, u3, &e)) return;
   iris_vec3 beta = e.power;
   if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;
   iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
+    /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
+    iris_sampler_set_bounce(&rng, bounce + 1);
     iris_hit hit;
     if (!iris_accel_intersect(s->accel, &ray, &hit)) return;
     iris_interaction si;
@@ -81,7 +105,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
     /* Russian roulette on the throughput relative to the emitted power. */
     if (bounce >= 2) {
       float q = fminf(1.0f, iris_max3(beta) / fmaxf(iris_max3(e.power), 1e-30f));
-      if (!(iris_sampler_next(&rng) < q)) return;
+      if (!(iris_sampler_slot(&rng, IRIS_SLOT_RR) < q)) return;
       beta = iris_scale(beta, 1.0f / q);
     }
     if (!(iris_max3(beta) > 0.0f)) return;

@@ -77,11 +77,24 @@ int main(void) {
   CHECK(iris_textures_load(s, &tex, &err) == IRIS_OK);
   CHECK(iris_lights_build(s, accel, &tex, &lights, &err) == IRIS_OK);
 
-  static const iris_vec3 refs[3] = {{0.1f, 0.2f, 0.05f}, {1.5f, 1.0f, -0.5f}, {-1.0f, -1.0f, 1.0f}};
-  for (int i = 0; i < 3; i++) {
+  /* refs 3 and 4 lie close to the planes of quad qa (below it) and of the
+   * tilted two-sided qc (just beyond its edge, so that qc hides no other
+   * emitter: pdf_fn counts the first emitter hit only): there those triangles
+   * are sampled by solid angle (lights.h), the others by area. */
+  static const iris_vec3 refs[5] = {{0.1f, 0.2f, 0.05f}, {1.5f, 1.0f, -0.5f}, {-1.0f, -1.0f, 1.0f},
+                                    {-0.2f, 1.93f, 0.3f}, {-1.62f, 0.66f, 0.7f}};
+  {
+    /* the mix of strategies really happens at the new refs */
+    int solid = 0, area = 0;
+    for (int i = 3; i < 5; i++)
+      for (size_t k = 0; k < lights.tri_count; k++)
+        if (iris_lights_triangle_solid_angle(&lights.tris[k], refs[i]) > 0.0f) solid++; else area++;
+    iris_check_record(solid > 0 && area > 0, __FILE__, __LINE__, "strategies at refs 3-4: %d solid, %d area", solid, area);
+  }
+  for (int i = 0; i < 5; i++) {
     ctx c = {accel, &lights, refs[i]};
     chi2_domain dom = {CHI2_SPHERE, 64, 128, 1234 + (uint64_t)i};
-    chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 500000, 0.01, 3);
+    chi2_result r = chi2_run(&dom, sample_fn, pdf_fn, &c, 500000, 0.01, 5);
     iris_check_record(r.passed, __FILE__, __LINE__, "light sampling at ref %d: %s", i, r.message);
     printf("ref %d: p = %.3g, pdf integral %.4f, lost %zu\n", i, r.p_value, r.pdf_integral, r.lost);
   }
