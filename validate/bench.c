@@ -38,7 +38,10 @@ extern char **environ;
  * seeds-1), so that no run shares samples with its reference. */
 #define REFERENCE_SEED 1000003u
 /* Bump when a change makes cached references invalid (key of the cache). */
-#define REFERENCE_CACHE_VERSION 1u
+/* 2: references use the independent sampler (their variance channels are then
+ * the exact error of the mean, so "own relMSE" stays honest) and the new
+ * dimension layout. */
+#define REFERENCE_CACHE_VERSION 2u
 
 iris_bench_params iris_bench_params_default(void) {
   iris_bench_params p;
@@ -365,6 +368,8 @@ static iris_render_params render_params(const iris_bench_params *p, const iris_b
   rp.height = sc->height;
   rp.threads = p->threads;
   rp.method = method;
+  rp.sampler = p->sampler;
+  rp.light_sampling = p->light_sampling;
   rp.seed = seed;
   rp.max_depth = max_depth;
   rp.cancel = p->cancel;
@@ -416,6 +421,7 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
                sc->width, sc->height, cache_dir);
   iris_render_params rp = render_params(p, sc, bs->max_depth, IRIS_METHOD_MIS, REFERENCE_SEED, NULL, ctx);
   rp.spp = spp;
+  rp.sampler = IRIS_SAMPLER_INDEPENDENT; /* honest own relMSE (docs/benchmarks.md) */
   begin_run(ctx, sc->name, "reference", 0.0, REFERENCE_SEED, 0.0);
   iris_render_result rr;
   st = iris_render(bs->scene, &rp, &rr, err);

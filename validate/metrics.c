@@ -184,7 +184,10 @@ iris_status iris_metric_blocks_floored(const iris_image *test, int tc0, int tv0,
       for (int c = 0; c < 3; c++) {
         a[c] += finite_or_zero(px(test, i, tc0 + c));
         a[3 + c] += finite_or_zero(px(ref, i, rc0 + c));
-        if (tv0 >= 0) {
+        if (rv.spread) {
+          double d = finite_or_zero(px(test, i, tc0 + c)) - finite_or_zero(px(ref, i, rc0 + c));
+          a[6 + c] += d * d;
+        } else if (tv0 >= 0) {
           double vt = test_var(ref, rv, test_floor, finite_or_zero(px(test, i, tv0 + c)), i, c);
           a[6 + c] += vt;
           a[9 + c] += ref_var(ref, rv, vt, i, c);
@@ -210,7 +213,7 @@ iris_status iris_metric_blocks_floored(const iris_image *test, int tc0, int tv0,
     }
   }
   out->rms_rel_dev = out->compared ? sqrt(sum_sq / out->compared) : 0.0;
-  if (tv0 >= 0) {
+  if (tv0 >= 0 || rv.spread) {
     out->z_done = true;
     for (size_t k = 0; k < tiles; k++)
       for (int c = 0; c < 3; c++)

@@ -63,6 +63,14 @@ typedef struct iris_ref_variance {
   int rv0;      /* variance channels of the reference image, or -1 */
   double scale; /* when rv0 < 0: var_ref = scale * var_test (e.g. test_spp / ref_spp,
                    assuming the same per-sample variance); 0: the reference is exact */
+  /* Block test only: estimate the variance of a tile's summed difference
+   * from the spread of its pixel differences, sum_i (t_i - r_i)^2, instead
+   * of the variance channels. That needs the pixels' errors to be independent
+   * and zero-mean under the hypothesis, not the samples within a pixel, so it
+   * stays honest for correlated (low-discrepancy) samples, whose per-pixel
+   * sample variance over-estimates the error (docs/validation.md, "Correlated
+   * samples"). */
+  bool spread;
 } iris_ref_variance;
 
 /* Optional floor for the test's variance in the z-tests (the _floored

@@ -58,6 +58,17 @@ static const undersampled UNDERSAMPLED[] = {
     {"stress-caustic", IRIS_METHOD_BSDF, "the caustic and the direct light come only from paths that hit a 10 cm light"},
     {"stress-caustic", IRIS_METHOD_GUIDED, "no light sampling: as bsdf"},
     {"stress-firefly", IRIS_METHOD_BSDF, "a 3 mm light is hit by about 1 path in 10^5"},
+    /* Measured with bench/stress/seed_spread.sh (docs/stability.md, "The CI test"): single
+     * 64-spp images of these are bimodal (the rare paths are in them or not),
+     * while their mean over 30-40 seeds matches the reference. */
+    {"stress-firefly", IRIS_METHOD_NEE, "the diffuse-glossy-light paths to the 3 mm light carry ~45% of "
+     "the energy and appear about once per 64-spp image: images are ~0.49 or ~1.42 against 0.89"},
+    {"stress-firefly", IRIS_METHOD_MIS, "as nee: the rare glossy-to-light paths"},
+    {"stress-firefly", IRIS_METHOD_GUIDED_NEE, "as nee: the rare glossy-to-light paths"},
+    {"stress-caustic", IRIS_METHOD_NEE, "the caustic under the glass comes only from paths that hit the "
+     "10 cm light: most 64-spp images miss its brightest part (0.351 or 0.375 against 0.361)"},
+    {"stress-caustic", IRIS_METHOD_MIS, "as nee: the caustic"},
+    {"stress-caustic", IRIS_METHOD_GUIDED_NEE, "as nee: the caustic"},
     {"stress-firefly", IRIS_METHOD_GUIDED, "no light sampling: as bsdf"},
     {"stress-veach-lights", IRIS_METHOD_BSDF, "the 3 cm light seen in the rough plates"},
     {"stress-veach-lights", IRIS_METHOD_GUIDED, "no light sampling: as bsdf"},

@@ -131,7 +131,7 @@ static void test_blocks(void) {
   /* bottom-right tile (8 x 4 = 32 pixels): R raised by 0.1 in 16 of its pixels */
   for (int y = 8; y < 12; y++)
     for (int x = 8; x < 12; x++) at(&t, x, y)[0] = 1.1f;
-  iris_ref_variance exact = {-1, 0.0};
+  iris_ref_variance exact = {-1, 0.0, false};
   iris_block_stats bs;
   CHECK_OK(iris_metric_blocks(&t, 0, 3, &r, 0, exact, 8, 0.01, &bs, &err), &err);
   CHECK_EQ_INT(bs.tiles_x, 2);
@@ -156,7 +156,7 @@ static void test_blocks(void) {
   CHECK(!bs.passed);
   CHECK_EQ_INT((int)bs.z_over, 1);
   /* the reference's variance as a scale of the test's (x 3): z = 3.2 / sqrt(4 x 0.32) = 2.83 */
-  iris_ref_variance scaled = {-1, 3.0};
+  iris_ref_variance scaled = {-1, 3.0, false};
   CHECK_OK(iris_metric_blocks(&t, 0, 3, &r, 0, scaled, 8, 0.01, &bs, &err), &err);
   CHECK_NEAR(bs.max_abs_z, 3.2 / sqrt(4 * 0.32), 1e-4);
   CHECK(bs.passed);
@@ -171,7 +171,7 @@ static void test_blocks(void) {
     set_rgb(&t1, 0, 0, 1.3f, 1.3f, 1.3f);
     set_rgb(&r1, 0, 0, 1, 1, 1);
     for (int c = 3; c < 6; c++) r1.data[c] = 0.001f;
-    iris_ref_variance with_var = {3, 0.0};
+    iris_ref_variance with_var = {3, 0.0, false};
     CHECK_OK(iris_metric_blocks_floored(&t1, 0, 3, &r1, 0, with_var, 16.0, 8, 0.01, &bs, &err), &err);
     CHECK_NEAR(bs.max_abs_z, 0.3 / sqrt(0.017), 1e-4);
     iris_pixel_ztest p1;
@@ -218,7 +218,7 @@ static void test_pixel_ztest(void) {
       p[3] = p[4] = p[5] = 0.04f;
     }
   at(&t, 1, 1)[1] = 1.5f;
-  iris_ref_variance exact = {-1, 0.0};
+  iris_ref_variance exact = {-1, 0.0, false};
   iris_pixel_ztest pz;
   float zimg[9];
   CHECK_OK(iris_metric_pixel_ztest(&t, 0, 3, &r, 0, exact, 0.01, zimg, &pz, &err), &err);
