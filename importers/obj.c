@@ -900,6 +900,7 @@ static iris_status build_scene(obj_ctx *c) {
   else snprintf(stem, sizeof stem, "mesh");
   for (size_t gi = 0; gi < c->group_count && st == IRIS_OK; gi++) st = build_group(c, gi, &s, stem);
 done:
+  if (st == IRIS_OK) iris_polygon_triangulator_report(s.tri, c->path, c->opts->stats);
   iris_polygon_triangulator_destroy(s.tri);
   free(s.poly), free(s.ptris), free(s.tris), free(s.head), free(s.stamp), free(s.chain), free(s.vkey);
   free(s.smooth_normals);

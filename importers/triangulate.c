@@ -13,6 +13,9 @@
  * the work per corner whatever the input. */
 #include "importers/triangulate.h"
 
+#include "core/log.h"
+#include "importers/import.h"
+
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -32,6 +35,7 @@ struct iris_polygon_triangulator {
   uint32_t *prev, *next;   /* the ring of corners left */
   uint32_t *lprev, *lnext; /* links in the reflex list or the ear list (never both: ears are convex) */
   uint8_t *flags;
+  uint32_t steps_per_corner;
   iris_triangulate_stats stats;
 };
 
@@ -56,7 +60,13 @@ static inline bool inside2(vec2 a, vec2 b, vec2 c, vec2 q) {
 }
 
 iris_polygon_triangulator *iris_polygon_triangulator_create(void) {
-  return calloc(1, sizeof(iris_polygon_triangulator));
+  iris_polygon_triangulator *t = calloc(1, sizeof *t);
+  if (t) t->steps_per_corner = IRIS_TRIANGULATE_STEPS_PER_CORNER;
+  return t;
+}
+
+void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner) {
+  t->steps_per_corner = steps_per_corner;
 }
 
 void iris_polygon_triangulator_destroy(iris_polygon_triangulator *t) {
@@ -67,6 +77,21 @@ void iris_polygon_triangulator_destroy(iris_polygon_triangulator *t) {
 
 iris_triangulate_stats iris_polygon_triangulator_stats(const iris_polygon_triangulator *t) {
   return t->stats;
+}
+
+void iris_polygon_triangulator_report(const iris_polygon_triangulator *t, const char *path,
+                                      struct iris_import_stats *stats) {
+  if (!t) return;
+  if (stats) {
+    stats->polygons += t->stats.polygons;
+    stats->polygon_corners += t->stats.corners;
+    stats->triangulation_steps += t->stats.steps;
+    stats->triangulation_fallbacks += t->stats.fallbacks;
+  }
+  if (t->stats.fallbacks)
+    iris_warnf("%s: %llu polygon(s) without enough ears (repeated, collinear or crossing corners) "
+               "were partly fan-triangulated",
+               path ? path : "input", (unsigned long long)t->stats.fallbacks);
 }
 
 static bool reserve(iris_polygon_triangulator *t, size_t n) {
@@ -152,8 +177,10 @@ uint32_t iris_polygon_triangulate(iris_polygon_triangulator *t, const float *pos
   t->stats.polygons++;
   t->stats.corners += n;
   if (!reserve(t, n)) return 0;
-  clip s = {t->p, t->prev, t->next, t->lprev, t->lnext, t->flags, NIL, NIL, 0,
-            (uint64_t)IRIS_TRIANGULATE_STEPS_PER_CORNER * n + IRIS_TRIANGULATE_STEPS_BASE};
+  const uint64_t budget = t->steps_per_corner == UINT32_MAX
+                              ? UINT64_MAX
+                              : (uint64_t)t->steps_per_corner * n + IRIS_TRIANGULATE_STEPS_BASE;
+  clip s = {t->p, t->prev, t->next, t->lprev, t->lnext, t->flags, NIL, NIL, 0, budget};
   /* Newell normal: robust for non-planar and concave polygons. */
   double nx = 0, ny = 0, nz = 0;
   for (uint32_t i = 0; i < n; i++) {

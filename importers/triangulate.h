@@ -32,6 +32,15 @@ typedef struct iris_triangulate_stats {
   uint64_t fallbacks; /* polygons whose budget ran out (rest fan-triangulated) */
 } iris_triangulate_stats;
 iris_triangulate_stats iris_polygon_triangulator_stats(const iris_polygon_triangulator *t);
+/* Replaces IRIS_TRIANGULATE_STEPS_PER_CORNER for this triangulator (UINT32_MAX:
+ * no budget); for the benchmark and the tests. */
+void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner);
+
+/* The importers' end of a file: adds t's counters to stats (when not NULL) and
+ * warns once, naming path, when some polygons were partly fan-triangulated. */
+struct iris_import_stats;
+void iris_polygon_triangulator_report(const iris_polygon_triangulator *t, const char *path,
+                                      struct iris_import_stats *stats);
 
 /* Triangulates one polygon of n >= 3 corners; corner i sits at
  * positions[3 * corners[i]]. Writes n - 2 triangles as corner numbers
