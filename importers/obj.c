@@ -675,9 +675,10 @@ typedef struct build_scratch {
   size_t ptris_cap;
   uint32_t *tris;   /* triangles of a group as corner numbers */
   size_t tris_cap;
-  int32_t *head;    /* per position: first local vertex, valid when stamp matches */
+  int32_t *head;    /* per hash bucket: first local vertex, valid when stamp matches */
   uint32_t *stamp;
-  int32_t *chain;   /* per local vertex: next with the same position */
+  size_t head_cap, stamp_cap;
+  int32_t *chain;   /* per local vertex: next in the same bucket */
   size_t chain_cap;
   int64_t *vkey;    /* per local vertex: its normal key */
   size_t vkey_cap;
@@ -719,10 +720,18 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
   if (tri_count > UINT32_MAX / 3 || g->corner_count > UINT32_MAX)
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, 0, g->name,
                           "mesh too large (more than 2^32 triangles)");
-  /* Deduplicate corners into vertices keyed by (v, vt, vn). */
+  /* Deduplicate corners into vertices keyed by (v, vt, vn), in a hash table on
+   * the whole key (buckets stamped per group, so none is cleared). A chain per
+   * position was quadratic when one position carried many texture coordinates. */
+  size_t buckets = 64;
+  while (buckets < g->corner_count) buckets *= 2;
+  const size_t old_stamps = s->stamp_cap;
   if (!grow((void **)&s->chain, &s->chain_cap, g->corner_count, sizeof(int32_t)) ||
-      !grow((void **)&s->vkey, &s->vkey_cap, g->corner_count, sizeof(int64_t)))
+      !grow((void **)&s->vkey, &s->vkey_cap, g->corner_count, sizeof(int64_t)) ||
+      !grow((void **)&s->head, &s->head_cap, buckets, sizeof(int32_t)) ||
+      !grow((void **)&s->stamp, &s->stamp_cap, buckets, sizeof(uint32_t)))
     return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
+  memset(s->stamp + old_stamps, 0, (s->stamp_cap - old_stamps) * sizeof(uint32_t));
   uint32_t *corner_vertex = malloc(g->corner_count * sizeof(uint32_t));
   uint32_t *first_corner = malloc(g->corner_count * sizeof(uint32_t)); /* per vertex */
   if (!corner_vertex || !first_corner) {
@@ -741,19 +750,22 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
       /* Corners of flat faces get their own vertices (with the face normal)
        * when the mesh has normals; the key -3 - f keeps them apart. */
       const int64_t kn = k[2] == OBJ_FLAT ? (want_normals ? -3 - (int64_t)f : OBJ_NO_INDEX) : k[2];
-      int32_t v = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
+      uint64_t h = ((uint64_t)(uint32_t)k[0] << 32 | (uint32_t)k[1]) ^ ((uint64_t)kn * 0x9E3779B97F4A7C15ull);
+      h ^= h >> 31, h *= 0xBF58476D1CE4E5B9ull, h ^= h >> 29, h *= 0x94D049BB133111EBull, h ^= h >> 32;
+      const size_t b = (size_t)(h & (buckets - 1));
+      int32_t v = s->stamp[b] == stamp ? s->head[b] : -1;
       while (v >= 0) {
         const int32_t *o = g->corners + 3 * (size_t)first_corner[v];
-        if (o[1] == k[1] && s->vkey[v] == kn) break;
+        if (o[0] == k[0] && o[1] == k[1] && s->vkey[v] == kn) break;
         v = s->chain[v];
       }
       if (v < 0) {
         v = (int32_t)nv++;
         first_corner[v] = (uint32_t)i;
         s->vkey[v] = kn;
-        s->chain[v] = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
-        s->head[k[0]] = v;
-        s->stamp[k[0]] = stamp;
+        s->chain[v] = s->stamp[b] == stamp ? s->head[b] : -1;
+        s->head[b] = v;
+        s->stamp[b] = stamp;
       }
       corner_vertex[i] = (uint32_t)v;
     }
@@ -850,9 +862,7 @@ static iris_status build_scene(obj_ctx *c) {
   memset(&s, 0, sizeof s);
   iris_status st = IRIS_OK;
   s.tri = iris_polygon_triangulator_create();
-  s.head = malloc((nv ? nv : 1) * sizeof(int32_t));
-  s.stamp = calloc(nv ? nv : 1, sizeof(uint32_t));
-  if (!s.tri || !s.head || !s.stamp) {
+  if (!s.tri) {
     st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
     goto done;
   }
