@@ -11,7 +11,8 @@
  *
  * The worst cases: degenerate n-gons (PLY and OBJ), one OBJ position with many
  * texture coordinates, many OBJ groups, a glTF whose primitives share one
- * vertex buffer and slices of one index buffer, a scene object with many keys. */
+ * vertex buffer and slices of one index buffer, many glTF nodes instancing one
+ * mesh (with the scene bounds the exporters compute), a scene object with many keys. */
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -114,8 +115,9 @@ static void gen_grid(buf *b, int scale, bool obj) {
 
 /* A binary glTF: a grid of (w + 1) x 65 vertices in one POSITION accessor,
  * its triangles in one index bufferView; `prims` primitives each draw a slice
- * of it through their own index accessor and all share the vertices. */
-static void gen_gltf(buf *b, int scale, int prims_per_scale) {
+ * of it through their own index accessor and all share the vertices; `nodes`
+ * root nodes instance the mesh. */
+static void gen_gltf(buf *b, int scale, int prims_per_scale, int nodes) {
   const int w = 512 * scale, h = 64, prims = prims_per_scale * scale;
   const size_t nv = (size_t)(w + 1) * (h + 1), nt = 2 * (size_t)w * h;
   buf bin = {0};
@@ -143,7 +145,11 @@ static void gen_gltf(buf *b, int scale, int prims_per_scale) {
   }
   putf(&js, "],\"meshes\":[{\"primitives\":[");
   for (int p = 0; p < prims; p++) putf(&js, "%s{\"attributes\":{\"POSITION\":0},\"indices\":%d}", p ? "," : "", p + 1);
-  putf(&js, "]}],\"nodes\":[{\"mesh\":0}],\"scenes\":[{\"nodes\":[0]}],\"scene\":0}");
+  putf(&js, "]}],\"nodes\":[");
+  for (int i = 0; i < nodes; i++) putf(&js, "%s{\"mesh\":0,\"translation\":[%d,0,0]}", i ? "," : "", i);
+  putf(&js, "],\"scenes\":[{\"nodes\":[");
+  for (int i = 0; i < nodes; i++) putf(&js, "%s%d", i ? "," : "", i);
+  putf(&js, "]}],\"scene\":0}");
   while (js.n % 4) put(&js, " ", 1);
   while (bin.n % 4) put(&bin, "", 1);
   const uint32_t header[3] = {0x46546C67u, 2, (uint32_t)(12 + 8 + js.n + 8 + bin.n)};
@@ -165,16 +171,17 @@ static void gen_scene_keys(buf *b, int scale) {
 }
 
 typedef enum kind {
-  PLY_NGONS, OBJ_NGONS, OBJ_SHARED_POSITION, OBJ_GROUPS, GLTF_SHARED, SCENE_KEYS, /* worst cases */
+  PLY_NGONS, OBJ_NGONS, OBJ_SHARED_POSITION, OBJ_GROUPS, GLTF_SHARED, GLTF_INSTANCES, SCENE_KEYS, /* worst cases */
   PLY_GRID, OBJ_GRID, GLTF_ONE,                                                     /* normal files */
   KIND_COUNT
 } kind;
 static const char *kind_name[] = {"ply: degenerate n-gons", "obj: degenerate n-gons",
                                   "obj: one position, many vt", "obj: many groups",
-                                  "glTF: primitives sharing buffers", "scene: object with many keys",
+                                  "glTF: primitives sharing buffers", "glTF: many nodes, one mesh",
+                                  "scene: object with many keys",
                                   "ply: quad grid (normal)", "obj: quad grid (normal)",
                                   "glTF: one primitive (normal)"};
-static const char *kind_ext[] = {"ply", "obj", "obj", "obj", "glb", "json", "ply", "obj", "glb"};
+static const char *kind_ext[] = {"ply", "obj", "obj", "obj", "glb", "glb", "json", "ply", "obj", "glb"};
 
 static void generate(kind k, int scale, buf *b) {
   switch (k) {
@@ -182,11 +189,12 @@ static void generate(kind k, int scale, buf *b) {
     case OBJ_NGONS: gen_ngons(b, scale, true); break;
     case OBJ_SHARED_POSITION: gen_obj_shared_position(b, scale); break;
     case OBJ_GROUPS: gen_obj_groups(b, scale); break;
-    case GLTF_SHARED: gen_gltf(b, 4 * scale, 16); break;
+    case GLTF_SHARED: gen_gltf(b, 4 * scale, 16, 1); break;
+    case GLTF_INSTANCES: gen_gltf(b, scale, 1, 4096 * scale); break;
     case SCENE_KEYS: gen_scene_keys(b, scale); break;
     case PLY_GRID: gen_grid(b, 16 * scale, false); break;
     case OBJ_GRID: gen_grid(b, 16 * scale, true); break;
-    case GLTF_ONE: gen_gltf(b, 8 * scale, 1); break;
+    case GLTF_ONE: gen_gltf(b, 8 * scale, 1, 1); break;
     default: break;
   }
 }
@@ -221,6 +229,8 @@ static iris_status import_buf(kind k, const buf *b, iris_import_stats *stats) {
     unlink(path);
   }
   if (st != IRIS_OK) printf("  %s: %s\n", kind_name[k], err.message);
+  iris_vec3 lo, hi; /* what framing and the exporters compute next */
+  if (st == IRIS_OK && k != SCENE_KEYS) CHECK(iris_scene_bounds(s, &lo, &hi));
   iris_scene_destroy(s);
   return st;
 }
