@@ -398,6 +398,12 @@ static iris_status validate_accessors(ctx *c) {
         return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
                     k ? "values" : "indices", views[k]);
     }
+    /* Reading the indices is charged to the mesh-data budget: accessors that
+     * share one sparse index view would otherwise cost accessors x indices. */
+    if ((double)n * 4.0 > (double)c->budget_left)
+      return fail(c, IRIS_ERR_NOMEM, el, "sparse indices of all accessors would exceed %zu MiB",
+                  c->budget_total >> 20);
+    c->budget_left -= n * 4;
     const iris_gltf_view *iv = &d->views[a->sparse_index_view];
     const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
     for (size_t k = 0; k < n; k++) {
