@@ -30,6 +30,13 @@
 #define EXR_MAX_EXPANSION 4096
 #define EXR_SMALL_IMAGE_BYTES ((uint64_t)64 << 20)
 #define LDR_MAX_PIXELS ((uint64_t)1 << 28)
+/* stb_image decodes a truncated JPEG to the end as if zeros followed, so its
+ * work follows the declared size, not the data: a 3.7 KB file declaring
+ * 16384 x 16384 took 5.6 s and 1.4 GB. A flat JPEG holds about 60 pixels per
+ * byte (stb_image_write, any quality); allow 1024 per byte plus 1 Mpixel. PNG
+ * needs no such cap: its inflate stops when the data does. */
+#define JPEG_MAX_PIXELS_PER_BYTE 1024
+#define JPEG_SMALL_IMAGE_PIXELS ((uint64_t)1 << 20)
 #define LDR_MAX_FILE ((size_t)1 << 30)
 
 /* ---------------------------------------------------------------- images */
@@ -619,6 +626,12 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
     return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "cannot decode image: %s", stbi_failure_reason());
   if (w <= 0 || h <= 0 || w > IMAGE_MAX_DIM || h > IMAGE_MAX_DIM || (uint64_t)w * (uint64_t)h > LDR_MAX_PIXELS)
     return iris_error_set(err, IRIS_ERR_INVALID, what, 0, NULL, "image size %dx%d is out of range", w, h);
+  const unsigned char *b = data;
+  if (size >= 2 && b[0] == 0xFF && b[1] == 0xD8 &&
+      (uint64_t)w * (uint64_t)h > JPEG_MAX_PIXELS_PER_BYTE * (uint64_t)size + JPEG_SMALL_IMAGE_PIXELS)
+    return iris_error_set(err, IRIS_ERR_INVALID, what, 0, NULL,
+                          "JPEG declares %dx%d pixels, more than its %zu bytes can hold (truncated or corrupt)",
+                          w, h, size);
   uint8_t *rgba = stbi_load_from_memory(data, (int)size, &w, &h, &n, 4);
   if (!rgba)
     return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "cannot decode image: %s", stbi_failure_reason());

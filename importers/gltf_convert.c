@@ -183,6 +183,11 @@ typedef struct ctx {
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
   size_t zero_normals;
   size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
+  uint32_t *vertex_mark, *vertex_remap; /* per accessor element, for primitive_vertices */
+  size_t vertex_cap;
+  uint32_t vertex_stamp;
+  uint32_t *prim_indices, *prim_used; /* one primitive's indices and used vertices */
+  size_t prim_indices_cap, prim_used_cap;
   int32_t *image_texture;           /* image -> last scene texture made from it */
   int *image_sampler;               /* ... and that texture's sampler */
 } ctx;
@@ -393,6 +398,12 @@ static iris_status validate_accessors(ctx *c) {
         return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
                     k ? "values" : "indices", views[k]);
     }
+    /* Reading the indices is charged to the mesh-data budget: accessors that
+     * share one sparse index view would otherwise cost accessors x indices. */
+    if ((double)n * 4.0 > (double)c->budget_left)
+      return fail(c, IRIS_ERR_NOMEM, el, "sparse indices of all accessors would exceed %zu MiB",
+                  c->budget_total >> 20);
+    c->budget_left -= n * 4;
     const iris_gltf_view *iv = &d->views[a->sparse_index_view];
     const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
     for (size_t k = 0; k < n; k++) {
@@ -446,6 +457,73 @@ static void read_indices(const iris_gltf_doc *d, const iris_gltf_accessor *a, ui
   size_t isize = component_size(a->sparse_index_type), vsize = component_size(a->component_type);
   for (size_t k = 0; k < (size_t)a->sparse_count; k++)
     out[load_u32(ip + k * isize, a->sparse_index_type)] = load_u32(vp + k * vsize, a->component_type);
+}
+
+/* Reads elements used[0..count) of an accessor (all of them when used is NULL). */
+static bool read_attribute(const iris_gltf_doc *d, const iris_gltf_accessor *a, int ncomp,
+                           const uint32_t *used, size_t count, float *out) {
+  if (!used) {
+    read_floats(d, a, ncomp, out);
+    return true;
+  }
+  if (a->sparse) { /* substitutions are listed by element: decode all, then gather */
+    float *all = malloc(a->count * (size_t)ncomp * sizeof(float));
+    if (!all) return false;
+    read_floats(d, a, ncomp, all);
+    for (size_t i = 0; i < count; i++)
+      memcpy(out + i * (size_t)ncomp, all + (size_t)used[i] * (size_t)ncomp, (size_t)ncomp * sizeof(float));
+    free(all);
+    return true;
+  }
+  const size_t cs = component_size(a->component_type);
+  for (size_t i = 0; i < count; i++) {
+    const uint8_t *p = element_ptr(d, a, used[i]);
+    for (int k = 0; k < ncomp; k++)
+      out[i * (size_t)ncomp + (size_t)k] = p ? load_component(p + (size_t)k * cs, a->component_type, a->normalized) : 0.0f;
+  }
+  return true;
+}
+
+static int cmp_u32(const void *a, const void *b) {
+  const uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* The vertices a primitive's indices use, renumbered in place to 0..count-1
+ * (in the accessors' order). *used (c->prim_used) is NULL when it uses all nv.
+ * Primitives often share one vertex buffer and draw slices of it: copying all
+ * nv vertices per primitive made the work (and memory) primitives x vertices.
+ * The marks are stamped per call, so the cost is O(ni log ni), not O(nv). */
+static bool primitive_vertices(ctx *c, uint32_t *idx, size_t ni, size_t nv, uint32_t **used, size_t *count) {
+  *used = NULL, *count = nv;
+  if (nv > c->vertex_cap) {
+    uint32_t *mark = realloc(c->vertex_mark, nv * sizeof *mark);
+    if (mark) c->vertex_mark = mark;
+    uint32_t *remap = mark ? realloc(c->vertex_remap, nv * sizeof *remap) : NULL;
+    if (remap) c->vertex_remap = remap;
+    if (!mark || !remap) return false;
+    memset(mark + c->vertex_cap, 0, (nv - c->vertex_cap) * sizeof *mark);
+    c->vertex_cap = nv;
+  }
+  if (++c->vertex_stamp == 0) { /* wrapped: clear the marks once */
+    memset(c->vertex_mark, 0, c->vertex_cap * sizeof *c->vertex_mark);
+    c->vertex_stamp = 1;
+  }
+  if (ni > c->prim_used_cap) {
+    uint32_t *p = realloc(c->prim_used, ni * sizeof *p);
+    if (!p) return false;
+    c->prim_used = p, c->prim_used_cap = ni;
+  }
+  uint32_t *list = c->prim_used;
+  size_t k = 0;
+  for (size_t i = 0; i < ni; i++)
+    if (c->vertex_mark[idx[i]] != c->vertex_stamp) c->vertex_mark[idx[i]] = c->vertex_stamp, list[k++] = idx[i];
+  if (k == nv) return true; /* all used: keep the file's numbering */
+  qsort(list, k, sizeof *list, cmp_u32);
+  for (size_t j = 0; j < k; j++) c->vertex_remap[list[j]] = (uint32_t)j;
+  for (size_t i = 0; i < ni; i++) idx[i] = c->vertex_remap[idx[i]];
+  *used = list, *count = k;
+  return true;
 }
 
 /* ---- meshes -------------------------------------------------------------- */
@@ -557,6 +635,28 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   size_t ni = ia ? ia->count : nv;
   if (mode == MODE_TRIANGLES && ni % 3 != 0)
     return fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
+  if ((ni ? ni : 1) > c->prim_indices_cap) {
+    uint32_t *p = realloc(c->prim_indices, (ni ? ni : 1) * sizeof *p);
+    if (!p) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    c->prim_indices = p, c->prim_indices_cap = ni ? ni : 1;
+  }
+  uint32_t *idx = c->prim_indices;
+  if (ia) {
+    read_indices(d, ia, idx);
+    for (size_t i = 0; i < ni; i++)
+      if (idx[i] >= nv) {
+        char iel[64];
+        ELEMENT(iel, "accessor %d", p->indices);
+        return fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i, nv, el);
+      }
+  } else {
+    for (size_t i = 0; i < ni; i++) idx[i] = (uint32_t)i;
+  }
+  /* Only the vertices this primitive uses are converted (renumbered in idx). */
+  const size_t nv_file = nv;
+  uint32_t *used = NULL;
+  if (ia && !primitive_vertices(c, idx, ni, nv, &used, &nv))
+    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
 
   /* Budget: converted data may exceed the file's buffers only by the expansion of
    * small types (u8 -> float, strip -> list), unless accessors are reused by many
@@ -564,6 +664,9 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
   double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
+  if (used) /* sparse accessors are decoded whole before the gather */
+    need += (double)nv_file * ((pos->sparse ? 12 : 0) + (nrm && nrm->sparse ? 12 : 0) +
+                               (uv && uv->sparse ? 8 : 0) + (col && col->sparse ? 16 : 0));
   if (need > (double)c->budget_left)
     return fail(c, IRIS_ERR_NOMEM, el,
                 "mesh data would exceed %zu MiB (%g MiB for this primitive; accessors reused by "
@@ -577,7 +680,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   m->vertex_count = (uint32_t)nv;
   m->positions = malloc(nv * 3 * sizeof(float));
   if (!m->positions) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  read_floats(d, pos, 3, m->positions);
+  if (!read_attribute(d, pos, 3, used, nv, m->positions)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   char ael[128];
   ELEMENT(ael, "accessor %d", (int)(pos - d->accessors));
   if ((st = check_finite_array(c, m->positions, nv * 3, ael, "POSITION"))) return st;
@@ -585,7 +688,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   if (nrm) {
     m->normals = malloc(nv * 3 * sizeof(float));
     if (!m->normals) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    read_floats(d, nrm, 3, m->normals);
+    if (!read_attribute(d, nrm, 3, used, nv, m->normals)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     if ((st = check_finite_array(c, m->normals, nv * 3, el, "NORMAL"))) return st;
     bool zero = false;
     for (size_t i = 0; i < nv; i++) {
@@ -606,7 +709,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   if (uv) {
     m->uvs = malloc(nv * 2 * sizeof(float));
     if (!m->uvs) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    read_floats(d, uv, 2, m->uvs);
+    if (!read_attribute(d, uv, 2, used, nv, m->uvs)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     if ((st = check_finite_array(c, m->uvs, nv * 2, el, "TEXCOORD_0"))) return st;
   }
   if (col) {
@@ -617,40 +720,21 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
       free(tmp);
       return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     }
-    read_floats(d, col, nc, tmp);
+    if (!read_attribute(d, col, nc, used, nv, tmp)) {
+      free(tmp);
+      return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    }
     for (size_t i = 0; i < nv; i++) /* alpha dropped: iris is opaque */
       for (int k = 0; k < 3; k++) m->colors[3 * i + (size_t)k] = tmp[(size_t)nc * i + (size_t)k];
     free(tmp);
     if ((st = check_finite_array(c, m->colors, nv * 3, el, "COLOR_0"))) return st;
   }
 
-  uint32_t *idx = malloc((ni ? ni : 1) * sizeof(uint32_t));
-  if (!idx) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  if (ia) {
-    read_indices(d, ia, idx);
-    for (size_t i = 0; i < ni; i++)
-      if (idx[i] >= nv) {
-        char iel[64];
-        ELEMENT(iel, "accessor %d", p->indices);
-        st = fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i,
-                  nv, el);
-        free(idx);
-        return st;
-      }
-  } else {
-    for (size_t i = 0; i < ni; i++) idx[i] = (uint32_t)i;
-  }
   /* Triangle list per glTF 2.0 section 3.7.2.1 (strip and fan orders). */
   size_t nt = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
-  if (nt > UINT32_MAX) {
-    free(idx);
-    return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
-  }
+  if (nt > UINT32_MAX) return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
   m->indices = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
-  if (!m->indices) {
-    free(idx);
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  }
+  if (!m->indices) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   size_t kept = 0;
   for (size_t t = 0; t < nt; t++) {
     uint32_t a, b, e;
@@ -668,7 +752,6 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     m->indices[3 * kept] = a, m->indices[3 * kept + 1] = b, m->indices[3 * kept + 2] = e;
     kept++;
   }
-  free(idx);
   m->triangle_count = (uint32_t)kept;
   /* Shared last step (meshproc.h): zero-area triangles out, angle-weighted
    * normals where the file has none, optional welding. */
@@ -1419,6 +1502,7 @@ static void ctx_free(ctx *c) {
   free(c->image_sampler);
   free(c->parent);
   free(c->world);
+  free(c->vertex_mark), free(c->vertex_remap), free(c->prim_indices), free(c->prim_used);
 }
 
 iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_options *opts,

@@ -6,6 +6,7 @@
 #define IRIS_IMPORTERS_IMPORT_H
 
 #include <stdbool.h>
+#include <stdint.h>
 
 #include "scene/scene.h"
 
@@ -13,10 +14,20 @@
 extern "C" {
 #endif
 
+/* Work counters of an import, for the tests and benchmarks that check that
+ * the work grows no faster than the input (docs/fuzzing.md). Added to, not reset. */
+typedef struct iris_import_stats {
+  uint64_t polygons;                /* faces of 4 or more corners triangulated */
+  uint64_t polygon_corners;         /* their corners, summed */
+  uint64_t triangulation_steps;     /* triangulation work (importers/triangulate.h) */
+  uint64_t triangulation_fallbacks; /* polygons whose work budget ran out (partly fanned) */
+} iris_import_stats;
+
 typedef struct iris_import_options {
-  const char *camera_name; /* glTF: pick this camera (default: the first one) */
-  bool weld;               /* weld coincident vertices (OpenMesh) */
-  bool compute_normals;    /* compute angle-weighted normals where absent (default true) */
+  const char *camera_name;  /* glTF: pick this camera (default: the first one) */
+  bool weld;                /* weld coincident vertices (OpenMesh) */
+  bool compute_normals;     /* compute angle-weighted normals where absent (default true) */
+  iris_import_stats *stats; /* optional (default NULL): work counters are added here */
 } iris_import_options;
 
 iris_import_options iris_import_options_default(void);

@@ -1,8 +1,9 @@
 /* Mesh processing shared by the OBJ and PLY importers, behind a C interface
- * (meshproc.cpp is the only C++ here): polygon triangulation by ear clipping,
- * angle-weighted vertex normals, degenerate-triangle removal and optional
- * welding. OpenMesh provides the halfedge reference for the normals (see
- * docs/import-obj-ply.md, "Mesh processing", for what runs where and why). */
+ * (meshproc.cpp is the only C++ here): angle-weighted vertex normals,
+ * degenerate-triangle removal and optional welding; polygon triangulation is
+ * in triangulate.h (C), included here for the importers. OpenMesh provides
+ * the halfedge reference for the normals (see docs/import-obj-ply.md, "Mesh
+ * processing", for what runs where and why). */
 #ifndef IRIS_IMPORTERS_MESHPROC_H
 #define IRIS_IMPORTERS_MESHPROC_H
 
@@ -10,31 +11,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "importers/triangulate.h"
 #include "scene/scene.h"
 
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/* Polygons larger than this are fan-triangulated (ear clipping is O(n^2) per
- * polygon and a hostile file could otherwise stall the import). */
-#define IRIS_POLYGON_EAR_CLIP_MAX 4096u
-
-/* Reusable scratch space for iris_polygon_triangulate (one per importer call). */
-typedef struct iris_polygon_triangulator iris_polygon_triangulator;
-iris_polygon_triangulator *iris_polygon_triangulator_create(void);
-void iris_polygon_triangulator_destroy(iris_polygon_triangulator *t);
-
-/* Triangulates one polygon of n >= 3 corners; corner i sits at
- * positions[3 * corners[i]]. Writes n - 2 triangles as corner numbers
- * (0..n-1, the polygon's winding kept) to tris (room for 3 * (n - 2)) and
- * returns n - 2, or 0 when out of memory. Quads are split along 0-2 unless
- * that diagonal lies outside (concave quad); larger polygons are ear-clipped
- * in the plane of their Newell normal, which handles concave polygons and
- * keyholes (repeated vertices). Zero-area output is left for
- * iris_mesh_remove_degenerate. */
-uint32_t iris_polygon_triangulate(iris_polygon_triangulator *t, const float *positions,
-                                  const uint32_t *corners, uint32_t n, uint32_t *tris);
 
 /* Adds, for every triangle, its unit face normal times the corner angle to
  * accum[3 * v] of each of its three vertices (angle-weighted normals, Thürmer &

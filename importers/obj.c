@@ -15,6 +15,7 @@
 #include "importers/mapped.h"
 #include "importers/meshproc.h"
 #include "importers/numparse.h"
+#include "importers/strmap.h"
 
 #define OBJ_MAX_FILE_SIZE ((size_t)1 << 34) /* 16 GiB */
 #define OBJ_NAME_MAX 256
@@ -95,6 +96,12 @@ typedef struct obj_ctx {
 
   mtl_material *mtls;
   size_t mtl_count, mtl_cap;
+
+  /* Look-ups by name (a scan per query was quadratic in the number of names):
+   * "name\nmaterial" -> group, material name -> its last definition (built on
+   * first use), "0path"/"1path" (repeat/clamp) -> texture, library paths read. */
+  iris_strmap group_map, mtl_map, texture_map, mtllib_map;
+  bool mtl_map_built;
 
   /* ignored things, reported once */
   char ignored[512];
@@ -328,6 +335,8 @@ static void load_mtllib(obj_ctx *c, const char *a, const char *le, long line) {
     for (char *ch = nm; *ch; ch++)
       if (*ch == '\\') *ch = '/';
     iris_path_join(c->dir, nm, full, sizeof full);
+    if (iris_strmap_find(&c->mtllib_map, full)) continue; /* read once, however often named */
+    iris_strmap_put(&c->mtllib_map, full, 0);
     char *data = NULL;
     size_t size = 0;
     iris_error e;
@@ -346,14 +355,17 @@ static void load_mtllib(obj_ctx *c, const char *a, const char *le, long line) {
 
 static obj_group *current_group(obj_ctx *c) {
   if (c->cur_group != SIZE_MAX) return &c->groups[c->cur_group];
-  for (size_t i = 0; i < c->group_count; i++) {
-    obj_group *g = &c->groups[i];
-    if (!strcmp(g->name, c->cur_name) && !strcmp(g->material, c->cur_material)) {
-      c->cur_group = i;
-      return g;
-    }
+  char key[2 * OBJ_NAME_MAX + 2]; /* names never hold a newline */
+  snprintf(key, sizeof key, "%s\n%s", c->cur_name, c->cur_material);
+  const int32_t *found = iris_strmap_find(&c->group_map, key);
+  if (found) {
+    c->cur_group = (size_t)*found;
+    return &c->groups[c->cur_group];
   }
-  if (!grow((void **)&c->groups, &c->group_cap, c->group_count + 1, sizeof *c->groups)) return NULL;
+  if (c->group_count >= INT32_MAX ||
+      !grow((void **)&c->groups, &c->group_cap, c->group_count + 1, sizeof *c->groups))
+    return NULL;
+  iris_strmap_put(&c->group_map, key, (int32_t)c->group_count);
   obj_group *g = &c->groups[c->group_count];
   memset(g, 0, sizeof *g);
   memcpy(g->name, c->cur_name, sizeof g->name);
@@ -549,10 +561,10 @@ static iris_status parse_obj(obj_ctx *c, const char *data, size_t size) {
 /* ---- materials into the scene ------------------------------------------ */
 
 static int32_t add_texture(obj_ctx *c, const char *path, bool clamp) {
-  for (size_t i = 0; i < c->scene->texture_count; i++)
-    if (c->scene->textures[i].path && !strcmp(c->scene->textures[i].path, path) &&
-        (c->scene->textures[i].wrap_s == IRIS_WRAP_CLAMP) == clamp)
-      return (int32_t)i;
+  char key[4096];
+  snprintf(key, sizeof key, "%d%s", clamp ? 1 : 0, path);
+  const int32_t *found = iris_strmap_find(&c->texture_map, key);
+  if (found) return *found;
   const char *mime = mime_of(path);
   if (!mime) {
     iris_warnf("%s: texture '%s' ignored: only PNG and JPEG are supported", c->path, path);
@@ -568,7 +580,9 @@ static int32_t add_texture(obj_ctx *c, const char *path, bool clamp) {
   snprintf(t.mime, sizeof t.mime, "%s", mime);
   t.wrap_s = t.wrap_t = clamp ? IRIS_WRAP_CLAMP : IRIS_WRAP_REPEAT;
   if (!t.path) return -1;
-  return iris_scene_add_texture(c->scene, &t);
+  const int32_t id = iris_scene_add_texture(c->scene, &t);
+  if (id >= 0) iris_strmap_put(&c->texture_map, key, id);
+  return id;
 }
 
 static float maxf3(const float *v) {
@@ -633,9 +647,13 @@ static iris_material material_from_mtl(obj_ctx *c, const mtl_material *m) {
 /* Scene material index for a usemtl name; -1 (default) for none/unknown. */
 static int32_t resolve_material(obj_ctx *c, const char *name, bool *warned) {
   if (!name[0]) return -1;
-  for (size_t i = c->mtl_count; i-- > 0;) { /* the last definition wins */
-    mtl_material *m = &c->mtls[i];
-    if (strcmp(m->name, name)) continue;
+  if (!c->mtl_map_built) { /* the last definition wins */
+    for (size_t i = 0; i < c->mtl_count && i < INT32_MAX; i++) iris_strmap_put(&c->mtl_map, c->mtls[i].name, (int32_t)i);
+    c->mtl_map_built = true;
+  }
+  const int32_t *found = iris_strmap_find(&c->mtl_map, name);
+  if (found) {
+    mtl_material *m = &c->mtls[*found];
     if (m->scene_index == -2) {
       iris_material mat = material_from_mtl(c, m);
       m->scene_index = iris_scene_add_material(c->scene, &mat);
@@ -675,13 +693,15 @@ typedef struct build_scratch {
   size_t ptris_cap;
   uint32_t *tris;   /* triangles of a group as corner numbers */
   size_t tris_cap;
-  int32_t *head;    /* per position: first local vertex, valid when stamp matches */
+  int32_t *head;    /* per hash bucket: first local vertex, valid when stamp matches */
   uint32_t *stamp;
-  int32_t *chain;   /* per local vertex: next with the same position */
+  size_t head_cap, stamp_cap;
+  int32_t *chain;   /* per local vertex: next in the same bucket */
   size_t chain_cap;
   int64_t *vkey;    /* per local vertex: its normal key */
   size_t vkey_cap;
   float *smooth_normals; /* per position, angle-weighted; NULL when not needed */
+  iris_strmap name_counts; /* group name -> number of non-empty groups of that name */
 } build_scratch;
 
 /* Triangulates every face of g into s->tris (corner numbers). */
@@ -719,10 +739,18 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
   if (tri_count > UINT32_MAX / 3 || g->corner_count > UINT32_MAX)
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, 0, g->name,
                           "mesh too large (more than 2^32 triangles)");
-  /* Deduplicate corners into vertices keyed by (v, vt, vn). */
+  /* Deduplicate corners into vertices keyed by (v, vt, vn), in a hash table on
+   * the whole key (buckets stamped per group, so none is cleared). A chain per
+   * position was quadratic when one position carried many texture coordinates. */
+  size_t buckets = 64;
+  while (buckets < g->corner_count) buckets *= 2;
+  const size_t old_stamps = s->stamp_cap;
   if (!grow((void **)&s->chain, &s->chain_cap, g->corner_count, sizeof(int32_t)) ||
-      !grow((void **)&s->vkey, &s->vkey_cap, g->corner_count, sizeof(int64_t)))
+      !grow((void **)&s->vkey, &s->vkey_cap, g->corner_count, sizeof(int64_t)) ||
+      !grow((void **)&s->head, &s->head_cap, buckets, sizeof(int32_t)) ||
+      !grow((void **)&s->stamp, &s->stamp_cap, buckets, sizeof(uint32_t)))
     return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
+  memset(s->stamp + old_stamps, 0, (s->stamp_cap - old_stamps) * sizeof(uint32_t));
   uint32_t *corner_vertex = malloc(g->corner_count * sizeof(uint32_t));
   uint32_t *first_corner = malloc(g->corner_count * sizeof(uint32_t)); /* per vertex */
   if (!corner_vertex || !first_corner) {
@@ -741,19 +769,22 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
       /* Corners of flat faces get their own vertices (with the face normal)
        * when the mesh has normals; the key -3 - f keeps them apart. */
       const int64_t kn = k[2] == OBJ_FLAT ? (want_normals ? -3 - (int64_t)f : OBJ_NO_INDEX) : k[2];
-      int32_t v = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
+      uint64_t h = ((uint64_t)(uint32_t)k[0] << 32 | (uint32_t)k[1]) ^ ((uint64_t)kn * 0x9E3779B97F4A7C15ull);
+      h ^= h >> 31, h *= 0xBF58476D1CE4E5B9ull, h ^= h >> 29, h *= 0x94D049BB133111EBull, h ^= h >> 32;
+      const size_t b = (size_t)(h & (buckets - 1));
+      int32_t v = s->stamp[b] == stamp ? s->head[b] : -1;
       while (v >= 0) {
         const int32_t *o = g->corners + 3 * (size_t)first_corner[v];
-        if (o[1] == k[1] && s->vkey[v] == kn) break;
+        if (o[0] == k[0] && o[1] == k[1] && s->vkey[v] == kn) break;
         v = s->chain[v];
       }
       if (v < 0) {
         v = (int32_t)nv++;
         first_corner[v] = (uint32_t)i;
         s->vkey[v] = kn;
-        s->chain[v] = s->stamp[k[0]] == stamp ? s->head[k[0]] : -1;
-        s->head[k[0]] = v;
-        s->stamp[k[0]] = stamp;
+        s->chain[v] = s->stamp[b] == stamp ? s->head[b] : -1;
+        s->head[b] = v;
+        s->stamp[b] = stamp;
       }
       corner_vertex[i] = (uint32_t)v;
     }
@@ -815,9 +846,8 @@ static iris_status build_group(obj_ctx *c, size_t gi, build_scratch *s, const ch
   free(first_corner);
   /* Name: the group/object name, else the material, else the file stem. */
   char name[2 * OBJ_NAME_MAX + 2];
-  int same_name = 0;
-  for (size_t i = 0; i < c->group_count; i++)
-    if (c->groups[i].face_count && !strcmp(c->groups[i].name, g->name)) same_name++;
+  const int32_t *named = iris_strmap_find(&s->name_counts, g->name);
+  const int same_name = named ? *named : 0;
   if (g->name[0] && same_name > 1 && g->material[0]) snprintf(name, sizeof name, "%s/%s", g->name, g->material);
   else snprintf(name, sizeof name, "%s", g->name[0] ? g->name : g->material[0] ? g->material : stem);
   m.name = iris_strdup(name);
@@ -850,9 +880,7 @@ static iris_status build_scene(obj_ctx *c) {
   memset(&s, 0, sizeof s);
   iris_status st = IRIS_OK;
   s.tri = iris_polygon_triangulator_create();
-  s.head = malloc((nv ? nv : 1) * sizeof(int32_t));
-  s.stamp = calloc(nv ? nv : 1, sizeof(uint32_t));
-  if (!s.tri || !s.head || !s.stamp) {
+  if (!s.tri) {
     st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
     goto done;
   }
@@ -898,11 +926,19 @@ static iris_status build_scene(obj_ctx *c) {
   char stem[256];
   if (c->path) iris_path_stem(c->path, stem, sizeof stem);
   else snprintf(stem, sizeof stem, "mesh");
+  for (size_t gi = 0; gi < c->group_count; gi++) {
+    if (!c->groups[gi].face_count) continue;
+    int32_t *n = iris_strmap_find(&s.name_counts, c->groups[gi].name);
+    if (n) (*n)++;
+    else iris_strmap_put(&s.name_counts, c->groups[gi].name, 1);
+  }
   for (size_t gi = 0; gi < c->group_count && st == IRIS_OK; gi++) st = build_group(c, gi, &s, stem);
 done:
+  if (st == IRIS_OK) iris_polygon_triangulator_report(s.tri, c->path, c->opts->stats);
   iris_polygon_triangulator_destroy(s.tri);
   free(s.poly), free(s.ptris), free(s.tris), free(s.head), free(s.stamp), free(s.chain), free(s.vkey);
   free(s.smooth_normals);
+  iris_strmap_free(&s.name_counts);
   return st;
 }
 
@@ -912,6 +948,8 @@ static void free_ctx(obj_ctx *c) {
   free(c->groups);
   for (size_t i = 0; i < c->mtl_count; i++) free(c->mtls[i].map_kd), free(c->mtls[i].map_ke);
   free(c->mtls);
+  iris_strmap_free(&c->group_map), iris_strmap_free(&c->mtl_map);
+  iris_strmap_free(&c->texture_map), iris_strmap_free(&c->mtllib_map);
 }
 
 iris_status iris_import_obj_memory(const char *data, size_t size, const char *path,

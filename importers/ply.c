@@ -536,10 +536,15 @@ static iris_status import_ply(ply_ctx *c, const char *data, size_t size, const i
       const uint32_t n = c->sizes[f];
       const uint32_t *poly = c->corners + corner;
       uint32_t t = iris_polygon_triangulate(tr, c->pos, poly, n, local);
+      if (t == 0) {
+        free(m.indices), free(local), iris_polygon_triangulator_destroy(tr);
+        return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, NULL, "out of memory");
+      }
       for (uint32_t i = 0; i < 3 * t; i++) m.indices[out++] = poly[local[i]];
       corner += n;
     }
     free(local);
+    iris_polygon_triangulator_report(tr, c->path, opts->stats);
     iris_polygon_triangulator_destroy(tr);
     m.triangle_count = (uint32_t)(out / 3);
   }

@@ -191,7 +191,7 @@ iris_status iris_scene_load(const char *json_path, iris_scene **out, iris_error 
  * twice gives identical bytes. */
 iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iris_error *err);
 
-/* World-space bounds of all instances; returns false for an empty scene. */
+/* World-space bounds of all instances; returns false for an empty scene (or out of memory). */
 bool iris_scene_bounds(const iris_scene *scene, iris_vec3 *lo, iris_vec3 *hi);
 /* Total world-space triangle count (instances counted separately). */
 uint64_t iris_scene_triangle_count(const iris_scene *scene);

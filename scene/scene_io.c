@@ -411,13 +411,45 @@ static void set_element(jctx *c, const char *array, size_t i) {
   snprintf(c->element, sizeof c->element, "%s[%zu]", array, i);
 }
 
+static int cmp_key(const void *a, const void *b) {
+  return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* The first key (in sorted order) that appears twice, or NULL. Sorting keeps
+ * this O(k log k): a pairwise check was quadratic in the number of keys, which
+ * a file controls. Small objects (all of a valid scene) are checked pairwise. */
+static const char *duplicate_key(jctx *c, const cJSON *o, iris_status *st) {
+  size_t k = 0;
+  for (const cJSON *it = o->child; it; it = it->next) k++;
+  if (k <= 32) {
+    for (const cJSON *it = o->child; it; it = it->next)
+      for (const cJSON *prev = o->child; prev != it; prev = prev->next)
+        if (strcmp(prev->string, it->string) == 0) return it->string;
+    return NULL;
+  }
+  const char **keys = malloc(k * sizeof *keys);
+  if (!keys) {
+    *st = jfail(c, IRIS_ERR_NOMEM, "out of memory");
+    return NULL;
+  }
+  k = 0;
+  for (const cJSON *it = o->child; it; it = it->next) keys[k++] = it->string;
+  qsort(keys, k, sizeof *keys, cmp_key);
+  const char *dup = NULL;
+  for (size_t i = 1; i < k && !dup; i++)
+    if (strcmp(keys[i - 1], keys[i]) == 0) dup = keys[i];
+  free(keys);
+  return dup;
+}
+
 /* Object check: must be an object; unknown keys warn; duplicate keys fail. */
 static iris_status check_keys(jctx *c, const cJSON *o, const char *const *known, size_t n) {
   if (!cJSON_IsObject(o)) return jfail(c, IRIS_ERR_INVALID, "expected an object");
+  iris_status st = IRIS_OK;
+  const char *dup = duplicate_key(c, o, &st);
+  if (st != IRIS_OK) return st;
+  if (dup) return jfail(c, IRIS_ERR_INVALID, "duplicate key '%s'", dup);
   for (const cJSON *it = o->child; it; it = it->next) {
-    for (const cJSON *prev = o->child; prev != it; prev = prev->next)
-      if (strcmp(prev->string, it->string) == 0)
-        return jfail(c, IRIS_ERR_INVALID, "duplicate key '%s'", it->string);
     bool found = false;
     for (size_t k = 0; k < n && !found; k++) found = strcmp(known[k], it->string) == 0;
     if (!found) {

@@ -359,6 +359,41 @@ static void test_textures(void) {
   }
 }
 
+/* A JPEG whose header declares far more pixels than its bytes can hold (a
+ * real one with its size patched to 16384 x 16384 and its scan cut short) is
+ * refused before decoding; stb_image would decode it all as if zeros followed. */
+static void test_jpeg_absurd_size(void) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/gltf/CesiumMilkTruck/glTF/CesiumMilkTruck.jpg", assets);
+  char *data = NULL;
+  size_t size = 0;
+  iris_error err;
+  CHECK_OK(iris_file_read(path, (size_t)1 << 26, &data, &size, &err), &err);
+  if (!data) return;
+  size_t i = 2, sof = 0, cut = 0;
+  while (i + 4 <= size && (unsigned char)data[i] == 0xFF) {
+    const unsigned m = (unsigned char)data[i + 1];
+    const size_t len = (size_t)(unsigned char)data[i + 2] << 8 | (unsigned char)data[i + 3];
+    if (m >= 0xC0 && m <= 0xC2) sof = i;
+    if (m == 0xDA) {
+      cut = i + 2 + len + 512;
+      break;
+    }
+    i += 2 + len;
+  }
+  CHECK(sof > 0 && cut > 0 && cut < size);
+  if (sof > 0 && cut > 0 && cut < size) {
+    iris_ldr_image ldr;
+    CHECK_OK(iris_ldr_load_memory(data, size, "CesiumMilkTruck.jpg", &ldr, &err), &err);
+    if (ldr.rgba) iris_ldr_destroy(&ldr);
+    data[sof + 5] = 0x40, data[sof + 6] = 0, data[sof + 7] = 0x40, data[sof + 8] = 0;
+    const iris_status st = iris_ldr_load_memory(data, cut, "huge.jpg", &ldr, &err);
+    CHECK_EQ_INT(st, IRIS_ERR_INVALID);
+    if (st == IRIS_OK) iris_ldr_destroy(&ldr);
+  }
+  free(data);
+}
+
 int main(int argc, char **argv) {
   assets = argc > 1 ? argv[1] : "../shared/assets";
   if (iris_test_tmpdir(dir, sizeof dir, "image") != 0) {
@@ -378,6 +413,7 @@ int main(int argc, char **argv) {
   test_png();
   test_srgb();
   test_textures();
+  test_jpeg_absurd_size();
   iris_test_rmtree(dir);
   return TEST_SUMMARY();
 }

@@ -2,12 +2,16 @@
 # libFuzzer adds new inputs to its first corpus folder, so the seeds (the
 # checked-in corpus and the shared assets, which must never change) are copied
 # into WORK first. Called by the fuzz.<name>.short tests:
-#   cmake -DFUZZER=<exe> -DWORK=<dir> -DSEEDS=<dir;dir> -DSECONDS=20 -P run_fuzz.cmake
+#   cmake -DFUZZER=<exe> -DWORK=<dir> -DSEEDS=<dir;file;...> -DSECONDS=20 -DTIMEOUT=2 -P run_fuzz.cmake
+# A seed that is a file (a finding) goes into the folder findings/.
 if(NOT FUZZER OR NOT WORK)
   message(FATAL_ERROR "run_fuzz.cmake needs FUZZER and WORK")
 endif()
 if(NOT SECONDS)
   set(SECONDS 20)
+endif()
+if(NOT TIMEOUT)
+  set(TIMEOUT 2)
 endif()
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}/corpus" "${WORK}/artifacts")
@@ -17,10 +21,12 @@ foreach(seed IN LISTS SEEDS)
     # One subfolder per seed folder: file names may repeat between folders.
     file(COPY "${seed}/" DESTINATION "${WORK}/corpus/seed${i}")
     math(EXPR i "${i} + 1")
+  elseif(EXISTS "${seed}")
+    file(COPY "${seed}" DESTINATION "${WORK}/corpus/findings")
   endif()
 endforeach()
 execute_process(
-  COMMAND "${FUZZER}" -max_total_time=${SECONDS} -timeout=10 -rss_limit_mb=2048
+  COMMAND "${FUZZER}" -max_total_time=${SECONDS} -timeout=${TIMEOUT} -rss_limit_mb=2048
           -max_len=1048576 -print_final_stats=1 -artifact_prefix=${WORK}/artifacts/
           "${WORK}/corpus"
   RESULT_VARIABLE rc)
