@@ -207,6 +207,120 @@ static const char *const PRELUDE[] = {
     "    nt.links.new(mul.outputs[0], socket)",
     "",
     "",
+    "def math_node(nt, op, a, b=None, c=None):",
+    "    \"\"\"Math node op(a, b, c); each input a constant or a socket. No clamping.\"\"\"",
+    "    node = nt.nodes.new(\"ShaderNodeMath\")",
+    "    node.operation = op",
+    "    node.use_clamp = False",
+    "    for i, v in enumerate((a, b, c)):",
+    "        if v is None:",
+    "            continue",
+    "        if isinstance(v, (int, float)):",
+    "            node.inputs[i].default_value = float(v)",
+    "        else:",
+    "            nt.links.new(v, node.inputs[i])",
+    "    return node.outputs[0]",
+    "",
+    "",
+    "def rgb_socket(nt, v):",
+    "    \"\"\"A colour socket for a constant (r, g, b), a scalar constant or a socket.\"\"\"",
+    "    if isinstance(v, (int, float)):",
+    "        v = (float(v),) * 3",
+    "    if isinstance(v, tuple):",
+    "        const = nt.nodes.new(\"ShaderNodeRGB\")",
+    "        const.outputs[0].default_value = (*v, 1.0)",
+    "        return const.outputs[0]",
+    "    return v",
+    "",
+    "",
+    "def mix_rgb(nt, blend, fac, a, b):",
+    "    \"\"\"MixRGB blend (MIX: (1-fac) a + fac b; MULTIPLY with fac 1: a b), no clamp.\"\"\"",
+    "    node = nt.nodes.new(\"ShaderNodeMixRGB\")",
+    "    node.blend_type = blend",
+    "    node.use_clamp = False",
+    "    if isinstance(fac, (int, float)):",
+    "        node.inputs[\"Fac\"].default_value = float(fac)",
+    "    else:",
+    "        nt.links.new(fac, node.inputs[\"Fac\"])",
+    "    nt.links.new(rgb_socket(nt, a), node.inputs[\"Color1\"])",
+    "    nt.links.new(rgb_socket(nt, b), node.inputs[\"Color2\"])",
+    "    return node.outputs[\"Color\"]",
+    "",
+    "",
+    "def link_or_set(nt, socket, v):",
+    "    if isinstance(v, (int, float)):",
+    "        socket.default_value = float(v)",
+    "    elif isinstance(v, tuple):",
+    "        socket.default_value = (*v, 1.0)",
+    "    else:",
+    "        nt.links.new(v, socket)",
+    "",
+    "",
+    "def add_shaders(nt, shaders):",
+    "    shader = shaders[0]",
+    "    for s in shaders[1:]:",
+    "        add = nt.nodes.new(\"ShaderNodeAddShader\")",
+    "        nt.links.new(shader, add.inputs[0])",
+    "        nt.links.new(s, add.inputs[1])",
+    "        shader = add.outputs[0]",
+    "    return shader",
+    "",
+    "",
+    "def gltf_nodes(nt, m, vc):",
+    "    \"\"\"glTF metallic-roughness as iris renders it (docs/materials.md), from",
+    "    Cycles closures: Diffuse (roughness 0) x (1-m)(1-T)(1 - w max Fr) + Glossy",
+    "    GGX x [w (1-m) Fr + m F_m] + Refraction GGX x (1-m) T (1 - w max Fr) base.",
+    "    The Schlick terms are built at N.V (Layer Weight Facing = 1 - |N.I|, to the",
+    "    5th power): exact for mirrors (and for every Lambert), where glTF's V.H is",
+    "    N.V; for rough lobes the residual is measured (docs/export.md).\"\"\"",
+    "    base = color_socket(nt, m[\"color\"], m[\"color_tex\"], vc)",
+    "    if base is None:",
+    "        base = tuple(m[\"color\"])",
+    "    metal = rough = None",
+    "    if m[\"mr_tex\"] >= 0:",
+    "        sep = nt.nodes.new(\"ShaderNodeSeparateColor\")",
+    "        nt.links.new(texture_node(nt, m[\"mr_tex\"], \"Non-Color\").outputs[\"Color\"], sep.inputs[0])",
+    "        metal = math_node(nt, \"MULTIPLY\", sep.outputs[\"Blue\"], m[\"metallic\"])",
+    "        rough = math_node(nt, \"MULTIPLY\", sep.outputs[\"Green\"], m[\"roughness\"])",
+    "    if metal is None:",
+    "        metal = m[\"metallic\"]",
+    "    if rough is None:",
+    "        rough = m[\"roughness\"]",
+    "    w, T, f0, ior = m[\"specular\"], m[\"transmission\"], m[\"f0\"], m[\"ior\"]",
+    "    f0max = max(f0)",
+    "    lw = nt.nodes.new(\"ShaderNodeLayerWeight\")",
+    "    lw.inputs[\"Blend\"].default_value = 0.5",
+    "    s = math_node(nt, \"POWER\", lw.outputs[\"Facing\"], 5.0)  # (1 - N.V)^5",
+    "    fr_max = math_node(nt, \"MULTIPLY_ADD\", s, 1.0 - f0max, f0max)",
+    "    base_w = math_node(nt, \"MAXIMUM\", math_node(nt, \"MULTIPLY_ADD\", fr_max, -w, 1.0), 0.0)",
+    "    one_minus_m = (1.0 - metal) if isinstance(metal, float) else math_node(nt, \"SUBTRACT\", 1.0, metal)",
+    "    shaders = []",
+    "    if (1.0 - T) > 0.0 and one_minus_m != 0.0:",
+    "        kd = math_node(nt, \"MULTIPLY\", math_node(nt, \"MULTIPLY\", base_w, one_minus_m), 1.0 - T)",
+    "        d = nt.nodes.new(\"ShaderNodeBsdfDiffuse\")",
+    "        d.inputs[\"Roughness\"].default_value = 0.0",
+    "        link_or_set(nt, d.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kd))",
+    "        shaders.append(d.outputs[0])",
+    "    if T > 0.0 and one_minus_m != 0.0:",
+    "        kt = math_node(nt, \"MULTIPLY\", math_node(nt, \"MULTIPLY\", base_w, one_minus_m), T)",
+    "        r = nt.nodes.new(\"ShaderNodeBsdfRefraction\")",
+    "        r.distribution = \"GGX\"",
+    "        link_or_set(nt, r.inputs[\"Roughness\"], rough)",
+    "        r.inputs[\"IOR\"].default_value = ior",
+    "        link_or_set(nt, r.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kt))",
+    "        shaders.append(r.outputs[0])",
+    "    if w > 0.0 or metal != 0.0:",
+    "        fr = mix_rgb(nt, \"MIX\", s, tuple(f0), (1.0, 1.0, 1.0))",
+    "        fm = mix_rgb(nt, \"MIX\", s, base, (1.0, 1.0, 1.0))",
+    "        diel = mix_rgb(nt, \"MULTIPLY\", 1.0, fr, w)",
+    "        g = nt.nodes.new(\"ShaderNodeBsdfGlossy\")",
+    "        g.distribution = \"GGX\"",
+    "        link_or_set(nt, g.inputs[\"Roughness\"], rough)",
+    "        link_or_set(nt, g.inputs[\"Color\"], mix_rgb(nt, \"MIX\", metal, diel, fm))",
+    "        shaders.append(g.outputs[0])",
+    "    return add_shaders(nt, shaders)",
+    "",
+    "",
     "def build_material(m):",
     "    mat = bpy.data.materials.new(text(m[\"name\"]))",
     "    mat.use_nodes = True",
@@ -229,7 +343,7 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"Roughness\"].default_value = m[\"roughness\"]",
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
-    "    else:",
+    "    elif m[\"principled\"]:",
     "        bsdf = nt.nodes.new(\"ShaderNodeBsdfPrincipled\")",
     "        bsdf.distribution = \"GGX\"",
     "        set_color(nt, bsdf.inputs[\"Base Color\"], m[\"color\"], m[\"color_tex\"], vc)",
@@ -245,7 +359,11 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        bsdf.inputs[\"Transmission\"].default_value = m[\"transmission\"]",
     "        bsdf.inputs[\"Transmission Roughness\"].default_value = 0.0",
-    "    shader = bsdf.outputs[0]",
+    "    else:",
+    "        bsdf = None",
+    "        shader = gltf_nodes(nt, m, vc)",
+    "    if bsdf is not None:",
+    "        shader = bsdf.outputs[0]",
     "    if max(m[\"emission\"]) > 0.0:",
     "        em = nt.nodes.new(\"ShaderNodeEmission\")",
     "        em.inputs[\"Strength\"].default_value = 1.0",
@@ -655,7 +773,7 @@ static float principled_specular(const iris_material *m) {
   return f0 / 0.08f * m->specular * col;
 }
 
-static void put_material(FILE *fp, const iris_scene *scene, material_variant v) {
+static void put_material(FILE *fp, const iris_scene *scene, material_variant v, bool principled) {
   iris_material def = iris_material_default(IRIS_MATERIAL_DIFFUSE);
   const iris_material *m = v.material >= 0 ? &scene->materials[v.material] : &def;
   fputs("    dict(name=", fp);
@@ -672,6 +790,14 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v) 
   put_float(fp, principled_specular(m));
   fputs(", transmission=", fp);
   put_float(fp, m->transmission);
+  /* glTF dielectric F0 per channel, as renderer/bsdf.c: min(((ior-1)/(ior+1))^2 s, 1). */
+  float f0 = iris_sqr((m->ior - 1.0f) / (m->ior + 1.0f)), f0c[3];
+  for (int k = 0; k < 3; k++) f0c[k] = fminf(f0 * m->specular_color[k], 1.0f);
+  fputs(", specular=", fp);
+  put_float(fp, m->specular);
+  fputs(", f0=", fp);
+  put_vec3(fp, f0c);
+  fprintf(fp, ", principled=%s", principled ? "True" : "False");
   fputs(", emission=", fp);
   put_vec3(fp, m->emission);
   fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s),\n",
@@ -803,7 +929,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("TEXTURES = [\n", fp);
   for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, scene, i, script_path);
   fputs("]\nMATERIALS = [\n", fp);
-  for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i]);
+  for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i], params->gltf_principled);
   fputs("]\nMESHES = [\n", fp);
   for (size_t i = 0; i < scene->mesh_count; i++) {
     const iris_mesh *m = &scene->meshes[i];

@@ -24,6 +24,9 @@ typedef struct iris_export_params {
   bool has_seed;           /* false: scene render settings, then 0 */
   bool embed_meshes;       /* blender: mesh data inside the script instead of a sidecar file */
   bool coverage;           /* pov: every object pure white emitter, black background, no lights */
+  bool gltf_principled;    /* blender: gltf materials as a Principled BSDF (the old, approximate
+                              mapping; kept for the measurement in docs/export.md) instead of
+                              the Appendix B node tree */
 } iris_export_params;
 
 #define IRIS_EXPORT_DEFAULT_HEIGHT IRIS_FRAMING_DEFAULT_HEIGHT
