@@ -96,6 +96,22 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
   cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
   iris_json_add_number(r, "seconds", res->reference.seconds);
+  if (res->blender_import) {
+    cJSON *bi = cJSON_AddObjectToObject(o, "blender_import");
+    const iris_import_diff *d = &res->import_diff;
+    cJSON_AddStringToObject(bi, "file", res->import_file);
+    cJSON_AddBoolToObject(bi, "geometry_differs", d->geometry_differs);
+    cJSON_AddNumberToObject(bi, "iris_triangles", (double)d->iris_triangles);
+    cJSON_AddNumberToObject(bi, "blender_triangles", (double)d->blender_triangles);
+    cJSON_AddNumberToObject(bi, "note_count", d->total);
+    cJSON *notes = cJSON_AddArrayToObject(bi, "notes");
+    for (int i = 0; i < d->note_count; i++) {
+      cJSON *n = cJSON_CreateObject();
+      cJSON_AddStringToObject(n, "topic", d->notes[i].topic);
+      cJSON_AddStringToObject(n, "text", d->notes[i].text);
+      cJSON_AddItemToArray(notes, n);
+    }
+  }
   cJSON *ms = cJSON_AddArrayToObject(o, "methods");
   for (int k = 0; k < res->method_count; k++) {
     const iris_validate_method *m = &res->methods[k];
