@@ -299,6 +299,8 @@ int iris_cmd_validate(int argc, char **argv) {
                    "the tolerance (%.2f%%): the energy check is dominated by noise; raise --spp",
                    iris_method_name(m->method), 100.0 * se, 100.0 * p.tolerance);
     }
+    if (p.source == IRIS_REFERENCE_BLENDER && !res.blender_import)
+      iris_infof("validate: materials: %s", res.export_note);
     if (res.blender_import) {
       const iris_import_diff *d = &res.import_diff;
       iris_infof("validate: iris's glTF import vs Blender's of %s: %d note(s)%s (%s/importers.txt)",

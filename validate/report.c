@@ -96,6 +96,10 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
   cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
   iris_json_add_number(r, "seconds", res->reference.seconds);
+  if (params->source == IRIS_REFERENCE_BLENDER && !res->blender_import) {
+    cJSON_AddBoolToObject(r, "export_exact", res->export_exact);
+    cJSON_AddStringToObject(r, "export_note", res->export_note);
+  }
   if (res->blender_import) {
     cJSON *bi = cJSON_AddObjectToObject(o, "blender_import");
     const iris_import_diff *d = &res->import_diff;

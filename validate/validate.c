@@ -18,6 +18,7 @@
 #include "importers/import.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
+#include "scene/material_class.h"
 #include "scenes/builtin.h"
 #include "validate/blender_run.h"
 #include "validate/json_out.h"
@@ -426,6 +427,30 @@ static iris_status write_render_pngs(const char *dir, const char *name, const ir
   return iris_report_write_false_colour(path, zimg, img->width, img->height, 5.0f, err);
 }
 
+/* Whether Cycles renders every material of the exported scene exactly
+ * (docs/export.md, "glTF materials"): rough gltf lobes are approximate. */
+static void describe_export_exactness(const iris_scene *scene, iris_validate_result *res) {
+  int rough = 0, used = 0;
+  char names[200] = "";
+  size_t len = 0;
+  for (size_t i = 0; i < scene->material_count; i++) {
+    const iris_material *m = &scene->materials[i];
+    if (m->type != IRIS_MATERIAL_GLTF || iris_material_gltf_smooth(m)) continue;
+    if (iris_material_gltf_class(m) == IRIS_GLTF_LAMBERT) continue; /* exact: diffuse weight 1, no lobe */
+    used++;
+    if (rough++ < 4 && len < sizeof names)
+      len += (size_t)snprintf(names + len, sizeof names - len, "%s'%s' (%s)", rough > 1 ? ", " : "",
+                              m->name ? m->name : "", iris_gltf_class_name(iris_material_gltf_class(m)));
+  }
+  res->export_exact = used == 0;
+  if (res->export_exact)
+    snprintf(res->export_note, sizeof res->export_note, "every material is exact in Cycles");
+  else
+    snprintf(res->export_note, sizeof res->export_note,
+             "%d rough glTF material(s) %s%s are approximate in Cycles (Fresnel at N.V, separable G): "
+             "expect the residual of docs/export.md", rough, names, rough > 4 ? ", ..." : "");
+}
+
 /* DIR/importers.txt: one line per disagreement of iris's and Blender's glTF import. */
 static iris_status write_import_notes(const char *dir, const iris_validate_result *res, iris_error *err) {
   char path[1300];
@@ -516,6 +541,7 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
       goto done;
     }
   }
+  if (p.source == IRIS_REFERENCE_BLENDER && !p.blender_import) describe_export_exactness(scene, res);
   if (p.source == IRIS_REFERENCE_BLENDER && p.blender_import) {
     char inventory[1000];
     snprintf(inventory, sizeof inventory, "%.880s/cycles/import.json", p.out_dir);

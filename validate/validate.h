@@ -109,6 +109,9 @@ typedef struct iris_validate_result {
   iris_validate_reference reference;
   iris_validate_method methods[IRIS_METHOD_COUNT];
   int method_count;
+  bool export_exact;        /* IRIS_REFERENCE_BLENDER via the export: every material is one Cycles
+                               reproduces exactly (diffuse, glossy, glass, smooth or Lambert gltf) */
+  char export_note[320];    /* otherwise which materials are approximate and the expected residual */
   bool blender_import;      /* the reference came from Blender's own glTF importer */
   char import_file[1024];
   iris_import_diff import_diff; /* where the two importers disagree (geometry fails the run) */
