@@ -1,4 +1,5 @@
-/* Blender 3.4 exporter (exporters/blender.h, docs/export.md).
+/* Blender 3.4 exporter (exporters/blender.h, docs/export.md); the script for
+ * Blender's own glTF importer is in blender_import.c.
  * The script is a fixed Python prelude (the functions that build a scene from
  * plain data tables and set the fair-comparison Cycles settings) followed by
  * the data tables of this scene and a call to main(). Mesh arrays are stored
@@ -11,10 +12,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "core/fileio.h"
 #include "core/log.h"
+#include "exporters/blender_script.h"
 
 /* clang-format off */
 static const char *const PRELUDE[] = {
@@ -563,121 +564,16 @@ static const char *const PRELUDE[] = {
     "    # bpy.ops.render.render (Cycles' sync, BVH build, path tracing, EXR write).",
     "    print(\"IRIS_BLENDER build_seconds=%.3f render_seconds=%.3f spp=%d threads=%d width=%d height=%d \"",
     "          \"data_seconds=%.3f\" % (t1 - t0, t2 - t1, a.spp, a.threads, a.width, a.height, t_data), flush=True)",
-    "",
-    "",
-    "# ---- Blender's own glTF importer (iris validate --blender-import) ----------",
-    "",
-    "def to_gltf(v):",
-    "    \"\"\"Blender's importer maps glTF (x, y, z) to Blender (x, -z, y); back again.\"\"\"",
-    "    return [v[0], v[2], -v[1]]",
-    "",
-    "",
-    "def socket_value(node, name):",
-    "    s = node.inputs.get(name)",
-    "    if s is None:",
-    "        return None",
-    "    if s.is_linked:",
-    "        return \"linked:\" + s.links[0].from_node.bl_idname",
-    "    v = s.default_value",
-    "    try:",
-    "        return [float(x) for x in v][:3]",
-    "    except TypeError:",
-    "        return float(v)",
-    "",
-    "",
-    "def describe_import(sc):",
-    "    \"\"\"What Blender's importer made of the file, in glTF's axes and units.\"\"\"",
-    "    dg = bpy.context.evaluated_depsgraph_get()",
-    "    out = dict(unit_system=sc.unit_settings.system, unit_scale=sc.unit_settings.scale_length,",
-    "               triangles=0, meshes=0, meshes_with_colors=0, materials=[], cameras=[], lights=[],",
-    "               bounds=None)",
-    "    lo, hi = [math.inf] * 3, [-math.inf] * 3",
-    "    for obj in sc.objects:",
-    "        if obj.type == \"MESH\":",
-    "            ev = obj.evaluated_get(dg)",
-    "            me = ev.to_mesh()",
-    "            me.calc_loop_triangles()",
-    "            out[\"triangles\"] += len(me.loop_triangles)",
-    "            out[\"meshes\"] += 1",
-    "            if len(obj.data.color_attributes) > 0:",
-    "                out[\"meshes_with_colors\"] += 1",
-    "            mw = obj.matrix_world",
-    "            for v in me.vertices:",
-    "                p = to_gltf(mw @ v.co)",
-    "                for k in range(3):",
-    "                    lo[k] = min(lo[k], p[k])",
-    "                    hi[k] = max(hi[k], p[k])",
-    "            ev.to_mesh_clear()",
-    "        elif obj.type == \"CAMERA\":",
-    "            c = obj.data",
-    "            out[\"cameras\"].append(dict(name=obj.name, type=c.type, sensor_fit=c.sensor_fit,",
-    "                                       angle_y=c.angle_y, angle_x=c.angle_x,",
-    "                                       position=to_gltf(obj.matrix_world.translation)))",
-    "        elif obj.type == \"LIGHT\":",
-    "            l = obj.data",
-    "            d = dict(name=obj.name, type=l.type, color=list(l.color),",
-    "                     position=to_gltf(obj.matrix_world.translation))",
-    "            if l.type == \"SUN\":",
-    "                d[\"strength\"] = l.energy",
-    "            else:",
-    "                d[\"power\"] = l.energy",
-    "            if l.type == \"SPOT\":",
-    "                d[\"spot_size\"] = l.spot_size",
-    "                d[\"spot_blend\"] = l.spot_blend",
-    "            out[\"lights\"].append(d)",
-    "    if out[\"meshes\"]:",
-    "        out[\"bounds\"] = [lo, hi]",
-    "    for mat in bpy.data.materials:",
-    "        d = dict(name=mat.name, nodes=[], blend_method=mat.blend_method)",
-    "        if mat.use_nodes and mat.node_tree:",
-    "            for n in mat.node_tree.nodes:",
-    "                d[\"nodes\"].append(n.bl_idname)",
-    "                if n.bl_idname in (\"ShaderNodeVertexColor\", \"ShaderNodeAttribute\"):",
-    "                    d[\"uses_vertex_color\"] = True",
-    "                if n.bl_idname == \"ShaderNodeBsdfPrincipled\":",
-    "                    for key in (\"Base Color\", \"Metallic\", \"Roughness\", \"Specular\", \"Transmission\",",
-    "                                \"IOR\", \"Emission\", \"Emission Strength\", \"Alpha\"):",
-    "                        d[key] = socket_value(n, key)",
-    "        out[\"materials\"].append(d)",
-    "    return out",
-    "",
-    "",
-    "def main_import():",
-    "    a = parse_args()",
-    "    t0 = time.perf_counter()",
-    "    bpy.ops.wm.read_factory_settings(use_empty=True)",
-    "    # Debian 12's numpy 1.24 removed np.bool, which the 3.4 add-on still uses.",
-    "    if not hasattr(np, \"bool\"):",
-    "        np.bool = bool",
-    "    sc = bpy.context.scene",
-    "    path = os.fsdecode(IMPORT)",
-    "    try:",
-    "        res = bpy.ops.import_scene.gltf(filepath=path)",
-    "    except Exception as e:  # the add-on raises on files it cannot read",
-    "        print(\"iris-blender: error: Blender's glTF importer failed on %s: %s\" % (path, e), file=sys.stderr)",
-    "        sys.exit(1)",
-    "    if \"FINISHED\" not in res:",
-    "        print(\"iris-blender: error: Blender's glTF importer did not finish on %s\" % path, file=sys.stderr)",
-    "        sys.exit(1)",
-    "    inventory = describe_import(sc)",
-    "    build_world(sc, WORLD)",
-    "    build_camera(sc)",
-    "    configure(sc, a)",
-    "    if a.inventory:",
-    "        import json",
-    "        with open(a.inventory, \"w\") as f:",
-    "            json.dump(inventory, f, indent=1)",
-    "    t1 = time.perf_counter()",
-    "    bpy.ops.render.render(write_still=True)",
-    "    t2 = time.perf_counter()",
-    "    if not os.path.isfile(sc.render.filepath):",
-    "        print(\"iris-blender: error: Cycles wrote no image to %s\" % sc.render.filepath, file=sys.stderr)",
-    "        sys.exit(1)",
-    "    print(\"IRIS_BLENDER build_seconds=%.3f render_seconds=%.3f spp=%d threads=%d width=%d height=%d \"",
-    "          \"data_seconds=0.000\" % (t1 - t0, t2 - t1, a.spp, a.threads, a.width, a.height), flush=True)",
     /* END PRELUDE */
 };
 /* clang-format on */
+
+void iris_blender_put_prelude(FILE *fp) {
+  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
+    fputs(PRELUDE[i], fp);
+    fputc('\n', fp);
+  }
+}
 
 /* ---- small writers --------------------------------------------------------- */
 
@@ -691,7 +587,7 @@ static void put_float(FILE *fp, float v) {
   fputs(buf, fp);
 }
 
-static void put_vec3(FILE *fp, const float *v) {
+void iris_blender_put_vec3(FILE *fp, const float *v) {
   fputc('(', fp);
   for (int i = 0; i < 3; i++) {
     if (i) fputs(", ", fp);
@@ -702,7 +598,7 @@ static void put_vec3(FILE *fp, const float *v) {
 
 /* A Python bytes literal holding the exact bytes of s (NULL -> b""). Names are
  * decoded with errors="replace" by the prelude's text(); paths with os.fsdecode. */
-static void put_bytes(FILE *fp, const char *s) {
+void iris_blender_put_bytes(FILE *fp, const char *s) {
   fputs("b\"", fp);
   for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; p++) {
     if (*p == '"' || *p == '\\')
@@ -892,9 +788,9 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v, 
   iris_material def = iris_material_default(IRIS_MATERIAL_DIFFUSE);
   const iris_material *m = v.material >= 0 ? &scene->materials[v.material] : &def;
   fputs("    dict(name=", fp);
-  put_bytes(fp, v.material >= 0 ? (m->name ? m->name : "material") : "iris-default");
+  iris_blender_put_bytes(fp, v.material >= 0 ? (m->name ? m->name : "material") : "iris-default");
   fprintf(fp, ", type=\"%s\", color=", material_type_name(m->type));
-  put_vec3(fp, m->color);
+  iris_blender_put_vec3(fp, m->color);
   fprintf(fp, ", color_tex=%d, roughness=", (int)m->color_texture);
   put_float(fp, m->roughness);
   fputs(", ior=", fp);
@@ -911,10 +807,10 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v, 
   fputs(", specular=", fp);
   put_float(fp, m->specular);
   fputs(", f0=", fp);
-  put_vec3(fp, f0c);
+  iris_blender_put_vec3(fp, f0c);
   fprintf(fp, ", principled=%s", principled ? "True" : "False");
   fputs(", emission=", fp);
-  put_vec3(fp, m->emission);
+  iris_blender_put_vec3(fp, m->emission);
   fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s),\n",
           (int)m->emission_texture, m->emission_two_sided ? "True" : "False",
           v.vertex_colors ? "True" : "False");
@@ -927,7 +823,7 @@ static void put_texture(FILE *fp, const iris_scene *scene, size_t index, const c
   char path[2048];
   iris_export_texture_file(scene, index, script_path, false, path, sizeof path);
   fputs("    dict(path=", fp);
-  put_bytes(fp, path);
+  iris_blender_put_bytes(fp, path);
   fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s),\n", wrap_name(t->wrap_s),
           wrap_name(t->wrap_t), t->nearest ? "True" : "False");
 }
@@ -948,15 +844,15 @@ static void put_light(FILE *fp, const iris_light *l, size_t index) {
     iris_warnf("light '%s': range %g ignored (Cycles lights have no range)", l->name ? l->name : name,
                (double)l->range);
   fputs("    dict(name=", fp);
-  put_bytes(fp, l->name ? l->name : name);
+  iris_blender_put_bytes(fp, l->name ? l->name : name);
   fprintf(fp, ", type=\"%s\", color=", TYPES[l->type <= IRIS_LIGHT_DIRECTIONAL ? l->type : 0]);
-  put_vec3(fp, l->color);
+  iris_blender_put_vec3(fp, l->color);
   fputs(", strength=", fp);
   put_float(fp, strength);
   fputs(", position=", fp);
-  put_vec3(fp, l->position);
+  iris_blender_put_vec3(fp, l->position);
   fputs(", direction=", fp);
-  put_vec3(fp, l->direction);
+  iris_blender_put_vec3(fp, l->direction);
   fputs(", cos_inner=", fp);
   put_float(fp, cosf(inner));
   fputs(", cos_outer=", fp);
@@ -964,7 +860,7 @@ static void put_light(FILE *fp, const iris_light *l, size_t index) {
   fputs("),\n", fp);
 }
 
-static void put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view) {
+void iris_blender_put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view) {
   /* Cycles starts camera rays at clip_start: keep it far below any feature
    * size. clip_end must reach past everything. */
   iris_vec3 lo, hi, eye = iris_v3(view->to_world.m[0][3], view->to_world.m[1][3], view->to_world.m[2][3]);
@@ -975,7 +871,7 @@ static void put_camera(FILE *fp, const iris_scene *scene, const iris_export_view
     far = iris_length(iris_sub(c, eye)) + diag;
   }
   fputs("CAMERA = dict(name=", fp);
-  put_bytes(fp, view->camera >= 0 && scene->cameras[view->camera].name ? scene->cameras[view->camera].name
+  iris_blender_put_bytes(fp, view->camera >= 0 && scene->cameras[view->camera].name ? scene->cameras[view->camera].name
                                                                        : "camera");
   fputs(", yfov=", fp);
   put_float(fp, view->yfov);
@@ -1019,23 +915,20 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fprintf(fp,
           "# Blender 3.4 scene written by iris %s from ",
           IRIS_VERSION_STRING);
-  put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
+  iris_blender_put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
   fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
         "# fair-comparison settings of iris's docs/export.md. Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
         "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n",
         fp);
-  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
-    fputs(PRELUDE[i], fp);
-    fputc('\n', fp);
-  }
+  iris_blender_put_prelude(fp);
 
   fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
   fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view->width,
           view->height, view->spp, view->max_depth, (unsigned long long)(view->seed & 0x7fffffffu));
   if (scene->has_environment) {
     fputs("WORLD = ", fp);
-    put_vec3(fp, scene->environment);
+    iris_blender_put_vec3(fp, scene->environment);
     fputc('\n', fp);
   } else {
     fputs("WORLD = None\n", fp);
@@ -1051,7 +944,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
     char name[32];
     snprintf(name, sizeof name, "mesh.%zu", i);
     fputs("    dict(name=", fp);
-    put_bytes(fp, m->name ? m->name : name);
+    iris_blender_put_bytes(fp, m->name ? m->name : name);
     fprintf(fp,
             ", nv=%u, nt=%u, pos=%lld, nrm=%lld, uv=%lld, col=%lld, idx=%lld, material=%d, "
             "validate=%s),\n",
@@ -1068,7 +961,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("]\nLIGHTS = [\n", fp);
   for (size_t i = 0; i < scene->light_count; i++) put_light(fp, &scene->lights[i], i);
   fputs("]\n", fp);
-  put_camera(fp, scene, view);
+  iris_blender_put_camera(fp, scene, view);
 
   fprintf(fp, "BLOB_SIZE = %llu\n", (unsigned long long)blob_size);
   if (params->embed_meshes) {
@@ -1078,75 +971,11 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
     fputs("\"\n", fp);
   } else {
     fputs("SIDECAR = ", fp);
-    put_bytes(fp, sidecar_name);
+    iris_blender_put_bytes(fp, sidecar_name);
     fputs("\nBLOB = None\n", fp);
   }
   fputs("\nmain()\n", fp);
   return IRIS_OK;
-}
-
-/* ---- the script for Blender's own glTF importer -------------------------- */
-
-iris_status iris_export_blender_import(const iris_scene *scene, const char *import_path,
-                                       const char *script_path, const iris_export_params *params,
-                                       iris_error *err) {
-  const char *file = scene->source_path ? scene->source_path : script_path;
-  iris_status st = iris_scene_validate(scene, file, err);
-  if (st != IRIS_OK) return st;
-  iris_export_view view;
-  st = iris_export_resolve_view(scene, params, file, &view, err);
-  if (st != IRIS_OK) return st;
-  if (!iris_path_exists(import_path))
-    return iris_error_set(err, IRIS_ERR_USAGE, import_path, 0, NULL, "no such file");
-  char abs_import[4096], cwd[2048];
-  if (import_path[0] == '/' || !getcwd(cwd, sizeof cwd))
-    snprintf(abs_import, sizeof abs_import, "%s", import_path);
-  else
-    iris_path_join(cwd, import_path, abs_import, sizeof abs_import);
-  /* Blender's importer turns glTF's +Y up into +Z up: glTF (x, y, z) lands at
-   * Blender (x, -z, y). iris keeps glTF's axes, so the camera is rotated the same way. */
-  iris_export_view bview = view;
-  for (int c = 0; c < 4; c++) {
-    float y = view.to_world.m[1][c], z = view.to_world.m[2][c];
-    bview.to_world.m[1][c] = -z;
-    bview.to_world.m[2][c] = y;
-  }
-  iris_atomic_file af;
-  st = iris_atomic_open(&af, script_path, err);
-  if (st != IRIS_OK) return st;
-  FILE *fp = af.fp;
-  fprintf(fp, "# Blender 3.4 script written by iris %s: imports ", IRIS_VERSION_STRING);
-  put_bytes(fp, abs_import);
-  fputs("\n# with Blender's own glTF importer and renders it with Cycles under iris's camera and\n"
-        "# world with the fair-comparison settings (docs/validation.md, --blender-import). Usage:\n"
-        "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
-        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n"
-        "#           [--inventory FILE.json]\n",
-        fp);
-  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
-    fputs(PRELUDE[i], fp);
-    fputc('\n', fp);
-  }
-  fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
-  fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view.width,
-          view.height, view.spp, view.max_depth, (unsigned long long)(view.seed & 0x7fffffffu));
-  if (scene->has_environment) {
-    fputs("WORLD = ", fp);
-    put_vec3(fp, scene->environment);
-    fputc('\n', fp);
-  } else {
-    fputs("WORLD = None\n", fp);
-  }
-  fputs("TEXTURES = []\nMATERIALS = []\nMESHES = []\nINSTANCES = []\nLIGHTS = []\n", fp);
-  put_camera(fp, scene, &bview);
-  fputs("BLOB_SIZE = 0\nSIDECAR = None\nBLOB = None\nIMPORT = ", fp);
-  put_bytes(fp, abs_import);
-  fputs("\n\nmain_import()\n", fp);
-  if (ferror(fp)) {
-    iris_atomic_abort(&af);
-    return iris_error_set(err, IRIS_ERR_IO, script_path, 0, NULL, "write failed: %s", strerror(errno));
-  }
-  return iris_atomic_commit(&af, err);
 }
 
 iris_status iris_export_blender(const iris_scene *scene, const char *script_path,
