@@ -99,6 +99,7 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   if (params->source == IRIS_REFERENCE_BLENDER && !res->blender_import) {
     cJSON_AddBoolToObject(r, "export_exact", res->export_exact);
     cJSON_AddStringToObject(r, "export_note", res->export_note);
+    iris_json_add_number(r, "export_expected_residual", res->export_residual);
   }
   if (res->blender_import) {
     cJSON *bi = cJSON_AddObjectToObject(o, "blender_import");

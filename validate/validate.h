@@ -111,7 +111,8 @@ typedef struct iris_validate_result {
   int method_count;
   bool export_exact;        /* IRIS_REFERENCE_BLENDER via the export: every material is one Cycles
                                reproduces exactly (diffuse, glossy, glass, smooth or Lambert gltf) */
-  char export_note[320];    /* otherwise which materials are approximate and the expected residual */
+  double export_residual;   /* largest expected |iris / Cycles - 1| of a material's furnace mean */
+  char export_note[360];    /* otherwise which materials are approximate and the expected residual */
   bool blender_import;      /* the reference came from Blender's own glTF importer */
   char import_file[1024];
   iris_import_diff import_diff; /* where the two importers disagree (geometry fails the run) */
