@@ -1,6 +1,6 @@
 /* validate.blender_import: `iris validate --blender-import` with real Blender
  * (SKIP without it) on a Khronos sample model under a uniform sky:
- *  - Box.gltf rendered through Blender's own glTF importer passes (energy
+ *  - Box.gltf and BoxTextured.gltf rendered through Blender's own glTF importer pass (energy
  *    within the documented --blender-import tolerance), the importers agree on
  *    the geometry, and the report lists the material note (Principled BSDF);
  *  - the same scene against Blender's import of another model
@@ -69,6 +69,27 @@ int main(int argc, char **argv) {
   text = read_text(path);
   CHECK(text && strstr(text, "\"blender_import\"") && strstr(text, "\"geometry_differs\":\tfalse"));
   free(text);
+
+  /* a textured model: passes too (its importer note is the Principled one) */
+  {
+    char tex[900], tjson[700], tout[700];
+    snprintf(tex, sizeof tex, "%s/gltf/BoxTextured/glTF/BoxTextured.gltf", argv[2]);
+    snprintf(tjson, sizeof tjson, "%s/textured.json", dir);
+    const char *timp[] = {argv[1], "import", tex, "-o", tjson, "-q", NULL};
+    CHECK_EQ_INT(run(timp), 0);
+    char *t = read_text(tjson);
+    if (CHECK(t && t[0] == '{')) {
+      FILE *tf = fopen(tjson, "w");
+      fprintf(tf, "{\"environment\": {\"radiance\": [1, 1, 1]},%s", t + 1);
+      fclose(tf);
+    }
+    free(t);
+    snprintf(tout, sizeof tout, "%s/textured", dir);
+    snprintf(arg, sizeof arg, "--blender-import=%s", tex);
+    const char *targs[] = {argv[1], "validate", tjson, arg, "--spp", "32", "--blender-spp", "32", "--width",
+                           "48", "--height", "48", "--threads", "2", "--quiet", "--out", tout, NULL};
+    CHECK_EQ_INT(run(targs), 0);
+  }
 
   snprintf(out, sizeof out, "%s/other", dir);
   snprintf(arg, sizeof arg, "--blender-import=%s", other);
