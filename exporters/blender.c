@@ -1,4 +1,5 @@
-/* Blender 3.4 exporter (exporters/blender.h, docs/export.md).
+/* Blender 3.4 exporter (exporters/blender.h, docs/export.md); the script for
+ * Blender's own glTF importer is in blender_import.c.
  * The script is a fixed Python prelude (the functions that build a scene from
  * plain data tables and set the fair-comparison Cycles settings) followed by
  * the data tables of this scene and a call to main(). Mesh arrays are stored
@@ -14,6 +15,7 @@
 
 #include "core/fileio.h"
 #include "core/log.h"
+#include "exporters/blender_script.h"
 
 /* clang-format off */
 static const char *const PRELUDE[] = {
@@ -46,6 +48,7 @@ static const char *const PRELUDE[] = {
     "    ap.add_argument(\"--width\", type=int, default=SETTINGS[\"width\"])",
     "    ap.add_argument(\"--height\", type=int, default=SETTINGS[\"height\"])",
     "    ap.add_argument(\"--max-bounces\", type=int, default=SETTINGS[\"max_depth\"])",
+    "    ap.add_argument(\"--inventory\", default=None, help=\"JSON file: what Blender's glTF importer created\")",
     "    a = ap.parse_args(argv)",
     "    if a.spp < 1 or a.threads < 1 or a.width < 1 or a.height < 1 or a.max_bounces < 0:",
     "        ap.error(\"--spp, --threads, --width, --height must be >= 1 and --max-bounces >= 0\")",
@@ -207,6 +210,120 @@ static const char *const PRELUDE[] = {
     "    nt.links.new(mul.outputs[0], socket)",
     "",
     "",
+    "def math_node(nt, op, a, b=None, c=None):",
+    "    \"\"\"Math node op(a, b, c); each input a constant or a socket. No clamping.\"\"\"",
+    "    node = nt.nodes.new(\"ShaderNodeMath\")",
+    "    node.operation = op",
+    "    node.use_clamp = False",
+    "    for i, v in enumerate((a, b, c)):",
+    "        if v is None:",
+    "            continue",
+    "        if isinstance(v, (int, float)):",
+    "            node.inputs[i].default_value = float(v)",
+    "        else:",
+    "            nt.links.new(v, node.inputs[i])",
+    "    return node.outputs[0]",
+    "",
+    "",
+    "def rgb_socket(nt, v):",
+    "    \"\"\"A colour socket for a constant (r, g, b), a scalar constant or a socket.\"\"\"",
+    "    if isinstance(v, (int, float)):",
+    "        v = (float(v),) * 3",
+    "    if isinstance(v, tuple):",
+    "        const = nt.nodes.new(\"ShaderNodeRGB\")",
+    "        const.outputs[0].default_value = (*v, 1.0)",
+    "        return const.outputs[0]",
+    "    return v",
+    "",
+    "",
+    "def mix_rgb(nt, blend, fac, a, b):",
+    "    \"\"\"MixRGB blend (MIX: (1-fac) a + fac b; MULTIPLY with fac 1: a b), no clamp.\"\"\"",
+    "    node = nt.nodes.new(\"ShaderNodeMixRGB\")",
+    "    node.blend_type = blend",
+    "    node.use_clamp = False",
+    "    if isinstance(fac, (int, float)):",
+    "        node.inputs[\"Fac\"].default_value = float(fac)",
+    "    else:",
+    "        nt.links.new(fac, node.inputs[\"Fac\"])",
+    "    nt.links.new(rgb_socket(nt, a), node.inputs[\"Color1\"])",
+    "    nt.links.new(rgb_socket(nt, b), node.inputs[\"Color2\"])",
+    "    return node.outputs[\"Color\"]",
+    "",
+    "",
+    "def link_or_set(nt, socket, v):",
+    "    if isinstance(v, (int, float)):",
+    "        socket.default_value = float(v)",
+    "    elif isinstance(v, tuple):",
+    "        socket.default_value = (*v, 1.0)",
+    "    else:",
+    "        nt.links.new(v, socket)",
+    "",
+    "",
+    "def add_shaders(nt, shaders):",
+    "    shader = shaders[0]",
+    "    for s in shaders[1:]:",
+    "        add = nt.nodes.new(\"ShaderNodeAddShader\")",
+    "        nt.links.new(shader, add.inputs[0])",
+    "        nt.links.new(s, add.inputs[1])",
+    "        shader = add.outputs[0]",
+    "    return shader",
+    "",
+    "",
+    "def gltf_nodes(nt, m, vc):",
+    "    \"\"\"glTF metallic-roughness as iris renders it (docs/materials.md), from",
+    "    Cycles closures: Diffuse (roughness 0) x (1-m)(1-T)(1 - w max Fr) + Glossy",
+    "    GGX x [w (1-m) Fr + m F_m] + Refraction GGX x (1-m) T (1 - w max Fr) base.",
+    "    The Schlick terms are built at N.V (Layer Weight Facing = 1 - |N.I|, to the",
+    "    5th power): exact for mirrors (and for every Lambert), where glTF's V.H is",
+    "    N.V; for rough lobes the residual is measured (docs/export.md).\"\"\"",
+    "    base = color_socket(nt, m[\"color\"], m[\"color_tex\"], vc)",
+    "    if base is None:",
+    "        base = tuple(m[\"color\"])",
+    "    metal = rough = None",
+    "    if m[\"mr_tex\"] >= 0:",
+    "        sep = nt.nodes.new(\"ShaderNodeSeparateColor\")",
+    "        nt.links.new(texture_node(nt, m[\"mr_tex\"], \"Non-Color\").outputs[\"Color\"], sep.inputs[0])",
+    "        metal = math_node(nt, \"MULTIPLY\", sep.outputs[\"Blue\"], m[\"metallic\"])",
+    "        rough = math_node(nt, \"MULTIPLY\", sep.outputs[\"Green\"], m[\"roughness\"])",
+    "    if metal is None:",
+    "        metal = m[\"metallic\"]",
+    "    if rough is None:",
+    "        rough = m[\"roughness\"]",
+    "    w, T, f0, ior = m[\"specular\"], m[\"transmission\"], m[\"f0\"], m[\"ior\"]",
+    "    f0max = max(f0)",
+    "    lw = nt.nodes.new(\"ShaderNodeLayerWeight\")",
+    "    lw.inputs[\"Blend\"].default_value = 0.5",
+    "    s = math_node(nt, \"POWER\", lw.outputs[\"Facing\"], 5.0)  # (1 - N.V)^5",
+    "    fr_max = math_node(nt, \"MULTIPLY_ADD\", s, 1.0 - f0max, f0max)",
+    "    base_w = math_node(nt, \"MAXIMUM\", math_node(nt, \"MULTIPLY_ADD\", fr_max, -w, 1.0), 0.0)",
+    "    one_minus_m = (1.0 - metal) if isinstance(metal, float) else math_node(nt, \"SUBTRACT\", 1.0, metal)",
+    "    shaders = []",
+    "    if (1.0 - T) > 0.0 and one_minus_m != 0.0:",
+    "        kd = math_node(nt, \"MULTIPLY\", math_node(nt, \"MULTIPLY\", base_w, one_minus_m), 1.0 - T)",
+    "        d = nt.nodes.new(\"ShaderNodeBsdfDiffuse\")",
+    "        d.inputs[\"Roughness\"].default_value = 0.0",
+    "        link_or_set(nt, d.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kd))",
+    "        shaders.append(d.outputs[0])",
+    "    if T > 0.0 and one_minus_m != 0.0:",
+    "        kt = math_node(nt, \"MULTIPLY\", math_node(nt, \"MULTIPLY\", base_w, one_minus_m), T)",
+    "        r = nt.nodes.new(\"ShaderNodeBsdfRefraction\")",
+    "        r.distribution = \"GGX\"",
+    "        link_or_set(nt, r.inputs[\"Roughness\"], rough)",
+    "        r.inputs[\"IOR\"].default_value = ior",
+    "        link_or_set(nt, r.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kt))",
+    "        shaders.append(r.outputs[0])",
+    "    if w > 0.0 or metal != 0.0:",
+    "        fr = mix_rgb(nt, \"MIX\", s, tuple(f0), (1.0, 1.0, 1.0))",
+    "        fm = mix_rgb(nt, \"MIX\", s, base, (1.0, 1.0, 1.0))",
+    "        diel = mix_rgb(nt, \"MULTIPLY\", 1.0, fr, w)",
+    "        g = nt.nodes.new(\"ShaderNodeBsdfGlossy\")",
+    "        g.distribution = \"GGX\"",
+    "        link_or_set(nt, g.inputs[\"Roughness\"], rough)",
+    "        link_or_set(nt, g.inputs[\"Color\"], mix_rgb(nt, \"MIX\", metal, diel, fm))",
+    "        shaders.append(g.outputs[0])",
+    "    return add_shaders(nt, shaders)",
+    "",
+    "",
     "def build_material(m):",
     "    mat = bpy.data.materials.new(text(m[\"name\"]))",
     "    mat.use_nodes = True",
@@ -229,7 +346,7 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"Roughness\"].default_value = m[\"roughness\"]",
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
-    "    else:",
+    "    elif m[\"principled\"]:",
     "        bsdf = nt.nodes.new(\"ShaderNodeBsdfPrincipled\")",
     "        bsdf.distribution = \"GGX\"",
     "        set_color(nt, bsdf.inputs[\"Base Color\"], m[\"color\"], m[\"color_tex\"], vc)",
@@ -245,7 +362,11 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        bsdf.inputs[\"Transmission\"].default_value = m[\"transmission\"]",
     "        bsdf.inputs[\"Transmission Roughness\"].default_value = 0.0",
-    "    shader = bsdf.outputs[0]",
+    "    else:",
+    "        bsdf = None",
+    "        shader = gltf_nodes(nt, m, vc)",
+    "    if bsdf is not None:",
+    "        shader = bsdf.outputs[0]",
     "    if max(m[\"emission\"]) > 0.0:",
     "        em = nt.nodes.new(\"ShaderNodeEmission\")",
     "        em.inputs[\"Strength\"].default_value = 1.0",
@@ -343,15 +464,16 @@ static const char *const PRELUDE[] = {
     "    sc.camera = obj",
     "",
     "",
-    "def build_world(sc):",
+    "def build_world(sc, env):",
+    "    \"\"\"World from the environment: None (black) or a constant radiance.\"\"\"",
     "    world = bpy.data.worlds.new(\"World\")",
     "    world.use_nodes = True",
     "    bg = world.node_tree.nodes[\"Background\"]",
-    "    if WORLD is None:",
+    "    if env is None:",
     "        bg.inputs[\"Color\"].default_value = (0.0, 0.0, 0.0, 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 0.0",
     "    else:",
-    "        bg.inputs[\"Color\"].default_value = (*WORLD, 1.0)",
+    "        bg.inputs[\"Color\"].default_value = (*env, 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 1.0",
     "    sc.world = world",
     "",
@@ -416,7 +538,7 @@ static const char *const PRELUDE[] = {
     "    t0 = time.perf_counter()",
     "    bpy.ops.wm.read_factory_settings(use_empty=True)",
     "    sc = bpy.context.scene",
-    "    build_world(sc)",
+    "    build_world(sc, WORLD)",
     "    global MATERIAL_BLOCKS",
     "    MATERIAL_BLOCKS = [build_material(m) for m in MATERIALS]",
     "    t_data = time.perf_counter()",
@@ -446,6 +568,13 @@ static const char *const PRELUDE[] = {
 };
 /* clang-format on */
 
+void iris_blender_put_prelude(FILE *fp) {
+  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
+    fputs(PRELUDE[i], fp);
+    fputc('\n', fp);
+  }
+}
+
 /* ---- small writers --------------------------------------------------------- */
 
 /* Python float literal: shortest round-trip form of a finite float. */
@@ -458,7 +587,7 @@ static void put_float(FILE *fp, float v) {
   fputs(buf, fp);
 }
 
-static void put_vec3(FILE *fp, const float *v) {
+void iris_blender_put_vec3(FILE *fp, const float *v) {
   fputc('(', fp);
   for (int i = 0; i < 3; i++) {
     if (i) fputs(", ", fp);
@@ -469,7 +598,7 @@ static void put_vec3(FILE *fp, const float *v) {
 
 /* A Python bytes literal holding the exact bytes of s (NULL -> b""). Names are
  * decoded with errors="replace" by the prelude's text(); paths with os.fsdecode. */
-static void put_bytes(FILE *fp, const char *s) {
+void iris_blender_put_bytes(FILE *fp, const char *s) {
   fputs("b\"", fp);
   for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; p++) {
     if (*p == '"' || *p == '\\')
@@ -655,13 +784,13 @@ static float principled_specular(const iris_material *m) {
   return f0 / 0.08f * m->specular * col;
 }
 
-static void put_material(FILE *fp, const iris_scene *scene, material_variant v) {
+static void put_material(FILE *fp, const iris_scene *scene, material_variant v, bool principled) {
   iris_material def = iris_material_default(IRIS_MATERIAL_DIFFUSE);
   const iris_material *m = v.material >= 0 ? &scene->materials[v.material] : &def;
   fputs("    dict(name=", fp);
-  put_bytes(fp, v.material >= 0 ? (m->name ? m->name : "material") : "iris-default");
+  iris_blender_put_bytes(fp, v.material >= 0 ? (m->name ? m->name : "material") : "iris-default");
   fprintf(fp, ", type=\"%s\", color=", material_type_name(m->type));
-  put_vec3(fp, m->color);
+  iris_blender_put_vec3(fp, m->color);
   fprintf(fp, ", color_tex=%d, roughness=", (int)m->color_texture);
   put_float(fp, m->roughness);
   fputs(", ior=", fp);
@@ -672,8 +801,16 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v) 
   put_float(fp, principled_specular(m));
   fputs(", transmission=", fp);
   put_float(fp, m->transmission);
+  /* glTF dielectric F0 per channel, as renderer/bsdf.c: min(((ior-1)/(ior+1))^2 s, 1). */
+  float f0 = iris_sqr((m->ior - 1.0f) / (m->ior + 1.0f)), f0c[3];
+  for (int k = 0; k < 3; k++) f0c[k] = fminf(f0 * m->specular_color[k], 1.0f);
+  fputs(", specular=", fp);
+  put_float(fp, m->specular);
+  fputs(", f0=", fp);
+  iris_blender_put_vec3(fp, f0c);
+  fprintf(fp, ", principled=%s", principled ? "True" : "False");
   fputs(", emission=", fp);
-  put_vec3(fp, m->emission);
+  iris_blender_put_vec3(fp, m->emission);
   fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s),\n",
           (int)m->emission_texture, m->emission_two_sided ? "True" : "False",
           v.vertex_colors ? "True" : "False");
@@ -686,7 +823,7 @@ static void put_texture(FILE *fp, const iris_scene *scene, size_t index, const c
   char path[2048];
   iris_export_texture_file(scene, index, script_path, false, path, sizeof path);
   fputs("    dict(path=", fp);
-  put_bytes(fp, path);
+  iris_blender_put_bytes(fp, path);
   fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s),\n", wrap_name(t->wrap_s),
           wrap_name(t->wrap_t), t->nearest ? "True" : "False");
 }
@@ -707,15 +844,15 @@ static void put_light(FILE *fp, const iris_light *l, size_t index) {
     iris_warnf("light '%s': range %g ignored (Cycles lights have no range)", l->name ? l->name : name,
                (double)l->range);
   fputs("    dict(name=", fp);
-  put_bytes(fp, l->name ? l->name : name);
+  iris_blender_put_bytes(fp, l->name ? l->name : name);
   fprintf(fp, ", type=\"%s\", color=", TYPES[l->type <= IRIS_LIGHT_DIRECTIONAL ? l->type : 0]);
-  put_vec3(fp, l->color);
+  iris_blender_put_vec3(fp, l->color);
   fputs(", strength=", fp);
   put_float(fp, strength);
   fputs(", position=", fp);
-  put_vec3(fp, l->position);
+  iris_blender_put_vec3(fp, l->position);
   fputs(", direction=", fp);
-  put_vec3(fp, l->direction);
+  iris_blender_put_vec3(fp, l->direction);
   fputs(", cos_inner=", fp);
   put_float(fp, cosf(inner));
   fputs(", cos_outer=", fp);
@@ -723,7 +860,7 @@ static void put_light(FILE *fp, const iris_light *l, size_t index) {
   fputs("),\n", fp);
 }
 
-static void put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view) {
+void iris_blender_put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view) {
   /* Cycles starts camera rays at clip_start: keep it far below any feature
    * size. clip_end must reach past everything. */
   iris_vec3 lo, hi, eye = iris_v3(view->to_world.m[0][3], view->to_world.m[1][3], view->to_world.m[2][3]);
@@ -734,7 +871,7 @@ static void put_camera(FILE *fp, const iris_scene *scene, const iris_export_view
     far = iris_length(iris_sub(c, eye)) + diag;
   }
   fputs("CAMERA = dict(name=", fp);
-  put_bytes(fp, view->camera >= 0 && scene->cameras[view->camera].name ? scene->cameras[view->camera].name
+  iris_blender_put_bytes(fp, view->camera >= 0 && scene->cameras[view->camera].name ? scene->cameras[view->camera].name
                                                                        : "camera");
   fputs(", yfov=", fp);
   put_float(fp, view->yfov);
@@ -778,23 +915,20 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fprintf(fp,
           "# Blender 3.4 scene written by iris %s from ",
           IRIS_VERSION_STRING);
-  put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
+  iris_blender_put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
   fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
         "# fair-comparison settings of iris's docs/export.md. Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
         "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n",
         fp);
-  for (size_t i = 0; i < sizeof PRELUDE / sizeof PRELUDE[0]; i++) {
-    fputs(PRELUDE[i], fp);
-    fputc('\n', fp);
-  }
+  iris_blender_put_prelude(fp);
 
   fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
   fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view->width,
           view->height, view->spp, view->max_depth, (unsigned long long)(view->seed & 0x7fffffffu));
   if (scene->has_environment) {
     fputs("WORLD = ", fp);
-    put_vec3(fp, scene->environment);
+    iris_blender_put_vec3(fp, scene->environment);
     fputc('\n', fp);
   } else {
     fputs("WORLD = None\n", fp);
@@ -803,14 +937,14 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("TEXTURES = [\n", fp);
   for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, scene, i, script_path);
   fputs("]\nMATERIALS = [\n", fp);
-  for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i]);
+  for (size_t i = 0; i < variant_count; i++) put_material(fp, scene, variants[i], params->gltf_principled);
   fputs("]\nMESHES = [\n", fp);
   for (size_t i = 0; i < scene->mesh_count; i++) {
     const iris_mesh *m = &scene->meshes[i];
     char name[32];
     snprintf(name, sizeof name, "mesh.%zu", i);
     fputs("    dict(name=", fp);
-    put_bytes(fp, m->name ? m->name : name);
+    iris_blender_put_bytes(fp, m->name ? m->name : name);
     fprintf(fp,
             ", nv=%u, nt=%u, pos=%lld, nrm=%lld, uv=%lld, col=%lld, idx=%lld, material=%d, "
             "validate=%s),\n",
@@ -827,7 +961,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("]\nLIGHTS = [\n", fp);
   for (size_t i = 0; i < scene->light_count; i++) put_light(fp, &scene->lights[i], i);
   fputs("]\n", fp);
-  put_camera(fp, scene, view);
+  iris_blender_put_camera(fp, scene, view);
 
   fprintf(fp, "BLOB_SIZE = %llu\n", (unsigned long long)blob_size);
   if (params->embed_meshes) {
@@ -837,7 +971,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
     fputs("\"\n", fp);
   } else {
     fputs("SIDECAR = ", fp);
-    put_bytes(fp, sidecar_name);
+    iris_blender_put_bytes(fp, sidecar_name);
     fputs("\nBLOB = None\n", fp);
   }
   fputs("\nmain()\n", fp);

@@ -21,6 +21,17 @@ extern "C" {
 iris_status iris_export_blender(const iris_scene *scene, const char *script_path,
                                 const iris_export_params *params, iris_error *err);
 
+/* Writes a script that imports `import_path` (a .gltf/.glb) with Blender's own
+ * glTF importer instead of building iris's scene, then sets the world
+ * (scene->environment), the camera (resolved from params exactly as
+ * iris_export_blender, rotated into Blender's Z-up axes as the importer rotates
+ * the geometry) and the same fair-comparison settings. Extra script flag
+ * `--inventory FILE.json`: what the importer created (materials, cameras,
+ * lights, units, triangle count, bounds in glTF axes). */
+iris_status iris_export_blender_import(const iris_scene *scene, const char *import_path,
+                                       const char *script_path, const iris_export_params *params,
+                                       iris_error *err);
+
 /* Path of the sidecar mesh file for a script path ("a/scene.py" -> "a/scene.meshes.bin"). */
 void iris_blender_sidecar_path(const char *script_path, char *out, size_t size);
 

@@ -15,6 +15,7 @@ iris_export_params iris_export_params_default(void) {
   iris_export_params p;
   memset(&p, 0, sizeof p);
   p.max_depth = -1;
+  p.pov_radiosity = IRIS_POV_RADIOSITY_MEDIUM;
   return p;
 }
 

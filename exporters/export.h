@@ -15,6 +15,14 @@
 extern "C" {
 #endif
 
+/* POV-Ray radiosity (indirect light) quality; OFF renders direct light only. */
+typedef enum iris_pov_radiosity {
+  IRIS_POV_RADIOSITY_OFF = 0,
+  IRIS_POV_RADIOSITY_LOW,
+  IRIS_POV_RADIOSITY_MEDIUM, /* the default */
+  IRIS_POV_RADIOSITY_HIGH
+} iris_pov_radiosity;
+
 typedef struct iris_export_params {
   const char *camera_name; /* NULL: the scene's first camera (or a framing camera if none) */
   int width, height;       /* <= 0: scene render settings, else IRIS_EXPORT_DEFAULT_HEIGHT high\n                              and as wide as the camera aspect (as `iris render`) */
@@ -24,6 +32,10 @@ typedef struct iris_export_params {
   bool has_seed;           /* false: scene render settings, then 0 */
   bool embed_meshes;       /* blender: mesh data inside the script instead of a sidecar file */
   bool coverage;           /* pov: every object pure white emitter, black background, no lights */
+  iris_pov_radiosity pov_radiosity; /* pov: indirect light (default MEDIUM; OFF in coverage mode) */
+  bool gltf_principled;    /* blender: gltf materials as a Principled BSDF (the old, approximate
+                              mapping; kept for the measurement in docs/export.md) instead of
+                              the Appendix B node tree */
 } iris_export_params;
 
 #define IRIS_EXPORT_DEFAULT_HEIGHT IRIS_FRAMING_DEFAULT_HEIGHT

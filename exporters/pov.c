@@ -316,10 +316,10 @@ static void put_light(FILE *fp, const iris_light *l, fade f, float far) {
   put_point_light(fp, p, c, f, NULL);
 }
 
-/* An emissive mesh instance becomes a light at its area-weighted centre:
- * an area light over its bounding rectangle when it is planar, else a point
- * light, of intensity L * A / 2 (the mean of L A cos over the hemisphere it
- * faces). The emissive object itself casts no shadow. */
+/* An emissive mesh instance becomes a light at its area-weighted centre: when
+ * it is planar, an area spotlight over its bounding rectangle with a cosine
+ * falloff per emitting side (below), else an isotropic point light of
+ * intensity L * A / 2. The emissive object itself casts no shadow. */
 static void put_emitter_light(FILE *fp, const iris_scene *scene, const iris_instance *inst, fade f) {
   const iris_mesh *m = &scene->meshes[inst->mesh];
   const iris_material *mat = &scene->materials[m->material];
@@ -366,11 +366,21 @@ static void put_emitter_light(FILE *fp, const iris_scene *scene, const iris_inst
   }
   iris_vec3 mid = iris_add(centre, iris_add(iris_scale(u, 0.5f * (lo_u + hi_u)), iris_scale(w, 0.5f * (lo_w + hi_w))));
   iris_vec3 au = iris_scale(u, hi_u - lo_u), aw = iris_scale(w, hi_w - lo_w);
-  char extra[512];
-  snprintf(extra, sizeof extra,
-           " area_light <%.9g,%.9g,%.9g>, <%.9g,%.9g,%.9g>, 5, 5 adaptive 1 area_illumination on",
-           (double)au.x, (double)au.y, (double)au.z, (double)aw.x, (double)aw.y, (double)aw.z);
-  put_point_light(fp, mid, c, f, extra);
+  /* A planar Lambertian emitter of radiance L and area A has radiant intensity
+   * L A cos(theta) on the side(s) it emits from: a spotlight along the normal
+   * with POV-Ray's cos^tightness falloff (tightness 1, radius = falloff = 90
+   * degrees: no cone edge), spread over the rectangle as an area light. */
+  for (int side = 0; side < (mat->emission_two_sided ? 2 : 1); side++) {
+    iris_vec3 at = iris_add(mid, side ? iris_scale(n, -1.0f) : n);
+    char extra[640];
+    snprintf(extra, sizeof extra,
+             " spotlight point_at <%.9g,%.9g,%.9g> radius 90 falloff 90 tightness 1"
+             " area_light <%.9g,%.9g,%.9g>, <%.9g,%.9g,%.9g>, 5, 5 adaptive 1 area_illumination on",
+             (double)at.x, (double)at.y, (double)at.z, (double)au.x, (double)au.y, (double)au.z,
+             (double)aw.x, (double)aw.y, (double)aw.z);
+    float cs[3] = {2.0f * c[0], 2.0f * c[1], 2.0f * c[2]}; /* L A on the axis */
+    put_point_light(fp, mid, cs, f, extra);
+  }
 }
 
 /* ---- the scene ------------------------------------------------------------- */
@@ -387,9 +397,34 @@ static void put_camera(FILE *fp, const iris_export_view *view) {
   fputs("\n}\n", fp);
 }
 
+/* POV-Ray 3.7 radiosity: diffuse interreflection gathered by hemisphere
+ * sampling and cached (docs/export.md). Its indirect term is the mean radiance
+ * over the cosine-weighted hemisphere, i.e. E/pi, times pigment x diffuse: the
+ * Lambert radiance, so `brightness 1` is the physical setting and
+ * `gray_threshold 0` keeps colour bleeding. recursion_limit is how many
+ * diffuse bounces are gathered (capped by --max-depth). */
+static void put_radiosity(FILE *fp, iris_pov_radiosity q, int max_depth) {
+  static const struct {
+    int count, nearest, recursion;
+    double error_bound, pretrace_end, minimum_reuse;
+  } LEVELS[] = {{0, 0, 0, 0, 0, 0},
+                {60, 5, 3, 1.0, 0.04, 0.015},
+                {300, 10, 6, 0.5, 0.01, 0.01},
+                {1000, 20, 10, 0.25, 0.005, 0.005}};
+  int rec = LEVELS[q].recursion < max_depth ? LEVELS[q].recursion : max_depth;
+  fprintf(fp,
+          "  radiosity { pretrace_start 0.08 pretrace_end %g count %d nearest_count %d error_bound %g\n"
+          "              recursion_limit %d low_error_factor 0.5 gray_threshold 0 minimum_reuse %g\n"
+          "              brightness 1 adc_bailout 0.005 normal on media off always_sample off }\n",
+          LEVELS[q].pretrace_end, LEVELS[q].count, LEVELS[q].nearest, LEVELS[q].error_bound, rec,
+          LEVELS[q].minimum_reuse);
+}
+
 static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_path,
                              const iris_export_params *params, const iris_export_view *view) {
   bool coverage = params->coverage;
+  bool radiosity = !coverage && params->pov_radiosity != IRIS_POV_RADIOSITY_OFF && view->max_depth > 0 &&
+                   params->pov_radiosity <= IRIS_POV_RADIOSITY_HIGH;
   iris_vec3 lo = iris_v3(-1, -1, -1), hi = iris_v3(1, 1, 1);
   iris_scene_bounds(scene, &lo, &hi);
   float diag = fmaxf(iris_length(iris_sub(hi, lo)), 1e-6f);
@@ -403,9 +438,11 @@ static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_
           "%s\n// Render: povray +I<this> +O<out>.png +FN +W%d +H%d -D -V\n"
           "// Approximations of iris's materials and lights: docs/export.md.\n"
           "#version 3.7;\n"
-          "global_settings { assumed_gamma 1.0 charset utf8 ambient_light rgb 0 max_trace_level %d }\n",
+          "global_settings { assumed_gamma 1.0 charset utf8 ambient_light rgb 0 max_trace_level %d\n",
           coverage ? " (coverage mode: every object white on black)" : "", view->width, view->height,
           view->max_depth + 1 < 1 ? 1 : (view->max_depth + 1 > 256 ? 256 : view->max_depth + 1));
+  if (radiosity) put_radiosity(fp, params->pov_radiosity, view->max_depth);
+  fputs("}\n", fp);
   if (scene->has_environment && !coverage) {
     fputs("background { ", fp);
     put_rgb(fp, scene->environment, 1.0f);
@@ -433,6 +470,9 @@ static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_
       fputs(" }", fp);
     }
     if (!coverage && emits(mat)) fputs("\n  no_shadow", fp);
+    /* An emitter already lights the scene through its light source (below);
+     * radiosity rays must not gather its emission a second time. */
+    if (radiosity && emits(mat)) fputs(" no_radiosity", fp);
     fputs("\n}\n", fp);
   }
 

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/fileio.h"
+#include "scene/material_class.h"
 
 iris_import_options iris_import_options_default(void) {
   iris_import_options o;
@@ -43,6 +44,9 @@ iris_status iris_import_file(const char *path, const iris_import_options *opts, 
   /* Every importer validates its result; checking again here costs one pass
    * and guarantees the renderer's invariants whatever the importer. */
   if (!(*out)->source_path) (*out)->source_path = iris_strdup(path);
+  /* A glTF material that is exactly a Lambert becomes `diffuse` (docs/import-gltf.md). */
+  if (!opts->keep_materials)
+    for (size_t i = 0; i < (*out)->material_count; i++) iris_material_canonicalize(&(*out)->materials[i]);
   st = iris_scene_validate(*out, path, err);
   if (st != IRIS_OK) {
     iris_scene_destroy(*out);

@@ -41,6 +41,8 @@ static void print_help(void) {
          "                       pov: max_trace_level B+1\n"
          "      --embed          blender: put the mesh data inside the script\n"
          "      --pov-coverage   pov: every object a pure white emitter on black, no lights\n"
+         "      --pov-radiosity Q  pov: indirect light by POV-Ray radiosity, Q = off, low,\n"
+         "                       medium (default) or high\n"
          "  -q, --quiet          no warnings or summary\n"
          "  -h, --help           show this help\n"
          "\n"
@@ -49,7 +51,7 @@ static void print_help(void) {
 }
 
 int iris_cmd_export(int argc, char **argv) {
-  enum { OPT_TO = 256, OPT_CAMERA, OPT_WIDTH, OPT_HEIGHT, OPT_SPP, OPT_SEED, OPT_DEPTH, OPT_EMBED, OPT_COVERAGE };
+  enum { OPT_TO = 256, OPT_CAMERA, OPT_WIDTH, OPT_HEIGHT, OPT_SPP, OPT_SEED, OPT_DEPTH, OPT_EMBED, OPT_COVERAGE, OPT_RADIOSITY };
   static const struct option longopts[] = {{"to", required_argument, NULL, OPT_TO},
                                            {"output", required_argument, NULL, 'o'},
                                            {"camera", required_argument, NULL, OPT_CAMERA},
@@ -60,11 +62,12 @@ int iris_cmd_export(int argc, char **argv) {
                                            {"max-depth", required_argument, NULL, OPT_DEPTH},
                                            {"embed", no_argument, NULL, OPT_EMBED},
                                            {"pov-coverage", no_argument, NULL, OPT_COVERAGE},
+                                           {"pov-radiosity", required_argument, NULL, OPT_RADIOSITY},
                                            {"quiet", no_argument, NULL, 'q'},
                                            {"help", no_argument, NULL, 'h'},
                                            {NULL, 0, NULL, 0}};
   iris_export_params params = iris_export_params_default();
-  const char *to = NULL, *output = NULL;
+  const char *to = NULL, *output = NULL, *radiosity = NULL;
   bool quiet = false;
   long v;
   opterr = 0;
@@ -106,6 +109,16 @@ int iris_cmd_export(int argc, char **argv) {
         break;
       case OPT_EMBED: params.embed_meshes = true; break;
       case OPT_COVERAGE: params.coverage = true; break;
+      case OPT_RADIOSITY: {
+        static const char *const LEVELS[] = {"off", "low", "medium", "high"};
+        if (!iris_cli_set_once(CMD, "--pov-radiosity", &radiosity, optarg)) return IRIS_EXIT_USAGE;
+        int k = 0;
+        while (k < 4 && strcmp(optarg, LEVELS[k]) != 0) k++;
+        if (k == 4)
+          return iris_cli_usage_error(CMD, "unknown --pov-radiosity '%s' (off, low, medium or high)", optarg);
+        params.pov_radiosity = (iris_pov_radiosity)k;
+        break;
+      }
       case 'q': quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
       default: return iris_cli_getopt_error(CMD, c, argv);
@@ -129,6 +142,9 @@ int iris_cmd_export(int argc, char **argv) {
   if (!blender && strcmp(ext, "pov") != 0)
     return iris_cli_usage_error(CMD, "POV-Ray output '%s' must end in .pov", output);
   if (blender && params.coverage) return iris_cli_usage_error(CMD, "--pov-coverage needs --to pov");
+  if (blender && radiosity) return iris_cli_usage_error(CMD, "--pov-radiosity needs --to pov");
+  if (params.coverage && radiosity && params.pov_radiosity != IRIS_POV_RADIOSITY_OFF)
+    return iris_cli_usage_error(CMD, "--pov-coverage and --pov-radiosity conflict (coverage has no light)");
   if (!blender && params.embed_meshes) return iris_cli_usage_error(CMD, "--embed needs --to blender");
   if (!blender && (params.spp > 0 || params.has_seed))
     return iris_cli_usage_error(CMD, "--spp and --seed apply to --to blender only");

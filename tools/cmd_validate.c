@@ -30,6 +30,9 @@ static void print_help(void) {
       "Reference (one of; default for cornell-box, veach-mis and door: the stored one):\n"
       "      --reference REF.exr   a Cycles (or other) EXR; iris renders at its size\n"
       "      --blender             export the scene, run Blender here (--blender-spp)\n"
+      "      --blender-import[=FILE]  run Blender here on FILE (default: INPUT, a .gltf/.glb)\n"
+      "                            imported by Blender's own glTF importer, under iris's\n"
+      "                            camera and world; reports where the importers disagree\n"
       "      --blender-spp N       Cycles samples per pixel (default %d; --refresh: per scene)\n"
       "Rendering:\n"
       "      --method M            bsdf | nee | mis | guided | guided-nee; repeat or give a\n"
@@ -103,13 +106,14 @@ int iris_cmd_validate(int argc, char **argv) {
   enum {
     OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
     OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
-    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER
+    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER, OPT_BLENDER_IMPORT
   };
   static const struct option longopts[] = {
       {"method", required_argument, NULL, OPT_METHOD},
       {"spp", required_argument, NULL, OPT_SPP},
       {"reference", required_argument, NULL, OPT_REFERENCE},
       {"blender", no_argument, NULL, OPT_BLENDER},
+      {"blender-import", optional_argument, NULL, OPT_BLENDER_IMPORT},
       {"tolerance", required_argument, NULL, OPT_TOLERANCE},
       {"blender-spp", required_argument, NULL, OPT_BLENDER_SPP},
       {"threads", required_argument, NULL, OPT_THREADS},
@@ -129,7 +133,8 @@ int iris_cmd_validate(int argc, char **argv) {
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
   iris_validate_params p = iris_validate_params_default();
-  bool blender = false, refresh = false, have_blender_spp = false;
+  bool blender = false, refresh = false, have_blender_spp = false, blender_import = false;
+  bool have_tolerance = false;
   const char *references = NULL;
   long v;
   double d;
@@ -153,9 +158,14 @@ int iris_cmd_validate(int argc, char **argv) {
         if (!iris_cli_set_once(CMD, "--reference", &p.reference_path, optarg)) return IRIS_EXIT_USAGE;
         break;
       case OPT_BLENDER: blender = true; break;
+      case OPT_BLENDER_IMPORT:
+        blender_import = true;
+        p.blender_import = optarg; /* NULL: the input itself */
+        break;
       case OPT_TOLERANCE:
         if (!iris_cli_parse_float(CMD, "--tolerance", optarg, 0.0, 10.0, &d)) return IRIS_EXIT_USAGE;
         p.tolerance = d;
+        have_tolerance = true;
         break;
       case OPT_ALPHA:
         if (!iris_cli_parse_float(CMD, "--alpha", optarg, 1e-12, 0.5, &d)) return IRIS_EXIT_USAGE;
@@ -210,7 +220,7 @@ int iris_cmd_validate(int argc, char **argv) {
   iris_error_clear(&err);
   if (refresh) {
     /* Everything checked before the (long) Blender runs. */
-    if (p.reference_path || blender || p.out_dir || p.method_count || p.width > 0 || p.height > 0)
+    if (p.reference_path || blender || blender_import || p.out_dir || p.method_count || p.width > 0 || p.height > 0)
       return iris_cli_usage_error(CMD, "--refresh takes only scene names, --blender-spp, --threads, "
                                        "--seed, --references and --blender-exe");
     for (int i = optind; i < argc; i++)
@@ -232,6 +242,18 @@ int iris_cmd_validate(int argc, char **argv) {
     return iris_cli_usage_error(CMD, "one input only (got '%s' and '%s')", argv[optind], argv[optind + 1]);
   p.input = argv[optind];
   if (!p.out_dir) return iris_cli_usage_error(CMD, "missing --out DIR");
+  if (blender_import) {
+    if (p.reference_path) return iris_cli_usage_error(CMD, "--reference and --blender-import exclude each other");
+    if (!p.blender_import) p.blender_import = p.input;
+    char ext[16];
+    iris_path_ext(p.blender_import, ext, sizeof ext);
+    if (strcmp(ext, "gltf") != 0 && strcmp(ext, "glb") != 0)
+      return iris_cli_usage_error(CMD, "--blender-import needs a .gltf or .glb file (got '%s')", p.blender_import);
+    if (!iris_path_exists(p.blender_import))
+      return iris_cli_usage_error(CMD, "--blender-import: '%s' does not exist", p.blender_import);
+    blender = true;
+    if (!have_tolerance) p.tolerance = IRIS_VALIDATE_IMPORT_TOLERANCE;
+  }
   if (blender && p.reference_path) return iris_cli_usage_error(CMD, "--reference and --blender exclude each other");
   if (have_blender_spp && !blender) return iris_cli_usage_error(CMD, "--blender-spp needs --blender (or --refresh)");
   if ((p.width > 0) != (p.height > 0)) return iris_cli_usage_error(CMD, "give both --width and --height");
@@ -282,6 +304,14 @@ int iris_cmd_validate(int argc, char **argv) {
         iris_warnf("validate: %s: the energy ratio's standard error (%.2f%%) is not small against "
                    "the tolerance (%.2f%%): the energy check is dominated by noise; raise --spp",
                    iris_method_name(m->method), 100.0 * se, 100.0 * p.tolerance);
+    }
+    if (p.source == IRIS_REFERENCE_BLENDER && !res.blender_import)
+      iris_infof("validate: materials: %s", res.export_note);
+    if (res.blender_import) {
+      const iris_import_diff *d = &res.import_diff;
+      iris_infof("validate: iris's glTF import vs Blender's of %s: %d note(s)%s (%s/importers.txt)",
+                 res.import_file, d->total, d->geometry_differs ? ", the GEOMETRY DIFFERS" : "", p.out_dir);
+      for (int i = 0; i < d->note_count; i++) iris_infof("  %s: %s", d->notes[i].topic, d->notes[i].text);
     }
     iris_infof("validate: report in %s/report.html", p.out_dir);
   }

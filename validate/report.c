@@ -96,6 +96,27 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
   cJSON_AddNumberToObject(r, "inf_count", (double)res->reference.inf_count);
   cJSON_AddBoolToObject(r, "has_variance", res->reference.has_variance);
   iris_json_add_number(r, "seconds", res->reference.seconds);
+  if (params->source == IRIS_REFERENCE_BLENDER && !res->blender_import) {
+    cJSON_AddBoolToObject(r, "export_exact", res->export_exact);
+    cJSON_AddStringToObject(r, "export_note", res->export_note);
+    iris_json_add_number(r, "export_expected_residual", res->export_residual);
+  }
+  if (res->blender_import) {
+    cJSON *bi = cJSON_AddObjectToObject(o, "blender_import");
+    const iris_import_diff *d = &res->import_diff;
+    cJSON_AddStringToObject(bi, "file", res->import_file);
+    cJSON_AddBoolToObject(bi, "geometry_differs", d->geometry_differs);
+    cJSON_AddNumberToObject(bi, "iris_triangles", (double)d->iris_triangles);
+    cJSON_AddNumberToObject(bi, "blender_triangles", (double)d->blender_triangles);
+    cJSON_AddNumberToObject(bi, "note_count", d->total);
+    cJSON *notes = cJSON_AddArrayToObject(bi, "notes");
+    for (int i = 0; i < d->note_count; i++) {
+      cJSON *n = cJSON_CreateObject();
+      cJSON_AddStringToObject(n, "topic", d->notes[i].topic);
+      cJSON_AddStringToObject(n, "text", d->notes[i].text);
+      cJSON_AddItemToArray(notes, n);
+    }
+  }
   cJSON *ms = cJSON_AddArrayToObject(o, "methods");
   for (int k = 0; k < res->method_count; k++) {
     const iris_validate_method *m = &res->methods[k];
@@ -223,6 +244,25 @@ iris_status iris_report_write_html(const char *dir, const iris_validate_params *
   fprintf(fp, "</code>), mean RGB %.6g %.6g %.6g, %llu NaN, %llu Inf.</p>\n", res->reference.mean[0],
           res->reference.mean[1], res->reference.mean[2], (unsigned long long)res->reference.nan_count,
           (unsigned long long)res->reference.inf_count);
+  if (params->source == IRIS_REFERENCE_BLENDER && !res->blender_import) {
+    fprintf(fp, "<p>Materials: ");
+    html_escape(fp, res->export_note);
+    fprintf(fp, ".</p>\n");
+  }
+  if (res->blender_import) {
+    const iris_import_diff *d = &res->import_diff;
+    fprintf(fp, "<h2>iris's glTF import vs Blender's</h2><p>");
+    html_escape(fp, res->import_file);
+    fprintf(fp, ": %d note(s)%s. Blender's importer renders Principled BSDFs, so the block z-test is "
+                "reported, not gating (docs/validation.md).</p>\n<table><tr><th>topic</th><th>note</th></tr>\n",
+            d->total, d->geometry_differs ? ", <b>the geometry differs</b> (the run fails)" : "");
+    for (int i = 0; i < d->note_count; i++) {
+      fprintf(fp, "<tr><td class=l>%s</td><td class=l>", d->notes[i].topic);
+      html_escape(fp, d->notes[i].text);
+      fprintf(fp, "</td></tr>\n");
+    }
+    fprintf(fp, "</table>\n");
+  }
 
   fprintf(fp, "<h2>Summary</h2><table><tr><th>method</th><th>spp</th><th>seconds</th>"
               "<th>ratio R</th><th>ratio G</th><th>ratio B</th><th>energy ratio</th><th>energy</th>"

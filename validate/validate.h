@@ -14,6 +14,7 @@
 #include "core/image.h"
 #include "renderer/integrator.h"
 #include "scene/scene.h"
+#include "validate/import_compare.h"
 #include "validate/metrics.h"
 
 #ifdef __cplusplus
@@ -23,6 +24,9 @@ extern "C" {
 #define IRIS_VALIDATE_DEFAULT_SPP 64
 #define IRIS_VALIDATE_DEFAULT_TOLERANCE 0.01
 #define IRIS_VALIDATE_DEFAULT_BLENDER_SPP 1024
+/* --blender-import: default energy tolerance, the measured residual of Blender's
+ * Principled BSDFs against iris's glTF BRDF on the sample models (docs/validation.md). */
+#define IRIS_VALIDATE_IMPORT_TOLERANCE 0.05
 /* Cycles runs split into independent batches to estimate the reference's
  * per-pixel variance (validate.c, render_cycles). */
 #define IRIS_VALIDATE_BLENDER_BATCHES 8
@@ -55,6 +59,8 @@ typedef struct iris_validate_params {
   const char *reference_path; /* IRIS_REFERENCE_FILE */
   int blender_spp;          /* IRIS_REFERENCE_BLENDER (0: default) */
   const char *blender;      /* executable (NULL: $IRIS_BLENDER, else "blender") */
+  const char *blender_import; /* IRIS_REFERENCE_BLENDER: a .gltf/.glb that Blender imports with its
+                               own importer instead of iris's export (NULL: the export) */
   double tolerance;         /* allowed |energy ratio - 1| per channel and overall */
   double alpha;             /* family-wise significance of the z-tests */
   bool pixel_test_gates;    /* the per-pixel z-test fails the run too (default: reported only;
@@ -104,6 +110,13 @@ typedef struct iris_validate_result {
   iris_validate_reference reference;
   iris_validate_method methods[IRIS_METHOD_COUNT];
   int method_count;
+  bool export_exact;        /* IRIS_REFERENCE_BLENDER via the export: every material is one Cycles
+                               reproduces exactly (diffuse, glossy, glass, smooth or Lambert gltf) */
+  double export_residual;   /* largest expected |iris / Cycles - 1| of a material's furnace mean */
+  char export_note[360];    /* otherwise which materials are approximate and the expected residual */
+  bool blender_import;      /* the reference came from Blender's own glTF importer */
+  char import_file[1024];
+  iris_import_diff import_diff; /* where the two importers disagree (geometry fails the run) */
   bool passed;
 } iris_validate_result;
 
