@@ -4,6 +4,7 @@
  * the data tables of this scene and a call to main(). Mesh arrays are stored
  * once, little-endian, in a sidecar file (or a base64 blob in the script) and
  * read with numpy + foreach_set, the fast path for large meshes. */
+#define _DEFAULT_SOURCE /* realpath */
 #include "exporters/blender.h"
 
 #include <errno.h>
@@ -350,8 +351,27 @@ static const char *const PRELUDE[] = {
     "    if WORLD is None:",
     "        bg.inputs[\"Color\"].default_value = (0.0, 0.0, 0.0, 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 0.0",
+    "    elif \"map\" in WORLD:",
+    "        # iris looks a direction up in the map as Blender does for a glTF file",
+    "        # imported by Blender (Z up; docs/format.md). The scene is exported Y-up",
+    "        # as is, so the direction is turned by 90 deg about X, (x, y, z) ->",
+    "        # (x, -z, y), then about Z by the map's rotation. Closest texel, as iris.",
+    "        nt = world.node_tree",
+    "        tc = nt.nodes.new(\"ShaderNodeTexCoord\")",
+    "        mp = nt.nodes.new(\"ShaderNodeMapping\")",
+    "        mp.vector_type = \"POINT\"",
+    "        mp.inputs[\"Rotation\"].default_value = (0.5 * math.pi, 0.0, math.radians(WORLD[\"rotation\"]))",
+    "        env = nt.nodes.new(\"ShaderNodeTexEnvironment\")",
+    "        env.image = bpy.data.images.load(text(WORLD[\"map\"]), check_existing=True)",
+    "        env.image.colorspace_settings.name = \"Linear\"",
+    "        env.interpolation = \"Closest\"",
+    "        env.projection = \"EQUIRECTANGULAR\"",
+    "        nt.links.new(tc.outputs[\"Generated\"], mp.inputs[\"Vector\"])",
+    "        nt.links.new(mp.outputs[\"Vector\"], env.inputs[\"Vector\"])",
+    "        nt.links.new(env.outputs[\"Color\"], bg.inputs[\"Color\"])",
+    "        bg.inputs[\"Strength\"].default_value = WORLD[\"strength\"]",
     "    else:",
-    "        bg.inputs[\"Color\"].default_value = (*WORLD, 1.0)",
+    "        bg.inputs[\"Color\"].default_value = (*WORLD[\"color\"], 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 1.0",
     "    sc.world = world",
     "",
@@ -792,10 +812,22 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
   fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view->width,
           view->height, view->spp, view->max_depth, (unsigned long long)(view->seed & 0x7fffffffu));
-  if (scene->has_environment) {
-    fputs("WORLD = ", fp);
+  if (scene->has_environment && scene->environment_map.path) {
+    char map[4096];
+    char *abs = realpath(scene->environment_map.path, NULL);
+    snprintf(map, sizeof map, "%s", abs ? abs : scene->environment_map.path);
+    free(abs);
+    fputs("WORLD = dict(map=", fp);
+    put_bytes(fp, map);
+    fputs(", strength=", fp);
+    put_float(fp, scene->environment_map.strength);
+    fputs(", rotation=", fp);
+    put_float(fp, scene->environment_map.rotation);
+    fputs(")\n", fp);
+  } else if (scene->has_environment) {
+    fputs("WORLD = dict(color=", fp);
     put_vec3(fp, scene->environment);
-    fputc('\n', fp);
+    fputs(")\n", fp);
   } else {
     fputs("WORLD = None\n", fp);
   }

@@ -219,7 +219,9 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
     size_t b = 0, r = index;
     while (r >= bindings[b].group->count) r -= bindings[b++].group->count;
     const iris_option *o = &bindings[b].group->rows[r];
-    if (bindings[b].seen & (1ull << r)) {
+    /* A repeated number or flag overrides (scripts append to a base command
+     * line); a repeated name of a file or camera is a mistake. */
+    if ((bindings[b].seen & (1ull << r)) && o->type == IRIS_OPT_STRING) {
       rc = iris_cli_usage_error(cmd, "--%s given twice", o->name);
       break;
     }

@@ -55,7 +55,8 @@ typedef struct iris_option_binding {
  * "--name=value" or "--name value", options and operands in any order).
  * Operands are stored in operands[0..*operand_count) (at most max_operands).
  * Returns 0 when done, 2 after printing a usage error (unknown option,
- * missing or bad value, an option given twice, too many operands) and -1
+ * missing or bad value, a string option given twice (a repeated number
+ * or flag overrides), too many operands) and -1
  * when --help or -h was given (the caller prints iris_options_help). */
 int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_binding *bindings,
                        size_t binding_count, const char **operands, int max_operands,
