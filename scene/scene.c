@@ -3,6 +3,8 @@
  * scene_io.c; docs/format.md describes both. */
 #include "scene/scene.h"
 
+#include "core/log.h"
+
 #include <stdlib.h>
 #include <string.h>
 
@@ -97,6 +99,13 @@ bool iris_scene_has_emitter(const iris_scene *scene) {
     }
   }
   return false;
+}
+
+void iris_scene_warn_if_lightless(const iris_scene *scene, const char *what) {
+  if (iris_scene_has_emitter(scene)) return;
+  iris_warnf("%s: the scene has no light (no emitter, no light, black environment): "
+             "the image will be black; pass --env FILE or --env-color R,G,B",
+             what ? what : "scene");
 }
 
 char *iris_strdup(const char *s) {

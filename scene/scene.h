@@ -191,6 +191,9 @@ void iris_scene_set_environment_color(iris_scene *scene, const float rgb[3]);
  * intensity, a non-black environment, or an instanced mesh with an emissive
  * material. A scene without any renders black. */
 bool iris_scene_has_emitter(const iris_scene *scene);
+/* One warning line when !iris_scene_has_emitter: the image will be black, and
+ * how to light it (--env FILE or --env-color R,G,B). `what` names the scene. */
+void iris_scene_warn_if_lightless(const iris_scene *scene, const char *what);
 
 /* A material with the defaults for its type (colour 0.8, roughness 0.5,
  * ior 1.5, specular 1, textures -1, not emissive, emission two-sided). */

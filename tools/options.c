@@ -240,6 +240,54 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
   return 0;
 }
 
+size_t iris_options_getopt_rows(const iris_option_group *g, int base, struct option *out) {
+  for (size_t r = 0; r < g->count; r++) {
+    out[r].name = g->rows[r].name;
+    out[r].has_arg = g->rows[r].type == IRIS_OPT_FLAG ? no_argument : required_argument;
+    out[r].flag = NULL;
+    out[r].val = base + (int)r;
+  }
+  return g->count;
+}
+
+static bool take_row(const char *cmd, iris_option_binding *b, size_t r, const char *arg, int *rc) {
+  const iris_option *o = &b->group->rows[r];
+  *rc = 0;
+  if ((b->seen & (1ull << r)) && o->type == IRIS_OPT_STRING) {
+    *rc = iris_cli_usage_error(cmd, "--%s given twice", o->name);
+    return true;
+  }
+  b->seen |= 1ull << r;
+  if (!set_value(cmd, o, arg, b->target)) *rc = IRIS_EXIT_USAGE;
+  return true;
+}
+
+bool iris_options_getopt_take(const char *cmd, iris_option_binding *b, int base, int c,
+                              const char *arg, int *rc) {
+  if (c < base || (size_t)(c - base) >= b->group->count) return false;
+  return take_row(cmd, b, (size_t)(c - base), arg, rc);
+}
+
+bool iris_options_take(const char *cmd, iris_option_binding *b, const char *name, const char *val,
+                       int argc, char **argv, int *i, int *rc) {
+  if (strncmp(name, "--", 2) != 0) return false;
+  for (size_t r = 0; r < b->group->count; r++) {
+    const iris_option *o = &b->group->rows[r];
+    if (strcmp(name + 2, o->name) != 0) continue;
+    if (o->type == IRIS_OPT_FLAG) {
+      if (val) {
+        *rc = iris_cli_usage_error(cmd, "option %s takes no value", name);
+        return true;
+      }
+    } else if (!val && !iris_cli_take_value(cmd, name, argc, argv, i, &val)) {
+      *rc = IRIS_EXIT_USAGE;
+      return true;
+    }
+    return take_row(cmd, b, r, val, rc);
+  }
+  return false;
+}
+
 void iris_options_help(const iris_option_binding *bindings, size_t binding_count) {
   for (size_t b = 0; b < binding_count; b++) {
     const iris_option_group *g = bindings[b].group;
@@ -299,8 +347,5 @@ int iris_env_options_apply(const char *cmd, const iris_option_binding *b, iris_s
 }
 
 void iris_warn_if_lightless(const iris_scene *scene, const char *what) {
-  if (iris_scene_has_emitter(scene)) return;
-  iris_warnf("%s: the scene has no light (no emitter, no light, black environment): "
-             "the image will be black; pass --env FILE or --env-color R,G,B",
-             what ? what : "scene");
+  iris_scene_warn_if_lightless(scene, what);
 }

@@ -61,6 +61,18 @@ typedef struct iris_option_binding {
 int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_binding *bindings,
                        size_t binding_count, const char **operands, int max_operands,
                        int *operand_count);
+/* For a command that keeps its own getopt_long loop: writes the group's rows
+ * as struct option entries with val = base + row (returns how many), and
+ * takes such a value c (with optarg) into the binding; *rc gets 0 or 2. */
+struct option;
+size_t iris_options_getopt_rows(const iris_option_group *g, int base, struct option *out);
+bool iris_options_getopt_take(const char *cmd, iris_option_binding *b, int base, int c,
+                              const char *arg, int *rc);
+/* For a command with a hand-rolled loop: when argv[*i] (already split into
+ * `name` and `val` by iris_cli_split_option) is one of the group's flags,
+ * takes it (and its value, advancing *i) and returns true; *rc gets 0 or 2. */
+bool iris_options_take(const char *cmd, iris_option_binding *b, const char *name, const char *val,
+                       int argc, char **argv, int *i, int *rc);
 /* Prints the groups' rows as --help sections. */
 void iris_options_help(const iris_option_binding *bindings, size_t binding_count);
 /* True when row `name` of the binding was given. */
