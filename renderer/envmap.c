@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "core/image.h"
 #include "core/log.h"
@@ -24,6 +25,11 @@ static bool is_exr(const char *path) {
 /* Decodes the file into packed RGB (3 floats per texel, row 0 top) and checks every texel. */
 static iris_status read_rgb(const char *path, float **rgb, int *w, int *h, iris_error *err) {
   *rgb = NULL;
+  struct stat sb;
+  if (stat(path, &sb) != 0)
+    return iris_error_set(err, IRIS_ERR_IO, path, 0, NULL, "cannot open environment map: %s", strerror(errno));
+  if (!S_ISREG(sb.st_mode))
+    return iris_error_set(err, IRIS_ERR_IO, path, 0, NULL, "cannot open environment map: not a regular file");
   FILE *probe = fopen(path, "rb");
   if (!probe) return iris_error_set(err, IRIS_ERR_IO, path, 0, NULL, "cannot open environment map: %s", strerror(errno));
   int c0 = fgetc(probe);

@@ -143,6 +143,10 @@ static bool set_value(const char *cmd, const iris_option *o, const char *val, vo
         iris_cli_usage_error(cmd, "%s needs a non-empty value", flag);
         return false;
       }
+      if (val[0] == '-' && val[1]) { /* "--env -o out.exr": the value was forgotten */
+        iris_cli_usage_error(cmd, "option '%s' needs a value (got the option '%s')", flag, val);
+        return false;
+      }
       *(const char **)field = val;
       return true;
     case IRIS_OPT_RGB:
