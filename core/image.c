@@ -652,6 +652,38 @@ iris_status iris_ldr_load_file(const char *path, iris_ldr_image *out, iris_error
   return st;
 }
 
+iris_status iris_hdr_read(const char *path, iris_image *img, iris_error *err) {
+  memset(img, 0, sizeof *img);
+  char *data = NULL;
+  size_t size = 0;
+  iris_status st = iris_file_read(path, LDR_MAX_FILE, &data, &size, err);
+  if (st != IRIS_OK) return st;
+  if (size == 0) {
+    free(data);
+    return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "empty file");
+  }
+  if (size > (size_t)INT32_MAX || !stbi_is_hdr_from_memory((const stbi_uc *)data, (int)size)) {
+    free(data);
+    return iris_error_set(err, IRIS_ERR_UNSUPPORTED, path, 0, NULL,
+                          "not a Radiance HDR image (no '#?RADIANCE' or '#?RGBE' header)");
+  }
+  int w = 0, h = 0, n = 0;
+  if (!stbi_info_from_memory((const stbi_uc *)data, (int)size, &w, &h, &n) || w <= 0 || h <= 0 ||
+      w > IMAGE_MAX_DIM || h > IMAGE_MAX_DIM || (uint64_t)w * (uint64_t)h > LDR_MAX_PIXELS) {
+    free(data);
+    return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cannot decode HDR image: %s",
+                          w > 0 && h > 0 ? "image size out of range" : stbi_failure_reason());
+  }
+  float *px = stbi_loadf_from_memory((const stbi_uc *)data, (int)size, &w, &h, &n, 3);
+  free(data);
+  if (!px) return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cannot decode HDR image: %s", stbi_failure_reason());
+  static const char *const rgb[3] = {"R", "G", "B"};
+  st = iris_image_create(img, w, h, 3, rgb, err);
+  if (st == IRIS_OK) memcpy(img->data, px, sizeof(float) * 3 * (size_t)w * (size_t)h);
+  stbi_image_free(px);
+  return st;
+}
+
 void iris_ldr_destroy(iris_ldr_image *img) {
   if (!img) return;
   stbi_image_free(img->rgba);

@@ -46,6 +46,11 @@ iris_status iris_exr_write(const char *path, const iris_image *img, const iris_i
 iris_status iris_exr_read(const char *path, iris_image *img, iris_image_meta **meta,
                           size_t *meta_count, iris_error *err);
 
+/* Radiance .hdr (RGBE, flat or run-length encoded) through stb_image: three
+ * float channels R, G, B, linear, top row first. A file that is not an HDR
+ * image (stb would gamma-decode a PNG into floats) is refused. */
+iris_status iris_hdr_read(const char *path, iris_image *img, iris_error *err);
+
 /* 8-bit sRGB PNG from three channels (r, g, b at offsets c0, c0+1, c0+2) scaled
  * by 2^exposure; values are clamped after the sRGB transfer function. */
 iris_status iris_png_write(const char *path, const iris_image *img, int c0, float exposure,

@@ -5,6 +5,7 @@
  * the data tables of this scene and a call to main(). Mesh arrays are stored
  * once, little-endian, in a sidecar file (or a base64 blob in the script) and
  * read with numpy + foreach_set, the fast path for large meshes. */
+#define _DEFAULT_SOURCE /* realpath */
 #include "exporters/blender.h"
 
 #include <errno.h>
@@ -465,15 +466,34 @@ static const char *const PRELUDE[] = {
     "",
     "",
     "def build_world(sc, env):",
-    "    \"\"\"World from the environment: None (black) or a constant radiance.\"\"\"",
+    "    \"\"\"World from the environment: None (black), dict(color=...) or dict(map=...).\"\"\"",
     "    world = bpy.data.worlds.new(\"World\")",
     "    world.use_nodes = True",
     "    bg = world.node_tree.nodes[\"Background\"]",
     "    if env is None:",
     "        bg.inputs[\"Color\"].default_value = (0.0, 0.0, 0.0, 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 0.0",
+    "    elif \"map\" in env:",
+    "        # iris looks a direction up in the map as Blender does for a glTF file",
+    "        # imported by Blender (Z up; docs/format.md). The scene is exported Y-up",
+    "        # as is, so the direction is turned by 90 deg about X, (x, y, z) ->",
+    "        # (x, -z, y), then about Z by the map's rotation. Closest texel, as iris.",
+    "        nt = world.node_tree",
+    "        tc = nt.nodes.new(\"ShaderNodeTexCoord\")",
+    "        mp = nt.nodes.new(\"ShaderNodeMapping\")",
+    "        mp.vector_type = \"POINT\"",
+    "        mp.inputs[\"Rotation\"].default_value = (0.5 * math.pi, 0.0, math.radians(env[\"rotation\"]))",
+    "        tex = nt.nodes.new(\"ShaderNodeTexEnvironment\")",
+    "        tex.image = bpy.data.images.load(text(env[\"map\"]), check_existing=True)",
+    "        tex.image.colorspace_settings.name = \"Linear\"",
+    "        tex.interpolation = \"Closest\"",
+    "        tex.projection = \"EQUIRECTANGULAR\"",
+    "        nt.links.new(tc.outputs[\"Generated\"], mp.inputs[\"Vector\"])",
+    "        nt.links.new(mp.outputs[\"Vector\"], tex.inputs[\"Vector\"])",
+    "        nt.links.new(tex.outputs[\"Color\"], bg.inputs[\"Color\"])",
+    "        bg.inputs[\"Strength\"].default_value = env[\"strength\"]",
     "    else:",
-    "        bg.inputs[\"Color\"].default_value = (*env, 1.0)",
+    "        bg.inputs[\"Color\"].default_value = (*env[\"color\"], 1.0)",
     "        bg.inputs[\"Strength\"].default_value = 1.0",
     "    sc.world = world",
     "",
@@ -598,6 +618,28 @@ void iris_blender_put_vec3(FILE *fp, const float *v) {
 
 /* A Python bytes literal holding the exact bytes of s (NULL -> b""). Names are
  * decoded with errors="replace" by the prelude's text(); paths with os.fsdecode. */
+void iris_blender_put_world(FILE *fp, const iris_scene *scene) {
+  if (scene->has_environment && scene->environment_map.path) {
+    char map[4096];
+    char *abs = realpath(scene->environment_map.path, NULL);
+    snprintf(map, sizeof map, "%s", abs ? abs : scene->environment_map.path);
+    free(abs);
+    fputs("WORLD = dict(map=", fp);
+    iris_blender_put_bytes(fp, map);
+    fputs(", strength=", fp);
+    put_float(fp, scene->environment_map.strength);
+    fputs(", rotation=", fp);
+    put_float(fp, scene->environment_map.rotation);
+    fputs(")\n", fp);
+  } else if (scene->has_environment) {
+    fputs("WORLD = dict(color=", fp);
+    iris_blender_put_vec3(fp, scene->environment);
+    fputs(")\n", fp);
+  } else {
+    fputs("WORLD = None\n", fp);
+  }
+}
+
 void iris_blender_put_bytes(FILE *fp, const char *s) {
   fputs("b\"", fp);
   for (const unsigned char *p = (const unsigned char *)(s ? s : ""); *p; p++) {
@@ -926,13 +968,7 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
   fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view->width,
           view->height, view->spp, view->max_depth, (unsigned long long)(view->seed & 0x7fffffffu));
-  if (scene->has_environment) {
-    fputs("WORLD = ", fp);
-    iris_blender_put_vec3(fp, scene->environment);
-    fputc('\n', fp);
-  } else {
-    fputs("WORLD = None\n", fp);
-  }
+  iris_blender_put_world(fp, scene);
 
   fputs("TEXTURES = [\n", fp);
   for (size_t i = 0; i < scene->texture_count; i++) put_texture(fp, scene, i, script_path);

@@ -173,13 +173,7 @@ iris_status iris_export_blender_import(const iris_scene *scene, const char *impo
   fputs("\n\n# ---- this scene ----------------------------------------------------------\n\n", fp);
   fprintf(fp, "SETTINGS = dict(width=%d, height=%d, spp=%d, max_depth=%d, seed=%llu)\n", view.width,
           view.height, view.spp, view.max_depth, (unsigned long long)(view.seed & 0x7fffffffu));
-  if (scene->has_environment) {
-    fputs("WORLD = ", fp);
-    iris_blender_put_vec3(fp, scene->environment);
-    fputc('\n', fp);
-  } else {
-    fputs("WORLD = None\n", fp);
-  }
+  iris_blender_put_world(fp, scene);
   fputs("TEXTURES = []\nMATERIALS = []\nMESHES = []\nINSTANCES = []\nLIGHTS = []\n", fp);
   iris_blender_put_camera(fp, scene, &bview);
   fputs("BLOB_SIZE = 0\nSIDECAR = None\nBLOB = None\nIMPORT = ", fp);

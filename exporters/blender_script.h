@@ -15,6 +15,9 @@ void iris_blender_put_prelude(FILE *fp);
 void iris_blender_put_bytes(FILE *fp, const char *s);
 /* A Python tuple of three floats (exact float round trip). */
 void iris_blender_put_vec3(FILE *fp, const float *v);
+/* WORLD = None, dict(color=(r, g, b)) or dict(map=PATH, strength=S, rotation=DEG):
+ * what the prelude's build_world(sc, WORLD) reads. */
+void iris_blender_put_world(FILE *fp, const iris_scene *scene);
 /* CAMERA = dict(...) for the view (clip range from the scene's bounds). */
 void iris_blender_put_camera(FILE *fp, const iris_scene *scene, const iris_export_view *view);
 

@@ -443,7 +443,19 @@ static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_
           view->max_depth + 1 < 1 ? 1 : (view->max_depth + 1 > 256 ? 256 : view->max_depth + 1));
   if (radiosity) put_radiosity(fp, params->pov_radiosity, view->max_depth);
   fputs("}\n", fp);
-  if (scene->has_environment && !coverage) {
+  if (scene->has_environment && scene->environment_map.path && !coverage) {
+    /* An approximation (docs/export.md): the map is seen directly and, with
+     * radiosity, lights the scene; its strength is ignored. POV-Ray's
+     * spherical map wraps u once around +Y; the x mirror and the half turn
+     * were chosen by eye against iris's render of env-objects. */
+    char ext[16];
+    iris_path_ext(scene->environment_map.path, ext, sizeof ext);
+    fprintf(fp, "background { rgb 0 }\nsky_sphere { pigment { image_map { %s ",
+            strcmp(ext, "exr") == 0 ? "exr" : "hdr");
+    put_string(fp, scene->environment_map.path);
+    fprintf(fp, " gamma 1.0 map_type 1 interpolate 2 } scale <-1, 1, 1> rotate y * %g } }\n",
+            (double)(180.0f + scene->environment_map.rotation));
+  } else if (scene->has_environment && !coverage) {
     fputs("background { ", fp);
     put_rgb(fp, scene->environment, 1.0f);
     fputs(" }\n", fp);

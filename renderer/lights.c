@@ -310,8 +310,26 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
   size_t emissive = 0;
   for (uint32_t t = 0; t < tri_count; t++)
     if (is_emissive(material_of(scene, iris_accel_triangle_material(accel, t)))) emissive++;
-  bool env = scene->has_environment &&
+  bool env = scene->has_environment && !scene->environment_map.path &&
              (scene->environment[0] > 0 || scene->environment[1] > 0 || scene->environment[2] > 0);
+  iris_vec3 env_mean = iris_v3_load(scene->environment);
+  if (scene->has_environment && scene->environment_map.path) {
+    out->envmap = calloc(1, sizeof *out->envmap);
+    if (!out->envmap) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the environment");
+    iris_status st = iris_envmap_load(&scene->environment_map, out->envmap, err);
+    if (st != IRIS_OK) {
+      free(out->envmap);
+      out->envmap = NULL;
+      return st;
+    }
+    env_mean = iris_v3_load(out->envmap->mean_rgb);
+    env = out->envmap->mean_luminance > 0.0;
+    if (!env) {
+      iris_envmap_destroy(out->envmap);
+      free(out->envmap);
+      out->envmap = NULL;
+    }
+  }
   size_t cap = emissive + scene->light_count + (env ? 1 : 0);
   out->light_of_prim = malloc(sizeof(uint32_t) * (tri_count ? tri_count : 1));
   out->entries = calloc(cap ? cap : 1, sizeof *out->entries);
@@ -376,8 +394,8 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
   if (env) {
     iris_light_entry *e = &out->entries[n];
     e->kind = IRIS_LIGHT_KIND_ENVIRONMENT;
-    e->radiance = iris_v3_load(scene->environment);
-    /* Power of a constant sky through the scene's bounding sphere (pbrt-v4). */
+    e->radiance = env_mean; /* a map's mean over the sphere */
+    /* Power of a sky of this mean radiance through the scene's bounding sphere (pbrt-v4). */
     e->power = luminance(e->radiance) * 4.0f * IRIS_PI * IRIS_PI * out->radius * out->radius;
     out->environment = (int32_t)n;
     n++;
@@ -449,6 +467,9 @@ void iris_lights_destroy(iris_lights *lights) {
   lights->tri_count = 0;
   free(lights->light_of_prim);
   iris_distrib1d_destroy(&lights->select);
+  iris_envmap_destroy(lights->envmap);
+  free(lights->envmap);
+  lights->envmap = NULL;
   lights->entries = NULL;
   lights->light_of_prim = NULL;
   lights->count = 0;
@@ -660,13 +681,20 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     }
     case IRIS_LIGHT_KIND_ENVIRONMENT:
     default: {
-      s->wi = iris_sample_uniform_sphere(u0, u1);
+      if (lights->envmap) {
+        float pdf;
+        if (!iris_envmap_sample(lights->envmap, u0, u1, &s->wi, &pdf)) return false;
+        s->L = iris_envmap_radiance(lights->envmap, s->wi);
+        s->pdf = pmf * pdf;
+      } else {
+        s->wi = iris_sample_uniform_sphere(u0, u1);
+        s->L = e->radiance;
+        s->pdf = pmf * iris_sample_uniform_sphere_pdf();
+      }
       s->dist = INFINITY;
       s->p = iris_madd(ref, s->wi, 2.0f * lights->radius);
       s->n = iris_neg(s->wi);
-      s->L = e->radiance;
-      s->pdf = pmf * iris_sample_uniform_sphere_pdf();
-      return true;
+      return s->pdf > 0.0f;
     }
   }
 }
@@ -690,16 +718,16 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
 }
 
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {
-  (void)d;
   if (lights->environment < 0) return iris_v3(0, 0, 0);
+  if (lights->envmap) return iris_envmap_radiance(lights->envmap, iris_normalize(d));
   return lights->entries[lights->environment].radiance;
 }
 
 float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d) {
-  (void)d;
   if (lights->environment < 0) return 0.0f;
-  return iris_lights_select_pmf_at(lights, ref, (uint32_t)lights->environment) *
-         iris_sample_uniform_sphere_pdf();
+  float pdf = lights->envmap ? iris_envmap_pdf(lights->envmap, iris_normalize(d))
+                             : iris_sample_uniform_sphere_pdf();
+  return iris_lights_select_pmf_at(lights, ref, (uint32_t)lights->environment) * pdf;
 }
 
 iris_status iris_lights_emission_selection(const iris_lights *lights, iris_emission_selection by,
@@ -792,9 +820,15 @@ bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_dist
     case IRIS_LIGHT_KIND_ENVIRONMENT:
     default: {
       float r = lights->radius;
+      iris_vec3 radiance = le->radiance;
       if (le->kind == IRIS_LIGHT_KIND_DIRECTIONAL) {
         e->dir = iris_normalize(iris_v3_load(lights->scene->lights[le->prim].direction));
         e->pdf_dir = 1.0f;
+      } else if (lights->envmap) { /* photons travel against the sampled incident direction */
+        iris_vec3 wi;
+        if (!iris_envmap_sample(lights->envmap, u2, u3, &wi, &e->pdf_dir)) return false;
+        radiance = iris_envmap_radiance(lights->envmap, wi);
+        e->dir = iris_neg(wi);
       } else {
         e->dir = iris_sample_uniform_sphere(u2, u3);
         e->pdf_dir = iris_sample_uniform_sphere_pdf();
@@ -807,7 +841,7 @@ bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_dist
                       iris_add(iris_scale(f.s, x * r), iris_scale(f.t, y * r)));
       e->n = e->dir;
       e->pdf_pos = 1.0f / (IRIS_PI * r * r);
-      e->power = iris_scale(le->radiance, 1.0f / (pmf * e->pdf_pos * e->pdf_dir));
+      e->power = iris_scale(radiance, 1.0f / (pmf * e->pdf_pos * e->pdf_dir));
       return true;
     }
   }

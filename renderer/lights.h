@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/math.h"
 #include "renderer/accel.h"
+#include "renderer/envmap.h"
 #include "renderer/sampling.h"
 #include "renderer/texture.h"
 #include "scene/scene.h"
@@ -101,6 +102,7 @@ typedef struct iris_lights {
   size_t group_count;
   uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
   int32_t environment;    /* entry index of the environment, or -1 */
+  iris_envmap *envmap;    /* the environment's map (owned), NULL for a constant one */
   iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */
   float radius;
   double total_power;
@@ -108,7 +110,8 @@ typedef struct iris_lights {
 } iris_lights;
 
 /* Builds the light list. A scene without emitters gives count == 0 (renders black
- * unless something is added). */
+ * unless something is added). An environment map is read and checked here
+ * (iris_envmap_load): a bad map is an error naming its file. */
 iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                               const iris_textures *textures, iris_lights *out, iris_error *err);
 void iris_lights_destroy(iris_lights *lights);

@@ -104,6 +104,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
   }
   hash_u64(&s, scene->has_environment ? 1 : 0);
   if (scene->has_environment) hash_floats(&s, scene->environment, 3);
+  if (scene->environment_map.path) { /* the map by its path (its texels are not read here) */
+    hash_str(&s, scene->environment_map.path);
+    float f[] = {scene->environment_map.strength, scene->environment_map.rotation};
+    hash_floats(&s, f, 2);
+  }
   return s.h;
 }
 

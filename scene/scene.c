@@ -4,6 +4,8 @@
 #include "scene/scene.h"
 
 #include <malloc.h>
+
+#include "core/log.h"
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,6 +43,7 @@ void iris_scene_destroy(iris_scene *scene) {
   for (size_t i = 0; i < scene->mesh_count; i++) free_mesh(&scene->meshes[i]);
   for (size_t i = 0; i < scene->camera_count; i++) free(scene->cameras[i].name);
   for (size_t i = 0; i < scene->light_count; i++) free(scene->lights[i].name);
+  free(scene->environment_map.path);
   iris_file_map *maps = scene->maps;
   for (size_t i = 0; i < scene->map_count; i++) iris_file_map_close(&maps[i]);
   free(scene->maps);
@@ -52,6 +55,58 @@ void iris_scene_destroy(iris_scene *scene) {
   free(scene->lights);
   free(scene->source_path);
   free(scene);
+}
+
+bool iris_scene_set_environment_map(iris_scene *scene, const char *path, float strength,
+                                    float rotation) {
+  char *copy = iris_strdup(path);
+  if (!copy) return false;
+  free(scene->environment_map.path);
+  scene->environment_map.path = copy;
+  scene->environment_map.strength = strength;
+  scene->environment_map.rotation = rotation;
+  scene->has_environment = true;
+  scene->environment[0] = scene->environment[1] = scene->environment[2] = 0.0f;
+  return true;
+}
+
+void iris_scene_set_environment_color(iris_scene *scene, const float rgb[3]) {
+  free(scene->environment_map.path);
+  scene->environment_map.path = NULL;
+  scene->has_environment = true;
+  memcpy(scene->environment, rgb, sizeof scene->environment);
+}
+
+bool iris_scene_has_emitter(const iris_scene *scene) {
+  for (size_t i = 0; i < scene->light_count; i++) {
+    const iris_light *l = &scene->lights[i];
+    if (l->intensity > 0.0f && (l->color[0] > 0.0f || l->color[1] > 0.0f || l->color[2] > 0.0f))
+      return true;
+  }
+  if (scene->has_environment) {
+    if (scene->environment_map.path && scene->environment_map.strength > 0.0f) return true;
+    if (!scene->environment_map.path &&
+        (scene->environment[0] > 0.0f || scene->environment[1] > 0.0f || scene->environment[2] > 0.0f))
+      return true;
+  }
+  /* an emissive material counts only when a mesh uses it */
+  for (size_t i = 0; i < scene->mesh_count; i++) {
+    int32_t m = scene->meshes[i].material;
+    if (m < 0 || (size_t)m >= scene->material_count || scene->meshes[i].triangle_count == 0) continue;
+    const float *e = scene->materials[m].emission;
+    if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) {
+      for (size_t k = 0; k < scene->instance_count; k++)
+        if (scene->instances[k].mesh == i) return true;
+    }
+  }
+  return false;
+}
+
+void iris_scene_warn_if_lightless(const iris_scene *scene, const char *what) {
+  if (iris_scene_has_emitter(scene)) return;
+  iris_warnf("%s: the scene has no light (no emitter, no light, black environment): "
+             "the image will be black; pass --env FILE or --env-color R,G,B",
+             what ? what : "scene");
 }
 
 char *iris_strdup(const char *s) {
@@ -186,6 +241,8 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
   if (!dst->has_environment && src->has_environment) {
     dst->has_environment = true;
     memcpy(dst->environment, src->environment, sizeof dst->environment);
+    dst->environment_map = src->environment_map; /* taken over */
+    src->environment_map.path = NULL;
   }
   /* dst's render settings win; src fills only what dst leaves at its default. */
   iris_render_settings *r = &dst->render;
@@ -360,6 +417,16 @@ iris_status iris_scene_validate(const iris_scene *s, const char *file, iris_erro
   if (s->has_environment && !nonneg_finite_n(s->environment, 3)) {
     snprintf(element, sizeof element, "environment");
     FAIL("environment must be finite and non-negative");
+  }
+  if (s->environment_map.path) {
+    const iris_environment_map *em = &s->environment_map;
+    snprintf(element, sizeof element, "environment.map");
+    if (!s->has_environment) FAIL("a map needs has_environment");
+    if (!em->path[0]) FAIL("path is empty");
+    if (!isfinite(em->strength) || em->strength < 0.0f)
+      FAIL("strength %g must be finite and non-negative", (double)em->strength);
+    if (!isfinite(em->rotation) || fabsf(em->rotation) > 1e6f)
+      FAIL("rotation %g must be a finite number of degrees", (double)em->rotation);
   }
   const iris_render_settings *r = &s->render;
   snprintf(element, sizeof element, "render");

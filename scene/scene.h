@@ -117,6 +117,18 @@ typedef struct iris_light {
   float outer_cone;   /* spot, radians */
 } iris_light;
 
+/* An equirectangular (latitude-longitude, 2:1) HDR image lighting the scene
+ * from infinitely far away: OpenEXR or Radiance .hdr. Direction d looks up
+ * texel (s, t) = (1/2 + atan2(d'z, d'x) / 2pi, acos(d'y) / pi), row 0 at the
+ * top, with d' = R_y(rotation) d: the texel Blender's Environment Texture
+ * (default mapping) shows for the same direction of a glTF file imported by
+ * Blender (docs/format.md, "environment"). */
+typedef struct iris_environment_map {
+  char *path;     /* absolute after loading a scene JSON; NULL = no map */
+  float strength; /* radiance = texel x strength */
+  float rotation; /* degrees about the up axis (+Y) */
+} iris_environment_map;
+
 typedef struct iris_render_settings {
   int width, height;  /* 0 = derive */
   int spp;            /* 0 = default */
@@ -143,7 +155,8 @@ typedef struct iris_scene {
   size_t light_count;
 
   bool has_environment;
-  float environment[3]; /* constant radiance of the world */
+  float environment[3]; /* constant radiance of the world (when there is no map) */
+  iris_environment_map environment_map; /* path != NULL: the world is this map */
 
   iris_render_settings render;
 
@@ -168,6 +181,19 @@ int32_t iris_scene_add_instance(iris_scene *scene, const iris_instance *inst);
 int32_t iris_scene_add_camera(iris_scene *scene, const iris_camera *cam);
 int32_t iris_scene_add_light(iris_scene *scene, const iris_light *light);
 char *iris_strdup(const char *s);
+/* The world becomes the map at `path` (copied; not opened here) times
+ * `strength`, rotated by `rotation` degrees about +Y; false when out of memory. */
+bool iris_scene_set_environment_map(iris_scene *scene, const char *path, float strength,
+                                    float rotation);
+/* The world becomes the constant radiance rgb (any map is dropped). */
+void iris_scene_set_environment_color(iris_scene *scene, const float rgb[3]);
+/* True when something in the scene emits: a punctual light of non-zero
+ * intensity, a non-black environment, or an instanced mesh with an emissive
+ * material. A scene without any renders black. */
+bool iris_scene_has_emitter(const iris_scene *scene);
+/* One warning line when !iris_scene_has_emitter: the image will be black, and
+ * how to light it (--env FILE or --env-color R,G,B). `what` names the scene. */
+void iris_scene_warn_if_lightless(const iris_scene *scene, const char *what);
 
 /* A material with the defaults for its type (colour 0.8, roughness 0.5,
  * ior 1.5, specular 1, textures -1, not emissive, emission two-sided). */

@@ -352,9 +352,25 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
     cJSON *a = cJSON_AddArrayToObject(root, "lights");
     for (size_t i = 0; i < scene->light_count; i++) cJSON_AddItemToArray(a, write_light(&scene->lights[i]));
   }
-  if (scene->has_environment) {
+  if (scene->has_environment && st == IRIS_OK) {
     cJSON *o = cJSON_AddObjectToObject(root, "environment");
-    add_floats(o, "radiance", scene->environment, 3);
+    const iris_environment_map *em = &scene->environment_map;
+    if (em->path) {
+      char *abs = realpath(em->path, NULL);
+      if (!abs) {
+        st = iris_error_set(err, IRIS_ERR_IO, scene_name, 0, "environment.map",
+                            "cannot find environment map '%s': %s", em->path, strerror(errno));
+      } else {
+        relative_path(dir_abs, abs, file, sizeof file);
+        free(abs);
+        cJSON *m = cJSON_AddObjectToObject(o, "map");
+        cJSON_AddStringToObject(m, "path", file);
+        cJSON_AddNumberToObject(m, "strength", em->strength);
+        cJSON_AddNumberToObject(m, "rotation", em->rotation);
+      }
+    } else {
+      add_floats(o, "radiance", scene->environment, 3);
+    }
   }
   cJSON *render = write_render(&scene->render);
   if (render) cJSON_AddItemToObject(root, "render", render);
@@ -918,11 +934,34 @@ static iris_status parse_scene(jctx *c, const cJSON *root, const char *dir, iris
   }
   const cJSON *env = item(root, "environment");
   if (env) {
-    static const char *const env_keys[] = {"radiance"};
+    static const char *const env_keys[] = {"radiance", "map"};
     snprintf(c->element, sizeof c->element, "environment");
-    TRY(check_keys(c, env, env_keys, 1));
-    TRY(require(c, env, "radiance"));
-    TRY(get_floats(c, env, "radiance", s->environment, 3));
+    TRY(check_keys(c, env, env_keys, 2));
+    const cJSON *map = item(env, "map");
+    if (map && item(env, "radiance"))
+      return jfail(c, IRIS_ERR_INVALID, "give either 'radiance' or 'map', not both");
+    if (!map) {
+      TRY(require(c, env, "radiance"));
+      TRY(get_floats(c, env, "radiance", s->environment, 3));
+    } else {
+      static const char *const map_keys[] = {"path", "strength", "rotation"};
+      snprintf(c->element, sizeof c->element, "environment.map");
+      TRY(check_keys(c, map, map_keys, 3));
+      TRY(require(c, map, "path"));
+      const char *file = NULL;
+      float strength = 1.0f, rotation = 0.0f;
+      TRY(get_string(c, map, "path", &file));
+      TRY(get_float(c, map, "strength", &strength));
+      TRY(get_float(c, map, "rotation", &rotation));
+      if (!file[0]) return jfail(c, IRIS_ERR_INVALID, "'path' is empty");
+      char joined[PATH_MAX];
+      iris_path_join(dir, file, joined, sizeof joined);
+      char *abs = realpath(joined, NULL);
+      if (!abs) return jfail(c, IRIS_ERR_IO, "cannot find environment map '%s': %s", joined, strerror(errno));
+      bool ok = iris_scene_set_environment_map(s, abs, strength, rotation);
+      free(abs);
+      if (!ok) return jfail(c, IRIS_ERR_NOMEM, "out of memory");
+    }
     s->has_environment = true;
   }
   const cJSON *render = item(root, "render");

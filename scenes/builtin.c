@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "scenes/door.h"
+#include "scenes/sky.h"
 #include "scenes/stress/stress.h"
 
 static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-shielded", "furnace-diffuse",
@@ -12,7 +13,9 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     /* the failure-stability scenes, scenes/stress/stress.h */
                                     "stress-gap", "stress-veach-lights", "stress-caustic",
                                     "stress-thin-walls", "stress-small-dim", "stress-closed-box",
-                                    "stress-firefly", "stress-glossy-room", NULL};
+                                    "stress-firefly", "stress-glossy-room",
+                                    /* lit by the HDR sky of ../shared (scenes/sky.h) */
+                                    "env-objects", "sky-room", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -318,6 +321,10 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = build_furnace(s, IRIS_MATERIAL_DIFFUSE);
   else if (strcmp(name, "furnace-glossy") == 0)
     st = build_furnace(s, IRIS_MATERIAL_GLOSSY);
+  else if (strcmp(name, "env-objects") == 0)
+    st = iris_sky_objects_build(s);
+  else if (strcmp(name, "sky-room") == 0)
+    st = iris_sky_room_build(s);
   else if (iris_stress_find(name))
     st = iris_stress_build(name, s);
   else

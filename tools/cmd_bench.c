@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "renderer/integrator.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 #include "validate/bench.h"
 
 static const char *CMD = "bench";
@@ -99,6 +100,8 @@ int iris_cmd_bench(int argc, char **argv) {
   bool ref_auto = false, quiet = false, no_charts = false;
   const char *plot_script = NULL;
   char methods_buf[256] = "", times_buf[512] = "";
+  iris_env_options eo = iris_env_options_default();
+  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0};
   for (int i = 1; i < argc; i++) {
     char name[64];
     const char *val;
@@ -113,9 +116,14 @@ int iris_cmd_bench(int argc, char **argv) {
   } while (0)
     long lv;
     double dv;
+    int erc = 0;
     if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       print_help();
+      printf("\n");
+      iris_options_help(&envb, 1);
       return IRIS_EXIT_OK;
+    } else if (iris_options_take(CMD, &envb, a, val, argc, argv, &i, &erc)) {
+      if (erc) return erc;
     } else if (strcmp(a, "--methods") == 0) {
       NEED_VALUE();
       snprintf(methods_buf, sizeof methods_buf, "%s", val);
@@ -199,6 +207,12 @@ int iris_cmd_bench(int argc, char **argv) {
   }
   /* Everything that can be checked is checked before any work starts. */
   if (input_count == 0) return iris_cli_usage_error(CMD, "no input scene given");
+  int erc = iris_env_options_check(CMD, &envb, true);
+  if (erc != IRIS_EXIT_OK) return erc;
+  p.world.map = eo.map;
+  p.world.strength = eo.strength;
+  p.world.rotation = eo.rotation;
+  p.world.color = iris_options_seen(&envb, "env-color") ? eo.color : NULL;
   if (!methods_buf[0]) return iris_cli_usage_error(CMD, "no --methods given (e.g. mis,guided)");
   if (!times_buf[0]) return iris_cli_usage_error(CMD, "no --times given (e.g. 1,2,4)");
   if (!p.out_dir) return iris_cli_usage_error(CMD, "no output folder: give --out DIR");

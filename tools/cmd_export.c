@@ -1,7 +1,7 @@
 /* `iris export INPUT --to blender|pov -o OUT`: loads an iris scene, an
  * importable file or a built-in scene and writes it as a Blender 3.4 Python
  * script or a POV-Ray 3.7 scene (docs/export.md). */
-#include <getopt.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,10 +11,45 @@
 #include "exporters/blender.h"
 #include "exporters/pov.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 
 static const char *const CMD = "export";
 
-static void print_help(void) {
+typedef struct export_cli {
+  const char *to, *output, *camera;
+  int width, height, spp, seed, max_depth;
+  int radiosity; /* index into POV_RADIOSITY */
+  bool embed, coverage, quiet;
+} export_cli;
+
+static const char *const POV_RADIOSITY[] = {"off", "low", "medium", "high", NULL};
+
+static const iris_option EXPORT_ROWS[] = {
+    {"to", 0, IRIS_OPT_STRING, "FORMAT", 0, 0, offsetof(export_cli, to), "blender or pov (required)", NULL},
+    {"output", 'o', IRIS_OPT_STRING, "FILE", 0, 0, offsetof(export_cli, output),
+     "the script (.py) or scene (.pov) to write (required)", NULL},
+    {"camera", 0, IRIS_OPT_STRING, "NAME", 0, 0, offsetof(export_cli, camera),
+     "scene camera to use (default: the first; none: framed\n"
+     "automatically, as `iris render` does)", NULL},
+    {"width", 0, IRIS_OPT_INT, "W", 1, 65536, offsetof(export_cli, width), "image width (default: as `iris render`)", NULL},
+    {"height", 0, IRIS_OPT_INT, "H", 1, 65536, offsetof(export_cli, height), "image height (default: as `iris render`)", NULL},
+    {"spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, offsetof(export_cli, spp), "blender: default samples per pixel of the script", NULL},
+    /* Cycles' seed is a non-negative 32-bit int. */
+    {"seed", 0, IRIS_OPT_INT, "N", 0, 2147483647.0, offsetof(export_cli, seed), "blender: default Cycles seed of the script", NULL},
+    {"max-depth", 0, IRIS_OPT_INT, "B", 0, 1024, offsetof(export_cli, max_depth),
+     "bounces as Cycles counts them (default: the scene's, else 64);\n"
+     "pov: max_trace_level B+1", NULL},
+    {"embed", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(export_cli, embed), "blender: put the mesh data inside the script", NULL},
+    {"pov-coverage", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(export_cli, coverage),
+     "pov: every object a pure white emitter on black, no lights", NULL},
+    {"pov-radiosity", 0, IRIS_OPT_CHOICE, "Q", 0, 0, offsetof(export_cli, radiosity),
+     "pov: indirect light by POV-Ray radiosity, Q = off, low,\n"
+     "medium (default) or high", POV_RADIOSITY},
+    {"quiet", 'q', IRIS_OPT_FLAG, NULL, 0, 0, offsetof(export_cli, quiet), "no warnings or summary", NULL},
+};
+static const iris_option_group EXPORT_OPTIONS = {"Options", EXPORT_ROWS, sizeof EXPORT_ROWS / sizeof EXPORT_ROWS[0]};
+
+static void print_help(const iris_option_binding *b, size_t n) {
   printf("Usage: iris export INPUT --to blender|pov -o OUT [options]\n"
          "\n"
          "Writes INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene:\n"
@@ -28,108 +63,47 @@ static void print_help(void) {
          "  pov      a POV-Ray 3.7 scene (materials and lights approximated):\n"
          "             povray +IOUT.pov +OIMG.png +FN +W<w> +H<h> -D -V\n"
          "In-memory textures are written to <stem>.textures/ next to OUT.\n"
-         "\n"
-         "Options:\n"
-         "      --to FORMAT      blender or pov (required)\n"
-         "  -o, --output FILE    the script (.py) or scene (.pov) to write (required)\n"
-         "      --camera NAME    scene camera to use (default: the first; none: framed\n"
-         "                       automatically, as `iris render` does)\n"
-         "      --width W, --height H   image size (default: as `iris render`)\n"
-         "      --spp N          blender: default samples per pixel of the script\n"
-         "      --seed N         blender: default Cycles seed of the script\n"
-         "      --max-depth B    bounces as Cycles counts them (default: the scene's, else 64);\n"
-         "                       pov: max_trace_level B+1\n"
-         "      --embed          blender: put the mesh data inside the script\n"
-         "      --pov-coverage   pov: every object a pure white emitter on black, no lights\n"
-         "      --pov-radiosity Q  pov: indirect light by POV-Ray radiosity, Q = off, low,\n"
-         "                       medium (default) or high\n"
-         "  -q, --quiet          no warnings or summary\n"
-         "  -h, --help           show this help\n"
+         "\n");
+  iris_options_help(b, n);
+  printf("  -h, --help              show this help\n"
          "\n"
          "Exit status: 0 success, 2 bad usage or bad input (nothing written), 1 other\n"
          "failure. Outputs are written atomically.\n");
 }
 
 int iris_cmd_export(int argc, char **argv) {
-  enum { OPT_TO = 256, OPT_CAMERA, OPT_WIDTH, OPT_HEIGHT, OPT_SPP, OPT_SEED, OPT_DEPTH, OPT_EMBED, OPT_COVERAGE, OPT_RADIOSITY };
-  static const struct option longopts[] = {{"to", required_argument, NULL, OPT_TO},
-                                           {"output", required_argument, NULL, 'o'},
-                                           {"camera", required_argument, NULL, OPT_CAMERA},
-                                           {"width", required_argument, NULL, OPT_WIDTH},
-                                           {"height", required_argument, NULL, OPT_HEIGHT},
-                                           {"spp", required_argument, NULL, OPT_SPP},
-                                           {"seed", required_argument, NULL, OPT_SEED},
-                                           {"max-depth", required_argument, NULL, OPT_DEPTH},
-                                           {"embed", no_argument, NULL, OPT_EMBED},
-                                           {"pov-coverage", no_argument, NULL, OPT_COVERAGE},
-                                           {"pov-radiosity", required_argument, NULL, OPT_RADIOSITY},
-                                           {"quiet", no_argument, NULL, 'q'},
-                                           {"help", no_argument, NULL, 'h'},
-                                           {NULL, 0, NULL, 0}};
   iris_export_params params = iris_export_params_default();
-  const char *to = NULL, *output = NULL, *radiosity = NULL;
-  bool quiet = false;
-  long v;
-  opterr = 0;
-  optind = 1;
-  int c;
-  while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
-    switch (c) {
-      case OPT_TO:
-        if (!iris_cli_set_once(CMD, "--to", &to, optarg)) return IRIS_EXIT_USAGE;
-        break;
-      case 'o':
-        if (!iris_cli_set_once(CMD, "--output", &output, optarg)) return IRIS_EXIT_USAGE;
-        break;
-      case OPT_CAMERA:
-        if (!iris_cli_set_once(CMD, "--camera", &params.camera_name, optarg)) return IRIS_EXIT_USAGE;
-        if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
-        break;
-      case OPT_WIDTH:
-        if (!iris_cli_parse_int(CMD, "--width", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
-        params.width = (int)v;
-        break;
-      case OPT_HEIGHT:
-        if (!iris_cli_parse_int(CMD, "--height", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
-        params.height = (int)v;
-        break;
-      case OPT_SPP:
-        if (!iris_cli_parse_int(CMD, "--spp", optarg, 1, 1 << 24, &v)) return IRIS_EXIT_USAGE;
-        params.spp = (int)v;
-        break;
-      case OPT_SEED:
-        /* Cycles' seed is a non-negative 32-bit int. */
-        if (!iris_cli_parse_int(CMD, "--seed", optarg, 0, 2147483647L, &v)) return IRIS_EXIT_USAGE;
-        params.seed = (uint64_t)v;
-        params.has_seed = true;
-        break;
-      case OPT_DEPTH:
-        if (!iris_cli_parse_int(CMD, "--max-depth", optarg, 0, 1024, &v)) return IRIS_EXIT_USAGE;
-        params.max_depth = (int)v;
-        break;
-      case OPT_EMBED: params.embed_meshes = true; break;
-      case OPT_COVERAGE: params.coverage = true; break;
-      case OPT_RADIOSITY: {
-        static const char *const LEVELS[] = {"off", "low", "medium", "high"};
-        if (!iris_cli_set_once(CMD, "--pov-radiosity", &radiosity, optarg)) return IRIS_EXIT_USAGE;
-        int k = 0;
-        while (k < 4 && strcmp(optarg, LEVELS[k]) != 0) k++;
-        if (k == 4)
-          return iris_cli_usage_error(CMD, "unknown --pov-radiosity '%s' (off, low, medium or high)", optarg);
-        params.pov_radiosity = (iris_pov_radiosity)k;
-        break;
-      }
-      case 'q': quiet = true; break;
-      case 'h': print_help(); return IRIS_EXIT_OK;
-      default: return iris_cli_getopt_error(CMD, c, argv);
-    }
+  export_cli ec;
+  memset(&ec, 0, sizeof ec);
+  iris_env_options eo = iris_env_options_default();
+  iris_option_binding bind[] = {{&EXPORT_OPTIONS, &ec, 0}, {&IRIS_ENV_OPTIONS, &eo, 0}};
+  const char *input = NULL;
+  int ninputs = 0;
+  int prc = iris_options_parse(CMD, argc, argv, bind, 2, &input, 1, &ninputs);
+  if (prc < 0) {
+    print_help(bind, 2);
+    return IRIS_EXIT_OK;
   }
+  if (prc != 0) return prc;
+  const char *to = ec.to, *output = ec.output;
+  bool quiet = ec.quiet;
+  params.camera_name = ec.camera;
+  if (iris_options_seen(&bind[0], "width")) params.width = ec.width;
+  if (iris_options_seen(&bind[0], "height")) params.height = ec.height;
+  if (iris_options_seen(&bind[0], "spp")) params.spp = ec.spp;
+  if (iris_options_seen(&bind[0], "seed")) {
+    params.seed = (uint64_t)ec.seed;
+    params.has_seed = true;
+  }
+  if (iris_options_seen(&bind[0], "max-depth")) params.max_depth = ec.max_depth;
+  params.embed_meshes = ec.embed;
+  params.coverage = ec.coverage;
+  const bool radiosity = iris_options_seen(&bind[0], "pov-radiosity");
+  if (radiosity) params.pov_radiosity = (iris_pov_radiosity)ec.radiosity;
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
   /* Everything that can be checked is checked before any work starts. */
-  if (argc - optind == 0) return iris_cli_usage_error(CMD, "no input");
-  if (argc - optind > 1) return iris_cli_usage_error(CMD, "one input only (got '%s' and '%s')", argv[optind], argv[optind + 1]);
-  const char *input = argv[optind];
+  if (ninputs == 0) return iris_cli_usage_error(CMD, "no input");
   if (!to) return iris_cli_usage_error(CMD, "missing --to blender|pov");
   bool blender = strcmp(to, "blender") == 0;
   if (!blender && strcmp(to, "pov") != 0)
@@ -142,19 +116,25 @@ int iris_cmd_export(int argc, char **argv) {
   if (!blender && strcmp(ext, "pov") != 0)
     return iris_cli_usage_error(CMD, "POV-Ray output '%s' must end in .pov", output);
   if (blender && params.coverage) return iris_cli_usage_error(CMD, "--pov-coverage needs --to pov");
+  if (!blender && params.embed_meshes) return iris_cli_usage_error(CMD, "--embed needs --to blender");
   if (blender && radiosity) return iris_cli_usage_error(CMD, "--pov-radiosity needs --to pov");
   if (params.coverage && radiosity && params.pov_radiosity != IRIS_POV_RADIOSITY_OFF)
     return iris_cli_usage_error(CMD, "--pov-coverage and --pov-radiosity conflict (coverage has no light)");
-  if (!blender && params.embed_meshes) return iris_cli_usage_error(CMD, "--embed needs --to blender");
   if (!blender && (params.spp > 0 || params.has_seed))
     return iris_cli_usage_error(CMD, "--spp and --seed apply to --to blender only");
   if (!iris_cli_output_folder_ok(CMD, output)) return IRIS_EXIT_USAGE;
   if (iris_path_exists(input) && iris_cli_same_file(input, output))
     return iris_cli_usage_error(CMD, "output '%s' is also the input", output);
 
-  iris_scene *scene = NULL;
-  int rc = iris_cli_load_scene(CMD, input, params.camera_name, NULL, &scene);
+  int rc = iris_env_options_check(CMD, &bind[1], true);
   if (rc != IRIS_EXIT_OK) return rc;
+  iris_scene *scene = NULL;
+  rc = iris_cli_load_scene(CMD, input, params.camera_name, NULL, &scene);
+  if (rc != IRIS_EXIT_OK) return rc;
+  if ((rc = iris_env_options_apply(CMD, &bind[1], scene)) != IRIS_EXIT_OK) {
+    iris_scene_destroy(scene);
+    return rc;
+  }
   iris_error err;
   iris_error_clear(&err);
   iris_status status = blender ? iris_export_blender(scene, output, &params, &err) : iris_export_pov(scene, output, &params, &err);

@@ -1,6 +1,6 @@
 /* `iris import INPUT... -o SCENE.json`: imports OBJ/PLY/glTF files (and iris
  * scenes), merges them and writes one iris scene (docs/cli.md). */
-#include <getopt.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,24 +11,39 @@
 #include "importers/import.h"
 #include "scene/scene.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 
 static const char *const CMD = "import";
 
-static void print_help(void) {
+typedef struct import_cli {
+  const char *output, *camera;
+  bool weld, no_normals, quiet;
+} import_cli;
+
+static const iris_option IMPORT_ROWS[] = {
+    {"output", 'o', IRIS_OPT_STRING, "FILE", 0, 0, offsetof(import_cli, output),
+     "scene JSON to write (required; must end in .json)", NULL},
+    {"camera", 0, IRIS_OPT_STRING, "NAME", 0, 0, offsetof(import_cli, camera),
+     "make the camera called NAME the scene's camera (the\n"
+     "first one, which render uses); error if there is none", NULL},
+    {"weld", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(import_cli, weld),
+     "weld coincident vertices of OBJ/PLY meshes", NULL},
+    {"no-normals", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(import_cli, no_normals),
+     "do not compute normals for meshes that have none", NULL},
+    {"quiet", 'q', IRIS_OPT_FLAG, NULL, 0, 0, offsetof(import_cli, quiet), "print no warnings or summary", NULL},
+};
+static const iris_option_group IMPORT_OPTIONS = {"Options", IMPORT_ROWS,
+                                                 sizeof IMPORT_ROWS / sizeof IMPORT_ROWS[0]};
+
+static void print_help(const iris_option_binding *b, size_t n) {
   printf("Usage: iris import INPUT... -o SCENE.json [OPTIONS]\n"
          "\n"
          "Converts OBJ (+MTL), PLY, glTF 2.0 (.gltf/.glb) files and iris scenes (.json)\n"
          "into one iris scene: SCENE.json plus its meshes in SCENE.meshes/ (and\n"
          "embedded textures in SCENE.textures/). Several inputs are merged in order.\n"
-         "\n"
-         "Options:\n"
-         "  -o, --output FILE  scene JSON to write (required; must end in .json)\n"
-         "      --camera NAME  make the camera called NAME the scene's camera (the\n"
-         "                     first one, which render uses); error if there is none\n"
-         "      --weld         weld coincident vertices of OBJ/PLY meshes\n"
-         "      --no-normals   do not compute normals for meshes that have none\n"
-         "  -q, --quiet        print no warnings or summary\n"
-         "  -h, --help         show this help\n"
+         "\n");
+  iris_options_help(b, n);
+  printf("  -h, --help              show this help\n"
          "\n"
          "Exit status: 0 success, 2 bad usage or bad input (nothing written), 1 other\n"
          "failure. Outputs are written atomically.\n");
@@ -56,42 +71,27 @@ static bool select_camera(iris_scene *s, const char *name) {
 }
 
 int iris_cmd_import(int argc, char **argv) {
-  enum { OPT_CAMERA = 256, OPT_WELD, OPT_NO_NORMALS };
-  static const struct option longopts[] = {{"output", required_argument, NULL, 'o'},
-                                           {"camera", required_argument, NULL, OPT_CAMERA},
-                                           {"weld", no_argument, NULL, OPT_WELD},
-                                           {"no-normals", no_argument, NULL, OPT_NO_NORMALS},
-                                           {"quiet", no_argument, NULL, 'q'},
-                                           {"help", no_argument, NULL, 'h'},
-                                           {NULL, 0, NULL, 0}};
   iris_import_options opts = iris_import_options_default();
-  const char *output = NULL;
-  bool quiet = false;
-  opterr = 0;
-  optind = 1;
-  int c;
-  /* "+" would stop at the first input; GNU permutation lets options follow inputs. */
-  while ((c = getopt_long(argc, argv, ":o:qh", longopts, NULL)) != -1) {
-    switch (c) {
-      case 'o':
-        if (!iris_cli_set_once(CMD, "--output", &output, optarg)) return IRIS_EXIT_USAGE;
-        break;
-      case OPT_CAMERA:
-        if (!iris_cli_set_once(CMD, "--camera", &opts.camera_name, optarg)) return IRIS_EXIT_USAGE;
-        if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
-        break;
-      case OPT_WELD: opts.weld = true; break;
-      case OPT_NO_NORMALS: opts.compute_normals = false; break;
-      case 'q': quiet = true; break;
-      case 'h': print_help(); return IRIS_EXIT_OK;
-      default: return iris_cli_getopt_error(CMD, c, argv);
-    }
+  import_cli ic;
+  memset(&ic, 0, sizeof ic);
+  iris_env_options eo = iris_env_options_default();
+  iris_option_binding bind[] = {{&IMPORT_OPTIONS, &ic, 0}, {&IRIS_ENV_OPTIONS, &eo, 0}};
+  const char *inputs[256];
+  int ninputs = 0;
+  int prc = iris_options_parse(CMD, argc, argv, bind, 2, inputs, 256, &ninputs);
+  if (prc < 0) {
+    print_help(bind, 2);
+    return IRIS_EXIT_OK;
   }
+  if (prc != 0) return prc;
+  const char *output = ic.output;
+  bool quiet = ic.quiet;
+  opts.camera_name = ic.camera;
+  opts.weld = ic.weld;
+  if (ic.no_normals) opts.compute_normals = false;
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
   /* Everything that can be checked is checked before any work starts. */
-  int ninputs = argc - optind;
-  char **inputs = argv + optind;
   if (ninputs == 0) return iris_cli_usage_error(CMD, "no input file");
   if (!output) return iris_cli_usage_error(CMD, "missing --output SCENE.json");
   char ext[16];
@@ -111,6 +111,8 @@ int iris_cmd_import(int argc, char **argv) {
     if (iris_cli_same_file(inputs[i], output))
       return iris_cli_usage_error(CMD, "output '%s' is also an input", output);
   }
+  int erc = iris_env_options_check(CMD, &bind[1], true);
+  if (erc != IRIS_EXIT_OK) return erc;
 
   iris_error err;
   iris_error_clear(&err);
@@ -137,6 +139,11 @@ int iris_cmd_import(int argc, char **argv) {
                                   names[0] ? names : "none");
     iris_scene_destroy(scene);
     return rc;
+  }
+  int arc = iris_env_options_apply(CMD, &bind[1], scene);
+  if (arc != IRIS_EXIT_OK) {
+    iris_scene_destroy(scene);
+    return arc;
   }
   /* Messages about the merged scene name the output it was going to be. */
   free(scene->source_path);

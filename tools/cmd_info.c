@@ -10,6 +10,7 @@
 #include "importers/import.h"
 #include "scene/scene.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 
 static const char *const CMD = "info";
 static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
@@ -143,10 +144,19 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
   } else {
     cJSON_AddNullToObject(o, "bounds");
   }
-  if (s->has_environment)
+  if (s->has_environment && !s->environment_map.path)
     cJSON_AddItemToObject(o, "environment", vec(s->environment));
   else
     cJSON_AddNullToObject(o, "environment");
+  if (s->environment_map.path) {
+    cJSON *m = cJSON_AddObjectToObject(o, "environment_map");
+    cJSON_AddStringToObject(m, "path", s->environment_map.path);
+    cJSON_AddNumberToObject(m, "strength", s->environment_map.strength);
+    cJSON_AddNumberToObject(m, "rotation", s->environment_map.rotation);
+  } else {
+    cJSON_AddNullToObject(o, "environment_map");
+  }
+  cJSON_AddBoolToObject(o, "has_light", iris_scene_has_emitter(s));
   char *text = cJSON_Print(o);
   if (text) printf("%s\n", text);
   free(text);
@@ -190,7 +200,10 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
            (double)(st->hi.x - st->lo.x), (double)(st->hi.y - st->lo.y), (double)(st->hi.z - st->lo.z));
   else
     printf("bounds       none (no instances)\n");
-  if (s->has_environment)
+  if (s->environment_map.path)
+    printf("environment  map %s, strength %g, rotation %g deg\n", s->environment_map.path,
+           (double)s->environment_map.strength, (double)s->environment_map.rotation);
+  else if (s->has_environment)
     printf("environment  %g %g %g\n", (double)s->environment[0], (double)s->environment[1],
            (double)s->environment[2]);
   else
@@ -226,6 +239,7 @@ int iris_cmd_info(int argc, char **argv) {
   iris_import_options opts = iris_import_options_default();
   if (iris_import_file(path, &opts, &scene, &err) != IRIS_OK) return iris_cli_report(&err);
   scene_stats st = compute_stats(scene);
+  iris_warn_if_lightless(scene, path);
   if (json)
     print_json(path, scene, &st);
   else

@@ -2,6 +2,7 @@
  * loads the input (an iris scene, an importable file or a built-in scene name),
  * renders and writes EXR/PNG. docs/cli.md ("render") lists every flag. */
 #include <math.h>
+#include <stddef.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -17,66 +18,63 @@
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 
 static const char *CMD = "render";
 
-static void print_help(void) {
+/* The flags only render takes; the shared groups are in tools/options.c. */
+typedef struct render_cli {
+  const char *output, *png, *pixel_bounds, *aov;
+  bool variance, quiet, json;
+  double exposure;
+  uint64_t sample_offset;
+} render_cli;
+
+static const iris_option OUTPUT_ROWS[] = {
+    {"output", 'o', IRIS_OPT_STRING, "FILE", 0, 0, offsetof(render_cli, output),
+     "OpenEXR output (float RGB + metadata)", NULL},
+    {"variance", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(render_cli, variance),
+     "also write var.R/G/B: variance of each pixel's mean", NULL},
+    {"png", 0, IRIS_OPT_STRING, "FILE", 0, 0, offsetof(render_cli, png),
+     "8-bit sRGB PNG as well (or instead)", NULL},
+    {"exposure", 0, IRIS_OPT_DOUBLE, "EV", -64, 64, offsetof(render_cli, exposure),
+     "scale the PNG by 2^EV (default 0)", NULL},
+    {"aov", 0, IRIS_OPT_STRING, "caches", 0, 0, offsetof(render_cli, aov),
+     "also write OUT-caches.png: the image with cache positions\n"
+     "marked (green: from camera rays, red: from photons)", NULL},
+    {"quiet", 'q', IRIS_OPT_FLAG, NULL, 0, 0, offsetof(render_cli, quiet), "no progress bar or messages", NULL},
+    {"json", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(render_cli, json), "JSON summary on stdout", NULL},
+};
+static const iris_option PARTITION_ROWS[] = {
+    {"sample-offset", 0, IRIS_OPT_U64, "K", 0, 0, offsetof(render_cli, sample_offset),
+     "render sample indices K .. K+spp-1 (default 0)", NULL},
+    {"pixel-bounds", 0, IRIS_OPT_STRING, "x0,y0,x1,y1", 0, 0, offsetof(render_cli, pixel_bounds),
+     "render only this window of the frame\n(half-open; the output image is the window)", NULL},
+};
+static const iris_option_group OUTPUT_OPTIONS = {"Output and reporting", OUTPUT_ROWS,
+                                                 sizeof OUTPUT_ROWS / sizeof OUTPUT_ROWS[0]};
+static const iris_option_group PARTITION_OPTIONS = {
+    "Partitioned renders (merge the parts with iris merge; docs/distributed.md)", PARTITION_ROWS,
+    sizeof PARTITION_ROWS / sizeof PARTITION_ROWS[0]};
+
+static void print_help(const iris_option_binding *b, size_t n) {
   printf(
       "Usage: iris render INPUT [-o OUT.exr] [--png OUT.png] [options]\n"
       "\n"
       "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene).\n"
       "Built-in scenes:");
   int column = 16;
-  for (const char *const *n = iris_builtin_names(); *n; n++) {
-    if (column + (int)strlen(*n) + 2 > 78) {
+  for (const char *const *nm = iris_builtin_names(); *nm; nm++) {
+    if (column + (int)strlen(*nm) + 2 > 78) {
       printf("\n ");
       column = 1;
     }
-    printf(" %s", *n);
-    column += (int)strlen(*n) + 1;
+    printf(" %s", *nm);
+    column += (int)strlen(*nm) + 1;
   }
+  printf("\n\n");
+  iris_options_help(b, n);
   printf(
-      "\n\n"
-      "Output:\n"
-      "  -o, --output FILE   OpenEXR output (float RGB + metadata)\n"
-      "      --variance      also write var.R/G/B: variance of each pixel's mean\n"
-      "      --png FILE      8-bit sRGB PNG as well (or instead)\n"
-      "      --exposure EV   scale the PNG by 2^EV (default 0)\n"
-      "Sampling:\n"
-      "      --spp N         samples per pixel (default: the scene's, else 64)\n"
-      "      --time SECONDS  whole passes until SECONDS have passed (not with --spp)\n"
-      "      --seed N        random seed (default: the scene's, else 0)\n"
-      "      --method M      bsdf | nee | mis (default) | guided | guided-nee\n"
-      "      --sampler S     sobol (default: Owen-scrambled Sobol) | independent\n"
-      "      --light-sampling M  emitter triangles: solid-angle (default, where it helps) | area\n"
-      "      --max-depth B   bounces as Cycles counts them, 0 = direct light (default 64)\n"
-      "      --threads N     worker threads (default: all cores); same image for any N\n"
-      "Partitioned renders (merge the parts with iris merge; docs/distributed.md):\n"
-      "      --sample-offset K   render sample indices K .. K+spp-1 (default 0)\n"
-      "      --pixel-bounds x0,y0,x1,y1   render only this window of the frame\n"
-      "                      (half-open; the output image is the window)\n"
-      "Guiding (--method guided | guided-nee; docs/guiding.md; unset = from the scene):\n"
-      "      --photons N     photon paths        --caches N      caches\n"
-      "      --cache-res R   map texels per side --cache-k K     photons per cache\n"
-      "      --pdf-floor F   texel probability floor (default 0.0002)\n"
-      "      --alpha-max A   cap on the cache-sampling probability (default 0.5 for\n"
-      "                      guided-nee, 0.7 for guided)\n"
-      "      --cos-min C     cache normal agreement needed (default 0.9)\n"
-      "      --splat nearest|bilinear   photon splatting (default bilinear)\n"
-      "      --photon-lights power|area   photons leave lights in proportion to\n"
-      "                      power (default) or, as the thesis, emitters by area\n"
-      "      --force-guiding build caches even where guiding would be skipped\n"
-      "      --dump-caches DIR   write pdf and photon-count PNGs of the caches that\n"
-      "                      serve a 4x3 grid of pixels (DIR/caches.txt lists them)\n"
-      "      --aov caches    also write OUT-caches.png: the image with cache positions\n"
-      "                      marked (green: from camera rays, red: from photons)\n"
-      "Camera:\n"
-      "      --camera NAME   scene camera to use (default: the first; none: auto-framed)\n"
-      "      --width W, --height H   film size (default: the scene's, else from the\n"
-      "                      camera's aspect ratio, 512 pixels high)\n"
-      "Reporting:\n"
-      "      --quiet         no progress bar or messages\n"
-      "      --json          JSON summary on stdout\n"
       "\n"
       "Exit status: 0 done, 2 bad usage or input, 1 other failure, 130 (SIGINT) or\n"
       "143 (SIGTERM) when interrupted: the image of the passes done is still written.\n");
@@ -194,155 +192,53 @@ int iris_cmd_render(int argc, char **argv) {
   iris_render_params p = iris_render_params_default();
   iris_guiding_params gp = iris_guiding_params_default();
   iris_guiding_marks marks = {0, 0, NULL};
-  bool aov_caches = false;
-  const char *input = NULL, *out_exr = NULL, *out_png = NULL, *camera = NULL;
-  bool variance = false, quiet = false, json = false, have_spp = false, have_seed = false;
-  double exposure = 0.0;
-  for (int i = 1; i < argc; i++) {
-    char name[64];
-    const char *val;
-    const char *a = iris_cli_split_option(argv[i], name, sizeof name, &val);
-#define NEED_VALUE()                                                                           \
-  do {                                                                                         \
-    if (!iris_cli_take_value(CMD, a, argc, argv, &i, &val)) return IRIS_EXIT_USAGE;            \
-  } while (0)
-    long lv;
-    double dv;
-    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-      print_help();
-      return IRIS_EXIT_OK;
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      NEED_VALUE();
-      out_exr = val;
-    } else if (strcmp(a, "--png") == 0) {
-      NEED_VALUE();
-      out_png = val;
-    } else if (strcmp(a, "--exposure") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_float(CMD, a, val, -64, 64, &exposure)) return IRIS_EXIT_USAGE;
-    } else if (strcmp(a, "--variance") == 0) {
-      variance = true;
-    } else if (strcmp(a, "--spp") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 1 << 24, &lv)) return IRIS_EXIT_USAGE;
-      p.spp = (int)lv;
-      have_spp = true;
-    } else if (strcmp(a, "--time") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_float(CMD, a, val, 1e-3, 1e7, &dv)) return IRIS_EXIT_USAGE;
-      p.time_budget = dv;
-    } else if (strcmp(a, "--seed") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_u64(CMD, a, val, &p.seed)) return IRIS_EXIT_USAGE;
-      have_seed = true;
-    } else if (strcmp(a, "--method") == 0) {
-      NEED_VALUE();
-      if (!iris_method_parse(val, &p.method))
-        return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", val);
-    } else if (strcmp(a, "--light-sampling") == 0) {
-      NEED_VALUE();
-      if (!iris_triangle_sampling_parse(val, &p.light_sampling))
-        return iris_cli_usage_error(CMD, "unknown light sampling '%s' (solid-angle, area)", val);
-    } else if (strcmp(a, "--sampler") == 0) {
-      NEED_VALUE();
-      if (!iris_sampler_kind_parse(val, &p.sampler))
-        return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", val);
-    } else if (strcmp(a, "--max-depth") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 0, 1000000, &lv)) return IRIS_EXIT_USAGE;
-      p.max_depth = (int)lv;
-    } else if (strcmp(a, "--threads") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 4096, &lv)) return IRIS_EXIT_USAGE;
-      p.threads = (int)lv;
-    } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0) {
-      bool w = strcmp(a, "--width") == 0;
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 65536, &lv)) return IRIS_EXIT_USAGE;
-      if (w)
-        p.width = (int)lv;
-      else
-        p.height = (int)lv;
-    } else if (strcmp(a, "--photons") == 0 || strcmp(a, "--caches") == 0) {
-      bool photons = strcmp(a, "--photons") == 0;
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 1L << 40, &lv)) return IRIS_EXIT_USAGE;
-      if (photons)
-        gp.photons = lv;
-      else
-        gp.caches = lv;
-    } else if (strcmp(a, "--cache-res") == 0 || strcmp(a, "--cache-k") == 0) {
-      bool res = strcmp(a, "--cache-res") == 0;
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, res ? 256 : 1000000, &lv)) return IRIS_EXIT_USAGE;
-      if (res)
-        gp.cache_res = (int)lv;
-      else
-        gp.cache_k = (int)lv;
-    } else if (strcmp(a, "--pdf-floor") == 0 || strcmp(a, "--alpha-max") == 0 ||
-               strcmp(a, "--cos-min") == 0) {
-      NEED_VALUE();
-      bool cosmin = strcmp(a, "--cos-min") == 0;
-      if (!iris_cli_parse_float(CMD, a, val, cosmin ? -1.0 : 0.0, 1.0, &dv)) return IRIS_EXIT_USAGE;
-      if (strcmp(a, "--pdf-floor") == 0)
-        gp.pdf_floor = (float)dv;
-      else if (cosmin)
-        gp.cos_min = (float)dv;
-      else
-        gp.alpha_max = (float)dv;
-    } else if (strcmp(a, "--splat") == 0) {
-      NEED_VALUE();
-      if (strcmp(val, "nearest") == 0)
-        gp.splat = IRIS_SPLAT_NEAREST;
-      else if (strcmp(val, "bilinear") == 0)
-        gp.splat = IRIS_SPLAT_BILINEAR;
-      else
-        return iris_cli_usage_error(CMD, "unknown splat mode '%s' (nearest, bilinear)", val);
-    } else if (strcmp(a, "--photon-lights") == 0) {
-      NEED_VALUE();
-      if (strcmp(val, "power") == 0)
-        gp.photon_lights = IRIS_EMIT_BY_POWER;
-      else if (strcmp(val, "area") == 0)
-        gp.photon_lights = IRIS_EMIT_BY_AREA;
-      else
-        return iris_cli_usage_error(CMD, "unknown photon light choice '%s' (power, area)", val);
-    } else if (strcmp(a, "--force-guiding") == 0) {
-      gp.force = true;
-    } else if (strcmp(a, "--dump-caches") == 0) {
-      NEED_VALUE();
-      gp.dump_dir = val;
-    } else if (strcmp(a, "--aov") == 0) {
-      NEED_VALUE();
-      if (strcmp(val, "caches") != 0) return iris_cli_usage_error(CMD, "unknown AOV '%s' (caches)", val);
-      aov_caches = true;
-    } else if (strcmp(a, "--sample-offset") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_u64(CMD, a, val, &p.sample_offset)) return IRIS_EXIT_USAGE;
-      if (p.sample_offset > (1ull << 40))
-        return iris_cli_usage_error(CMD, "invalid value '%s' for %s (at most 2^40)", val, a);
-    } else if (strcmp(a, "--pixel-bounds") == 0) {
-      NEED_VALUE();
-      if (!parse_bounds(val, &p.bounds))
-        return iris_cli_usage_error(CMD, "invalid value '%s' for %s (x0,y0,x1,y1 with "
-                                         "0 <= x0 < x1 and 0 <= y0 < y1)", val, a);
-    } else if (strcmp(a, "--camera") == 0) {
-      NEED_VALUE();
-      camera = val;
-    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-      quiet = true;
-    } else if (strcmp(a, "--json") == 0) {
-      json = true;
-    } else if (a[0] == '-' && a[1] != 0) {
-      return iris_cli_usage_error(CMD, "unknown option '%s'", argv[i]);
-    } else {
-      if (input) return iris_cli_usage_error(CMD, "more than one input ('%s' and '%s')", input, a);
-      input = a;
-    }
-    if (val && (strcmp(a, "--variance") == 0 || strcmp(a, "--quiet") == 0 ||
-                strcmp(a, "--json") == 0 || strcmp(a, "--force-guiding") == 0))
-      return iris_cli_usage_error(CMD, "option %s takes no value", a);
-#undef NEED_VALUE
+  render_cli rc_opts;
+  memset(&rc_opts, 0, sizeof rc_opts);
+  iris_render_options ro;
+  memset(&ro, 0, sizeof ro);
+  iris_env_options eo = iris_env_options_default();
+  iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0},
+                                {&PARTITION_OPTIONS, &rc_opts, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0},
+                                {&IRIS_ENV_OPTIONS, &eo, 0}};
+  const size_t nbind = sizeof bind / sizeof bind[0];
+  const char *input = NULL;
+  int operands = 0;
+  int prc = iris_options_parse(CMD, argc, argv, bind, nbind, &input, 1, &operands);
+  if (prc < 0) {
+    print_help(bind, nbind);
+    return IRIS_EXIT_OK;
   }
+  if (prc != 0) return prc;
+  const iris_option_binding *rb = &bind[1];
+  const char *out_exr = rc_opts.output, *out_png = rc_opts.png, *camera = ro.camera;
+  bool variance = rc_opts.variance, quiet = rc_opts.quiet, json = rc_opts.json;
+  bool have_spp = iris_options_seen(rb, "spp"), have_seed = iris_options_seen(rb, "seed");
+  double exposure = rc_opts.exposure;
+  if (have_spp) p.spp = ro.spp;
+  if (iris_options_seen(rb, "time")) p.time_budget = ro.time;
+  if (have_seed) p.seed = ro.seed;
+  if (ro.method && !iris_method_parse(ro.method, &p.method))
+    return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", ro.method);
+  p.sampler = (iris_sampler_kind)ro.sampler;               /* 0 (sobol) unless given */
+  p.light_sampling = (iris_triangle_sampling)ro.light_sampling;
+  if (iris_options_seen(rb, "max-depth")) p.max_depth = ro.max_depth;
+  if (iris_options_seen(rb, "threads")) p.threads = ro.threads;
+  if (iris_options_seen(rb, "width")) p.width = ro.width;
+  if (iris_options_seen(rb, "height")) p.height = ro.height;
+  bool aov_caches = false;
+  if (rc_opts.aov) {
+    if (strcmp(rc_opts.aov, "caches") != 0) return iris_cli_usage_error(CMD, "unknown AOV '%s' (caches)", rc_opts.aov);
+    aov_caches = true;
+  }
+  p.sample_offset = rc_opts.sample_offset;
+  if (p.sample_offset > (1ull << 40))
+    return iris_cli_usage_error(CMD, "invalid value '%llu' for --sample-offset (at most 2^40)",
+                                (unsigned long long)p.sample_offset);
+  if (rc_opts.pixel_bounds && !parse_bounds(rc_opts.pixel_bounds, &p.bounds))
+    return iris_cli_usage_error(CMD, "invalid value '%s' for --pixel-bounds (x0,y0,x1,y1 with "
+                                     "0 <= x0 < x1 and 0 <= y0 < y1)", rc_opts.pixel_bounds);
+  int erc = iris_env_options_check(CMD, &bind[4], false);
+  if (erc != IRIS_EXIT_OK) return erc;
   /* Everything that can be checked is checked before any work starts. */
   if (!input) return iris_cli_usage_error(CMD, "no input scene given");
   if (!out_exr && !out_png) return iris_cli_usage_error(CMD, "no output: give -o OUT.exr and/or --png OUT.png");
@@ -371,6 +267,11 @@ int iris_cmd_render(int argc, char **argv) {
   iris_scene *scene = NULL;
   int rc = iris_cli_load_scene(CMD, input, camera, NULL, &scene);
   if (rc != IRIS_EXIT_OK) return rc;
+  if ((rc = iris_env_options_apply(CMD, &bind[4], scene)) != IRIS_EXIT_OK) {
+    iris_scene_destroy(scene);
+    return rc;
+  }
+  if (!quiet) iris_warn_if_lightless(scene, input);
   iris_error err;
   iris_error_clear(&err);
   iris_status st;

@@ -13,6 +13,7 @@
 #include "core/log.h"
 #include "validate/validate.h"
 #include "tools/cli.h"
+#include "tools/options.h"
 
 static const char *const CMD = "validate";
 
@@ -44,6 +45,9 @@ static void print_help(void) {
       "      --width W --height H  image size (must match a given reference)\n"
       "      --max-depth B         bounces as Cycles counts them (default: scene's, else 64)\n"
       "      --camera NAME         scene camera to use\n"
+      "Environment (replaces the scene's world; docs/format.md):\n"
+      "      --env FILE, --env-strength S, --env-rotation DEG, --env-color R,G,B\n"
+      "                            as `iris render` (iris render --help)\n"
       "Checks:\n"
       "      --tolerance T         allowed relative mean-energy difference (default 0.01)\n"
       "      --alpha A             family-wise significance of the z-tests (default 0.01)\n"
@@ -106,9 +110,10 @@ int iris_cmd_validate(int argc, char **argv) {
   enum {
     OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
     OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
-    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER, OPT_BLENDER_IMPORT
+    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER, OPT_BLENDER_IMPORT,
+    OPT_ENV = 512
   };
-  static const struct option longopts[] = {
+  static const struct option own_opts[] = {
       {"method", required_argument, NULL, OPT_METHOD},
       {"spp", required_argument, NULL, OPT_SPP},
       {"reference", required_argument, NULL, OPT_REFERENCE},
@@ -130,8 +135,15 @@ int iris_cmd_validate(int argc, char **argv) {
       {"strict-pixels", no_argument, NULL, OPT_STRICT},
       {"sampler", required_argument, NULL, OPT_SAMPLER},
       {"quiet", no_argument, NULL, 'q'},
-      {"help", no_argument, NULL, 'h'},
-      {NULL, 0, NULL, 0}};
+      {"help", no_argument, NULL, 'h'}};
+  /* the shared environment rows (tools/options.h) after validate's own */
+  struct option longopts[sizeof own_opts / sizeof own_opts[0] + IRIS_OPTIONS_MAX_ROWS + 1];
+  memset(longopts, 0, sizeof longopts);
+  memcpy(longopts, own_opts, sizeof own_opts);
+  iris_options_getopt_rows(&IRIS_ENV_OPTIONS, OPT_ENV, longopts + sizeof own_opts / sizeof own_opts[0]);
+  iris_env_options eo = iris_env_options_default();
+  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0};
+  int erc = 0;
   iris_validate_params p = iris_validate_params_default();
   bool blender = false, refresh = false, have_blender_spp = false, blender_import = false;
   bool have_tolerance = false;
@@ -210,10 +222,20 @@ int iris_cmd_validate(int argc, char **argv) {
       case OPT_STRICT: p.pixel_test_gates = true; break;
       case 'q': p.quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
-      default: return iris_cli_getopt_error(CMD, c, argv);
+      default:
+        if (iris_options_getopt_take(CMD, &envb, OPT_ENV, c, optarg, &erc)) {
+          if (erc) return erc;
+          break;
+        }
+        return iris_cli_getopt_error(CMD, c, argv);
     }
   }
   if (p.quiet) iris_log_set_level(IRIS_LOG_QUIET);
+  if ((erc = iris_env_options_check(CMD, &envb, true)) != IRIS_EXIT_OK) return erc;
+  p.world.map = eo.map;
+  p.world.strength = eo.strength;
+  p.world.rotation = eo.rotation;
+  p.world.color = iris_options_seen(&envb, "env-color") ? eo.color : NULL;
   if (!references) references = default_references_dir();
 
   iris_error err;

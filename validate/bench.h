@@ -15,6 +15,7 @@
 
 #include "core/error.h"
 #include "renderer/integrator.h"
+#include "validate/validate.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -40,6 +41,7 @@ typedef struct iris_bench_progress {
 typedef struct iris_bench_params {
   const char *const *inputs;  /* files or built-in scene names (validate.h's loader) */
   int input_count;
+  iris_world_override world;  /* zeroed: each scene's own world (validate.h) */
   iris_method methods[IRIS_METHOD_COUNT];
   int method_count;
   iris_sampler_kind sampler;  /* of the timed iris runs (the reference's is fixed) */

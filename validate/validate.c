@@ -62,6 +62,12 @@ iris_validate_params iris_validate_params_default(void) {
   return p;
 }
 
+bool iris_world_override_apply(const iris_world_override *w, iris_scene *scene) {
+  if (w->map) return iris_scene_set_environment_map(scene, w->map, w->strength, w->rotation);
+  if (w->color) iris_scene_set_environment_color(scene, w->color);
+  return true;
+}
+
 iris_status iris_validate_load_scene(const char *input, const char *camera_name, iris_scene **out,
                                      iris_error *err) {
   *out = NULL;
@@ -530,6 +536,9 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
   }
   iris_scene *scene = NULL;
   st = iris_validate_load_scene(p.input, p.camera_name, &scene, err);
+  if (st == IRIS_OK && !iris_world_override_apply(&p.world, scene))
+    st = iris_error_set(err, IRIS_ERR_NOMEM, p.input, 0, NULL, "out of memory");
+  if (st == IRIS_OK) iris_scene_warn_if_lightless(scene, p.input);
   if (st == IRIS_OK) st = iris_mkdir_p(p.out_dir, err);
   if (st != IRIS_OK) goto done;
   snprintf(res->scene, sizeof res->scene, "%s", p.input);

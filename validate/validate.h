@@ -44,8 +44,20 @@ typedef enum iris_reference_source {
   IRIS_REFERENCE_BLENDER   /* Blender run on the exported script */
 } iris_reference_source;
 
+/* A world that replaces the scene's after loading it (the --env flags of
+ * bench and validate): a map when `map` is set, else a constant colour when
+ * `color` is set; all NULL: the scene's own. */
+typedef struct iris_world_override {
+  const char *map;
+  float strength, rotation;
+  const float *color;
+} iris_world_override;
+/* Applies the override; false when out of memory. */
+bool iris_world_override_apply(const iris_world_override *w, iris_scene *scene);
+
 typedef struct iris_validate_params {
   const char *input;
+  iris_world_override world; /* zeroed: the scene's world */
   iris_method methods[IRIS_METHOD_COUNT];
   int method_count;         /* 0: mis */
   iris_sampler_kind sampler; /* iris's sampler (default sobol) */

@@ -301,6 +301,12 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
 
 /* ---- budget ---------------------------------------------------------------- */
 
+/* Share of the environment in the lights' power (photon emission by power). */
+static double environment_share(const iris_lights *L) {
+  if (L->environment < 0 || !(L->total_power > 0.0)) return 0.0;
+  return (double)L->entries[L->environment].power / L->total_power;
+}
+
 static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int *stride) {
   int64_t pixels = (int64_t)s->camera->width * s->camera->height;
   if (p->caches <= 0) {
@@ -321,6 +327,10 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
     int64_t n = p->caches * (int64_t)p->cache_k / 20;
     size_t lights = s->lights->group_count; /* emitting instances + punctual + sky, not triangles */
     n = (int64_t)((double)n * (1.0 + 0.05 * (double)(lights > 1 ? lights - 1 : 0)));
+    /* Environment photons leave a disk covering the whole scene, and many of
+     * them hit nothing or only the outside of what the camera sees: in
+     * proportion to the sky's share of the power, up to twice as many paths. */
+    n = (int64_t)((double)n * (1.0 + environment_share(s->lights)));
     p->photons = n < 100000 ? 100000 : (n > 4000000 ? 4000000 : n);
   }
   /* Measured (docs/guiding.md, "Parameters around the defaults"): with light
@@ -359,6 +369,31 @@ static float pick_radius2(const iris_guiding *g, float *spacing) {
   return r2 > 0.0f ? r2 : INFINITY;
 }
 
+/* Fraction of indirect photons the skip rule looks at. Over all stored
+ * photons, except in scenes lit mostly by the environment: there most
+ * photons land directly on outside surfaces the camera never sees (the roof
+ * and walls of a room lit through a window), so the fraction is taken over
+ * up to 4096 photons (an even stride through the map) on surfaces the
+ * camera sees: unoccluded from the camera and facing it. */
+static double indirect_share(const iris_guide_setup *s, const iris_photon_map *ph) {
+  if (ph->count == 0) return 0.0;
+  double all = (double)ph->indirect / (double)ph->count;
+  if (environment_share(s->lights) < 0.5) return all;
+  size_t step = ph->count > 4096 ? ph->count / 4096 : 1, seen = 0, indirect = 0;
+  iris_vec3 eye = s->camera->origin;
+  for (size_t i = 0; i < ph->count; i += step) {
+    const iris_photon *q = &ph->photons[i];
+    iris_vec3 to_eye = iris_sub(eye, q->p);
+    if (iris_dot(to_eye, q->n) <= 0.0f) continue;
+    iris_ray r = iris_spawn_ray_to(q->p, q->n, eye, iris_neg(iris_normalize(to_eye)));
+    r.tmax = 1.0f; /* the eye is a point, not a surface */
+    if (iris_accel_occluded(s->accel, &r)) continue;
+    seen++;
+    indirect += q->bounce > 0;
+  }
+  return seen > 0 ? (double)indirect / (double)seen : all;
+}
+
 static void skip(iris_guiding *g, const char *why) {
   g->stats.skipped = true;
   snprintf(g->stats.reason, sizeof g->stats.reason, "%s", why);
@@ -384,7 +419,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   /* Mostly direct light (Veach: 20% of the photons indirect) is light
    * sampling's job; there the guide costs more per sample than it saves
    * (docs/guiding.md, benchmark). Door 75%, Cornell 65%. */
-  if (p->use_nee && !p->force && (double)photons.indirect < 0.3 * (double)photons.count) {
+  if (p->use_nee && !p->force && indirect_share(s, &photons) < 0.3) {
     iris_photons_destroy(&photons);
     skip(g, "the scene is lit mostly directly (< 30% indirect photons): light sampling covers it");
     return IRIS_OK;

@@ -1,0 +1,60 @@
+/* Equirectangular environment maps: the decoded, validated texels of an
+ * OpenEXR or Radiance .hdr map (times its strength), the direction <-> texel
+ * mapping that matches Blender's Environment Texture for glTF scenes, and
+ * importance sampling of directions in proportion to luminance x sin(theta)
+ * (a marginal CDF over rows and one conditional CDF per row; piecewise
+ * constant, so the per-texel pdf in solid angle is exact). Lookups are
+ * nearest-texel ("Closest" in Blender), which keeps the sampled density and
+ * the radiance on the same texels. docs/format.md and docs/rendering.md. */
+#ifndef IRIS_RENDERER_ENVMAP_H
+#define IRIS_RENDERER_ENVMAP_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "core/error.h"
+#include "core/math.h"
+#include "renderer/sampling.h"
+#include "scene/scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct iris_envmap {
+  int width, height;
+  float *rgb;             /* 3 * width * height, linear radiance (strength applied), row 0 top */
+  float cos_rot, sin_rot; /* rotation about +Y */
+  iris_distrib1d rows;    /* marginal over rows: sum of the row's weights */
+  iris_distrib1d *cols;   /* one conditional per row (height of them) */
+  double mean_luminance;  /* (1 / 4pi) * integral of the luminance over the sphere */
+  float mean_rgb[3];      /* the same per channel */
+} iris_envmap;
+
+/* Reads and checks the map (extension .exr or .hdr, or by the file's magic):
+ * a missing, unreadable or empty file, one with NaN, Inf or negative texels,
+ * or a map that is black everywhere is an error naming the file; a map that
+ * is not 2:1 gets a warning (it is still usable). Then builds the sampling
+ * tables. */
+iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, iris_error *err);
+/* Only the checks of iris_envmap_load (for commands that do not render). */
+iris_status iris_envmap_check(const char *path, iris_error *err);
+void iris_envmap_destroy(iris_envmap *env);
+
+/* Map coordinates of unit direction d: s in [0,1) across, t in [0,1] down. */
+void iris_envmap_dir_to_st(const iris_envmap *env, iris_vec3 d, float *s, float *t);
+/* Unit direction of map coordinates (s, t). */
+iris_vec3 iris_envmap_st_to_dir(const iris_envmap *env, float s, float t);
+
+/* Radiance arriving from direction d (unit; travelling towards -d). */
+iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d);
+/* Samples a direction with two uniform numbers; returns false when nothing
+ * can be sampled. *pdf is the solid-angle density. */
+bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf);
+/* Solid-angle density with which iris_envmap_sample returns d. */
+float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

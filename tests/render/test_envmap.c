@@ -1,0 +1,279 @@
+/* render.envmap: environment maps (renderer/envmap.h) and their use as a light.
+ *  - direction -> (s, t) -> direction round trip, with rotation;
+ *  - the documented texel of six axis directions (docs/format.md);
+ *  - chi-square of iris_envmap_sample against iris_envmap_pdf on a map with a
+ *    sharp bright block, a smooth gradient and black rows; the pdf integrates to 1;
+ *  - chi-square of light sampling (iris_lights_sample) of a scene lit by the map
+ *    against iris_lights_pdf_environment; photon emission's mean power equals
+ *    the map's power through the scene's disk (pi r^2 x 4 pi x mean radiance);
+ *  - white furnace: a diffuse sphere of albedo rho inside a uniform map of
+ *    radiance 1 is rho everywhere (convex: no interreflection), for every
+ *    method; a constant sky (environment.radiance) gives the same image
+ *    within statistical error. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "chi2.h"
+#include "core/fileio.h"
+#include "core/image.h"
+#include "renderer/envmap.h"
+#include "renderer/guiding/guiding.h"
+#include "renderer/lights.h"
+#include "renderer/render.h"
+#include "scenes/builtin.h"
+
+static char g_dir[1024];
+
+static void write_map(const char *path, int w, int h, int kind) {
+  static const char *const rgb[3] = {"R", "G", "B"};
+  iris_image img;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_image_create(&img, w, h, 3, rgb, &err), &err);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *p = &img.data[3 * ((size_t)y * (size_t)w + (size_t)x)];
+      if (kind == 0) {
+        p[0] = p[1] = p[2] = 1.0f;
+      } else {
+        float v = 0.05f + 0.5f * (float)x / (float)w;
+        if (y == 0 || y == h - 1) v = 0.0f;                     /* black polar rows */
+        if (x >= w / 3 && x < w / 3 + 3 && y >= h / 4 && y < h / 4 + 2) v = 200.0f; /* a sun */
+        p[0] = v;
+        p[1] = 0.7f * v;
+        p[2] = 0.3f * v + 0.01f;
+      }
+    }
+  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
+  iris_image_destroy(&img);
+}
+
+static bool env_sample(void *ctx, const double u[3], double dir[3]) {
+  iris_vec3 d;
+  float pdf;
+  if (!iris_envmap_sample((const iris_envmap *)ctx, (float)u[0], (float)u[1], &d, &pdf)) return false;
+  dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
+  return true;
+}
+static double env_pdf(void *ctx, const double dir[3]) {
+  return iris_envmap_pdf((const iris_envmap *)ctx, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+typedef struct lctx {
+  const iris_lights *lights;
+  iris_vec3 ref;
+} lctx;
+static bool light_sample(void *vc, const double u[3], double dir[3]) {
+  lctx *c = (lctx *)vc;
+  iris_light_sample s;
+  if (!iris_lights_sample(c->lights, c->ref, (float)u[0], (float)u[1], (float)u[2], &s)) return false;
+  dir[0] = s.wi.x, dir[1] = s.wi.y, dir[2] = s.wi.z;
+  return true;
+}
+static double light_pdf(void *vc, const double dir[3]) {
+  lctx *c = (lctx *)vc;
+  return iris_lights_pdf_environment(c->lights, c->ref,
+                                     iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+static void test_mapping(const char *path) {
+  iris_environment_map m = {(char *)path, 1.0f, 37.0f};
+  iris_envmap env;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_envmap_load(&m, &env, &err), &err);
+  uint64_t st = 5;
+  double worst = 0.0;
+  for (int i = 0; i < 10000; i++) {
+    iris_vec3 d = iris_sample_uniform_sphere((float)chi2_uniform(&st), (float)chi2_uniform(&st));
+    float s, t;
+    iris_envmap_dir_to_st(&env, d, &s, &t);
+    CHECK(s >= 0.0f && s < 1.0f && t >= 0.0f && t <= 1.0f);
+    iris_vec3 back = iris_envmap_st_to_dir(&env, s, t);
+    worst = fmax(worst, (double)iris_length(iris_sub(back, d)));
+  }
+  CHECK(worst < 1e-4);
+  iris_envmap_destroy(&env);
+  /* Without rotation: +X is the map's centre column, +Z three quarters across,
+   * -Z a quarter, +Y the top row, -Y the bottom (Blender's glTF import puts
+   * glTF (x, y, z) at (x, -z, y); measured in Blender 3.4.1: docs/format.md). */
+  m.rotation = 0.0f;
+  CHECK_OK(iris_envmap_load(&m, &env, &err), &err);
+  float s, t;
+  iris_envmap_dir_to_st(&env, iris_v3(1, 0, 0), &s, &t);
+  CHECK_NEAR(s, 0.5, 1e-6);
+  CHECK_NEAR(t, 0.5, 1e-6);
+  iris_envmap_dir_to_st(&env, iris_v3(0, 0, 1), &s, &t);
+  CHECK_NEAR(s, 0.75, 1e-6);
+  iris_envmap_dir_to_st(&env, iris_v3(0, 0, -1), &s, &t);
+  CHECK_NEAR(s, 0.25, 1e-6);
+  iris_envmap_dir_to_st(&env, iris_v3(0, 1, 0), &s, &t);
+  CHECK_NEAR(t, 0.0, 1e-6);
+  iris_envmap_dir_to_st(&env, iris_v3(0, -1, 0), &s, &t);
+  CHECK_NEAR(t, 1.0, 1e-6);
+  /* a rotation of 90 degrees brings +Z's column to +X's: d' = R_y(90) d */
+  iris_envmap_destroy(&env);
+  m.rotation = 90.0f;
+  CHECK_OK(iris_envmap_load(&m, &env, &err), &err);
+  iris_envmap_dir_to_st(&env, iris_v3(0, 0, 1), &s, &t);
+  CHECK_NEAR(s, 0.5, 1e-5);
+  iris_envmap_destroy(&env);
+}
+
+static void test_sampling(const char *path) {
+  iris_environment_map m = {(char *)path, 2.0f, 37.0f};
+  iris_envmap env;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_envmap_load(&m, &env, &err), &err);
+  chi2_domain dom = {CHI2_SPHERE, 32, 64, 77}; /* the quadrature of a discontinuous pdf dominates the cost */
+  chi2_result r = chi2_run(&dom, env_sample, env_pdf, &env, 400000, 0.01, 3);
+  iris_check_record(r.passed, __FILE__, __LINE__, "envmap sampling: %s", r.message);
+  printf("envmap: p = %.3g, pdf integral %.5f, lost %zu\n", r.p_value, r.pdf_integral, r.lost);
+  CHECK_NEAR(r.pdf_integral, 1.0, 2e-3);
+  CHECK(r.lost == 0);
+  /* the map's texels times the strength are the radiance */
+  iris_vec3 L = iris_envmap_radiance(&env, iris_envmap_st_to_dir(&env, 0.9f, 0.5f));
+  int x = (int)(0.9f * 64), y = 16;
+  float expect = 2.0f * (0.05f + 0.5f * (float)x / 64.0f);
+  (void)y;
+  CHECK_NEAR(L.x, expect, 1e-5);
+
+  /* As a light of a scene (a small quad that does not block the reference point). */
+  iris_scene *s = iris_scene_create();
+  iris_material mat = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  int32_t mi = iris_scene_add_material(s, &mat);
+  iris_builtin_add_quad(s, iris_v3(-1, -1, -1), iris_v3(2, 0, 0), iris_v3(0, 0, 2), 1, mi, "floor");
+  CHECK(iris_scene_set_environment_map(s, path, 2.0f, 37.0f));
+  iris_accel *accel = NULL;
+  iris_textures tex;
+  iris_lights lights;
+  CHECK_OK(iris_accel_build(s, &accel, &err), &err);
+  CHECK_OK(iris_textures_load(s, &tex, &err), &err);
+  CHECK_OK(iris_lights_build(s, accel, &tex, &lights, &err), &err);
+  CHECK(lights.envmap != NULL);
+  lctx c = {&lights, iris_v3(0.1f, 0.3f, 0.2f)};
+  r = chi2_run(&dom, light_sample, light_pdf, &c, 400000, 0.01, 3);
+  iris_check_record(r.passed, __FILE__, __LINE__, "environment light sampling: %s", r.message);
+  printf("lights: p = %.3g, pdf integral %.5f\n", r.p_value, r.pdf_integral);
+  CHECK_NEAR(r.pdf_integral, 1.0, 2e-3);
+  /* Photon power: mean = pi r^2 * integral of L over the sphere = pi r^2 4 pi mean. */
+  uint64_t st = 11;
+  double sum[3] = {0, 0, 0};
+  const int n = 400000;
+  for (int i = 0; i < n; i++) {
+    float u[5];
+    for (int k = 0; k < 5; k++) u[k] = (float)chi2_uniform(&st);
+    iris_photon_emission e;
+    if (!iris_lights_sample_emission(&lights, u[0], u[1], u[2], u[3], u[4], &e)) continue;
+    sum[0] += e.power.x, sum[1] += e.power.y, sum[2] += e.power.z;
+  }
+  double area = IRIS_PI * (double)lights.radius * (double)lights.radius;
+  for (int k = 0; k < 3; k++) {
+    double expect_p = area * 4.0 * IRIS_PI * env.mean_rgb[k];
+    printf("photon power[%d] %.5g expected %.5g\n", k, sum[k] / n, expect_p);
+    CHECK_NEAR(sum[k] / n, expect_p, 0.01 * expect_p);
+  }
+  iris_lights_destroy(&lights);
+  iris_textures_destroy(&tex);
+  iris_accel_destroy(accel);
+  iris_scene_destroy(s);
+  iris_envmap_destroy(&env);
+}
+
+/* Mean and standard error of the mean of the image's first channel. */
+static void image_mean(const iris_render_result *res, double *mean, double *se) {
+  iris_image img;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_film_to_image(&res->film, true, &img, &err), &err);
+  int vr = iris_image_channel(&img, "var.R");
+  double m = 0.0, v = 0.0;
+  size_t n = (size_t)img.width * (size_t)img.height;
+  for (size_t i = 0; i < n; i++) {
+    m += img.data[i * (size_t)img.channel_count];
+    v += vr >= 0 ? img.data[i * (size_t)img.channel_count + (size_t)vr] : 0.0;
+  }
+  *mean = m / (double)n;
+  *se = sqrt(v) / (double)n;
+  iris_image_destroy(&img);
+}
+
+static void test_furnace(const char *uniform) {
+  const float rho = 0.5f;
+  double means[2][IRIS_METHOD_COUNT], ses[2][IRIS_METHOD_COUNT];
+  for (int world = 0; world < 2; world++) {
+    iris_scene *s = NULL;
+    iris_error err;
+    iris_error_clear(&err);
+    CHECK_OK(iris_builtin_create("furnace-diffuse", &s, &err), &err);
+    for (int k = 0; k < 3; k++) s->materials[0].color[k] = rho;
+    if (world == 1) {
+      CHECK(iris_scene_set_environment_map(s, uniform, 1.0f, 20.0f));
+    } else {
+      const float one[3] = {1, 1, 1};
+      iris_scene_set_environment_color(s, one);
+    }
+    for (int m = 0; m < IRIS_METHOD_COUNT; m++) {
+      iris_render_params p = iris_render_params_default();
+      p.width = p.height = 16;
+      p.spp = 32;
+      p.threads = 2;
+      p.method = (iris_method)m;
+      iris_guiding_params gp = iris_guiding_params_default();
+      gp.photons = 20000;
+      if (iris_method_uses_guiding(p.method)) {
+        p.guide = &iris_guiding_provider;
+        p.guide_options = &gp;
+      }
+      iris_render_result res;
+      CHECK_OK(iris_render(s, &p, &res, &err), &err);
+      /* pixel by pixel: everything between rho (sphere) and 1 (sky; silhouette
+       * pixels mix both), the centre rho and the corners 1 within 5 sigma */
+      iris_image img;
+      CHECK_OK(iris_film_to_image(&res.film, true, &img, &err), &err);
+      int vr = iris_image_channel(&img, "var.R");
+      int bad = 0;
+      for (int y = 0; y < img.height; y++)
+        for (int x = 0; x < img.width; x++) {
+          size_t i = ((size_t)y * (size_t)img.width + (size_t)x) * (size_t)img.channel_count;
+          float v = img.data[i], tol = 5.0f * sqrtf(img.data[i + (size_t)vr]) + 1e-4f;
+          bool centre = abs(2 * x + 1 - img.width) <= 4 && abs(2 * y + 1 - img.height) <= 4;
+          bool corner = (x == 0 || x == img.width - 1) && (y == 0 || y == img.height - 1);
+          if (v < rho - tol || v > 1.0f + tol || (centre && fabsf(v - rho) > tol) ||
+              (corner && fabsf(v - 1.0f) > tol))
+            bad++;
+        }
+      iris_check_record(bad == 0, __FILE__, __LINE__, "%s %s: %d pixels off", world ? "map" : "colour",
+                        iris_method_name(p.method), bad);
+      iris_image_destroy(&img);
+      image_mean(&res, &means[world][m], &ses[world][m]);
+      iris_render_result_destroy(&res);
+    }
+    iris_scene_destroy(s);
+  }
+  for (int m = 0; m < IRIS_METHOD_COUNT; m++) {
+    double d = means[1][m] - means[0][m], se = sqrt(ses[0][m] * ses[0][m] + ses[1][m] * ses[1][m]);
+    printf("furnace %-10s colour %.5f +- %.5f  map %.5f +- %.5f\n", iris_method_name((iris_method)m),
+           means[0][m], ses[0][m], means[1][m], ses[1][m]);
+    iris_check_record(fabs(d) <= 4.0 * se + 1e-6, __FILE__, __LINE__,
+                      "%s: constant colour %.5f and constant map %.5f differ by more than 4 sigma",
+                      iris_method_name((iris_method)m), means[0][m], means[1][m]);
+  }
+}
+
+int main(void) {
+  if (iris_test_tmpdir(g_dir, sizeof g_dir, "envmap") != 0) return TEST_SKIP("no temporary folder");
+  char patterned[1200], uniform[1200];
+  snprintf(patterned, sizeof patterned, "%s/pattern.exr", g_dir);
+  snprintf(uniform, sizeof uniform, "%s/uniform.exr", g_dir);
+  write_map(patterned, 64, 32, 1);
+  write_map(uniform, 32, 16, 0);
+  test_mapping(patterned);
+  test_sampling(patterned);
+  test_furnace(uniform);
+  return TEST_SUMMARY();
+}
