@@ -85,7 +85,6 @@ int main(int argc, char **argv) {
   expect_usage_error("cornell-box --to pov -o x.pov --pov-radiosity ultra", "ultra");
   expect_usage_error("cornell-box --to blender -o x.py --pov-radiosity low", "--pov-radiosity");
   expect_usage_error("cornell-box --to pov -o x.pov --pov-coverage --pov-radiosity high", "conflict");
-  expect_usage_error("cornell-box --to pov -o x.pov --pov-radiosity low --pov-radiosity high", "--pov-radiosity");
   expect_usage_error("cornell-box --to blender -o x.py --spp 0", "--spp");
   expect_usage_error("cornell-box --to blender -o x.py --width -3", "--width");
   expect_usage_error("cornell-box --to blender -o x.py --seed abc", "--seed");
