@@ -16,6 +16,7 @@
 #include "core/rng.h"
 #include "scenes/builtin.h"
 #include "renderer/guiding/guiding.h"
+#include "renderer/guiding/inspect.h"
 #include "renderer/render.h"
 #include "tools/cli.h"
 #include "tools/options.h"
@@ -257,6 +258,7 @@ int iris_cmd_render(int argc, char **argv) {
   if (gp.dump_dir && !iris_path_exists(gp.dump_dir))
     return iris_cli_usage_error(CMD, "the --dump-caches folder '%s' does not exist", gp.dump_dir);
   if (aov_caches) gp.marks = &marks;
+  if (gp.marks || gp.dump_dir) gp.inspect = iris_guiding_inspect;
   if (iris_method_uses_guiding(p.method)) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &gp;

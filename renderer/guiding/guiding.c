@@ -11,7 +11,6 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
-#include "renderer/guiding/inspect.h"
 #include "renderer/guiding/photons.h"
 
 #define CAMERA_SAMPLE_INDEX 0x63616d6361636865ULL /* streams apart from pixels and photons */
@@ -554,9 +553,8 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   }
   g->stats.cache_seconds = iris_time_now() - t1;
   /* Inspection outputs need the photons (counts in the dumps): before freeing them. */
-  if (st == IRIS_OK && !g->stats.skipped && p->dump_dir)
-    st = iris_guiding_dump_caches(g, s, &photons, &ptree, p->dump_dir, err);
-  if (st == IRIS_OK && !g->stats.skipped && p->marks) st = iris_guiding_mark_caches(g, s, p->marks, err);
+  if (st == IRIS_OK && !g->stats.skipped && p->inspect && (p->dump_dir || p->marks))
+    st = p->inspect(g, s, p, &photons, &ptree, err);
   iris_kdtree_destroy(&ptree);
   iris_photons_destroy(&photons); /* thesis 4.2.4: photons are not needed any more */
   return st;

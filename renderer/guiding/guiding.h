@@ -15,6 +15,7 @@
 #include "renderer/guiding/cache.h"
 #include "renderer/guiding/kdtree.h"
 #include "renderer/guiding/octmap.h"
+#include "renderer/guiding/photons.h"
 #include "renderer/guiding/pickgrid.h"
 #include "renderer/integrator.h"
 #include "renderer/render.h"
@@ -36,6 +37,7 @@ void iris_guiding_marks_destroy(iris_guiding_marks *m);
 
 /* Every parameter has a flag in `iris render`; <= 0 (or < 0 for the floor)
  * means "choose from the scene" (docs/guiding.md, "Budget"). */
+struct iris_guiding;
 typedef struct iris_guiding_params {
   int64_t photons;      /* photon paths emitted (--photons) */
   int64_t caches;       /* caches, half from camera rays, half from photons (--caches) */
@@ -56,6 +58,13 @@ typedef struct iris_guiding_params {
   const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
                                  serving a 4 x 3 grid of pixels (docs/guiding.md) */
   iris_guiding_marks *marks;  /* --aov caches: filled with the visible cache positions */
+  /* Called at the end of a build that was not skipped, while the photons
+   * still exist, when dump_dir or marks is set (NULL: nothing is written).
+   * The inspection module provides it (iris_guiding_inspect, inspect.h), so
+   * guiding depends on no inspection code and inspection on guiding alone. */
+  iris_status (*inspect)(const struct iris_guiding *g, const iris_guide_setup *setup,
+                         const struct iris_guiding_params *params, const iris_photon_map *photons,
+                         const iris_kdtree *photon_tree, iris_error *err);
 } iris_guiding_params;
 
 iris_guiding_params iris_guiding_params_default(void);

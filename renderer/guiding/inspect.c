@@ -162,3 +162,12 @@ iris_status iris_guiding_dump_caches(const iris_guiding *g, const iris_guide_set
   free(text);
   return st;
 }
+
+iris_status iris_guiding_inspect(const iris_guiding *g, const iris_guide_setup *setup,
+                                 const iris_guiding_params *params, const iris_photon_map *photons,
+                                 const iris_kdtree *photon_tree, iris_error *err) {
+  iris_status st = IRIS_OK;
+  if (params->dump_dir) st = iris_guiding_dump_caches(g, setup, photons, photon_tree, params->dump_dir, err);
+  if (st == IRIS_OK && params->marks) st = iris_guiding_mark_caches(g, setup, params->marks, err);
+  return st;
+}

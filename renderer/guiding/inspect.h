@@ -29,6 +29,12 @@ iris_status iris_guiding_dump_caches(const iris_guiding *g, const iris_guide_set
                                      const iris_photon_map *photons, const iris_kdtree *photon_tree,
                                      const char *dir, iris_error *err);
 
+/* The guide's inspection hook (iris_guiding_params.inspect): the dumps when
+ * params->dump_dir is set, then the marks when params->marks is. */
+iris_status iris_guiding_inspect(const iris_guiding *g, const iris_guide_setup *setup,
+                                 const iris_guiding_params *params, const iris_photon_map *photons,
+                                 const iris_kdtree *photon_tree, iris_error *err);
+
 #ifdef __cplusplus
 }
 #endif
