@@ -26,12 +26,15 @@ static void print_help(void) {
       "top 0.1%% of pixels dropped), MAPE and the mean-energy ratio against a reference.\n"
       "\n"
       "Runs:\n"
-      "      --methods LIST   comma-separated: bsdf,nee,mis,guided,guided-nee\n"
+      "      --methods LIST   comma-separated: bsdf,nee,mis,guided,guided-nee; a method may\n"
+      "                       name its variant: mis@independent, mis@area,\n"
+      "                       mis@independent+area (sampler, emitter triangles)\n"
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
-      "      --sampler S      sobol (default) | independent (the reference's is fixed: docs/benchmarks.md)\n"
-      "      --light-sampling M  solid-angle (default) | area (the timed runs' emitter triangles)\n"
+      "      --sampler S      sobol (default) | independent: what a plain method name uses\n"
+      "                       (the reference's is fixed: docs/benchmarks.md)\n"
+      "      --light-sampling M  solid-angle (default) | area: likewise\n"
       "      --width W, --height H   image size (default: the reference's, else the\n"
       "                       scene's; one of them: the other keeps the scene's aspect)\n"
       "      --max-depth B    bounces as Cycles counts them (default: the scene's, else 64)\n"
@@ -94,6 +97,8 @@ static int split_list(char *text, char **items, int max) {
 
 int iris_cmd_bench(int argc, char **argv) {
   iris_bench_params p = iris_bench_params_default();
+  iris_sampler_kind sampler = IRIS_SAMPLER_SOBOL;
+  iris_triangle_sampling light_sampling = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
   const char *inputs[IRIS_BENCH_MAX_SCENES + 1];
   const char *refs[IRIS_BENCH_MAX_SCENES + 1];
   int input_count = 0, ref_count = 0;
@@ -136,11 +141,11 @@ int iris_cmd_bench(int argc, char **argv) {
       p.seeds = (int)lv;
     } else if (strcmp(a, "--light-sampling") == 0) {
       NEED_VALUE();
-      if (!iris_triangle_sampling_parse(val, &p.light_sampling))
+      if (!iris_triangle_sampling_parse(val, &light_sampling))
         return iris_cli_usage_error(CMD, "unknown light sampling '%s' (solid-angle, area)", val);
     } else if (strcmp(a, "--sampler") == 0) {
       NEED_VALUE();
-      if (!iris_sampler_kind_parse(val, &p.sampler))
+      if (!iris_sampler_kind_parse(val, &sampler))
         return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", val);
     } else if (strcmp(a, "--threads") == 0) {
       NEED_VALUE();
@@ -224,16 +229,31 @@ int iris_cmd_bench(int argc, char **argv) {
     return iris_cli_usage_error(CMD, "%d reference file(s) for %d input(s): give one per input",
                                 ref_count, input_count);
   {
-    char *items[IRIS_METHOD_COUNT + 1];
-    int n = split_list(methods_buf, items, IRIS_METHOD_COUNT);
-    if (n <= 0) return iris_cli_usage_error(CMD, "invalid --methods '%s'", methods_buf);
+    char *items[IRIS_BENCH_MAX_METHODS + 1];
+    int n = split_list(methods_buf, items, IRIS_BENCH_MAX_METHODS);
+    if (n < 0) return iris_cli_usage_error(CMD, "at most %d --methods", IRIS_BENCH_MAX_METHODS);
+    if (n == 0) return iris_cli_usage_error(CMD, "invalid --methods '%s'", methods_buf);
     for (int k = 0; k < n; k++) {
       iris_method m;
-      if (!iris_method_parse(items[k], &m))
-        return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", items[k]);
+      iris_sampler_kind smp;
+      iris_triangle_sampling ls;
+      if (!iris_bench_method_parse(items[k], &m, &smp, &ls))
+        return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee, "
+                                         "optionally @independent, @area or @independent+area)", items[k]);
+      /* --sampler and --light-sampling set what a plain name means */
+      if (!strchr(items[k], '@')) {
+        smp = sampler;
+        ls = light_sampling;
+      }
+      p.methods[p.method_count] = m;
+      p.samplers[p.method_count] = smp;
+      p.light_samplings[p.method_count] = ls;
+      char a[64], b[64];
+      iris_bench_method_label(&p, p.method_count, a, sizeof a);
       for (int j = 0; j < p.method_count; j++)
-        if (p.methods[j] == m) return iris_cli_usage_error(CMD, "method '%s' is given twice", items[k]);
-      p.methods[p.method_count++] = m;
+        if (strcmp(iris_bench_method_label(&p, j, b, sizeof b), a) == 0)
+          return iris_cli_usage_error(CMD, "method '%s' is given twice", a);
+      p.method_count++;
     }
   }
   {

@@ -43,6 +43,39 @@ extern char **environ;
  * dimension layout. */
 #define REFERENCE_CACHE_VERSION 2u
 
+const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size) {
+  const bool indep = p->samplers[k] == IRIS_SAMPLER_INDEPENDENT;
+  const bool area = p->light_samplings[k] == IRIS_TRIANGLE_SAMPLING_AREA;
+  snprintf(buf, size, "%s%s%s%s", iris_method_name(p->methods[k]), indep || area ? "@" : "",
+           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "");
+  return buf;
+}
+
+bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
+                             iris_triangle_sampling *light) {
+  char name[64];
+  snprintf(name, sizeof name, "%s", label);
+  char *at = strchr(name, '@');
+  *sampler = IRIS_SAMPLER_SOBOL;
+  *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+  if (at) {
+    *at++ = '\0';
+    for (char *tok = strtok(at, "+"); tok; tok = strtok(NULL, "+")) {
+      if (strcmp(tok, "independent") == 0)
+        *sampler = IRIS_SAMPLER_INDEPENDENT;
+      else if (strcmp(tok, "sobol") == 0)
+        *sampler = IRIS_SAMPLER_SOBOL;
+      else if (strcmp(tok, "area") == 0)
+        *light = IRIS_TRIANGLE_SAMPLING_AREA;
+      else if (strcmp(tok, "solid-angle") == 0)
+        *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+      else
+        return false;
+    }
+  }
+  return iris_method_parse(name, m);
+}
+
 iris_bench_params iris_bench_params_default(void) {
   iris_bench_params p;
   memset(&p, 0, sizeof p);
@@ -368,8 +401,6 @@ static iris_render_params render_params(const iris_bench_params *p, const iris_b
   rp.height = sc->height;
   rp.threads = p->threads;
   rp.method = method;
-  rp.sampler = p->sampler;
-  rp.light_sampling = p->light_sampling;
   rp.seed = seed;
   rp.max_depth = max_depth;
   rp.cancel = p->cancel;
@@ -471,11 +502,12 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
   ep.has_seed = true;
   st = iris_export_blender(bs->scene, script, &ep, err);
   if (st != IRIS_OK) return st;
-  const char *base = "mis";
-  bool have_mis = false;
-  for (int k = 0; k < p->method_count; k++)
-    if (p->methods[k] == IRIS_METHOD_MIS) have_mis = true;
-  if (!have_mis) base = iris_method_name(p->methods[0]);
+  /* Cycles takes the spp of the first mis variant's runs (else the first method's) */
+  char base[64];
+  int kb = 0;
+  for (int k = p->method_count - 1; k >= 0; k--)
+    if (p->methods[k] == IRIS_METHOD_MIS) kb = k;
+  iris_bench_method_label(p, kb, base, sizeof base);
   int threads = p->threads > 0 ? p->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
   for (int t = 0; t < p->time_count; t++) {
     int spp = 0;
@@ -689,8 +721,12 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
       for (int s = 0; s < p.seeds && st == IRIS_OK; s++)
         for (int k = 0; k < p.method_count && st == IRIS_OK; k++) {
           iris_method m = p.methods[k];
-          begin_run(&ctx, sc->name, iris_method_name(m), p.times[t], (uint64_t)s, p.times[t]);
+          char label[32];
+          iris_bench_method_label(&p, k, label, sizeof label);
+          begin_run(&ctx, sc->name, label, p.times[t], (uint64_t)s, p.times[t]);
           iris_render_params rp = render_params(&p, sc, bs[i].max_depth, m, (uint64_t)s, &gp, &ctx);
+          rp.sampler = p.samplers[k];
+          rp.light_sampling = p.light_samplings[k];
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;
@@ -706,7 +742,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           iris_bench_row row;
           memset(&row, 0, sizeof row);
           snprintf(row.scene, sizeof row.scene, "%s", sc->name);
-          snprintf(row.method, sizeof row.method, "%s", iris_method_name(m));
+          snprintf(row.method, sizeof row.method, "%s", label);
           row.seed = (uint64_t)s;
           row.budget_s = p.times[t];
           /* the whole call: setup, passes and the film's allocation */
@@ -720,7 +756,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           fill_metrics(&img, &bs[i].ref, &row);
           st = add_row(res, &row, err);
           if (st == IRIS_OK && s == 0 && t == p.time_count - 1)
-            st = write_preview(p.out_dir, sc, iris_method_name(m), &img, &bs[i].ref, exposure, err);
+            st = write_preview(p.out_dir, sc, label, &img, &bs[i].ref, exposure, err);
           iris_image_destroy(&img);
         }
     if (st == IRIS_OK && p.cycles) st = run_cycles(&p, &ctx, &bs[i], sc, res, exposure, err);
@@ -792,7 +828,10 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
   cJSON *par = cJSON_AddObjectToObject(o, "params");
   cJSON *ms = cJSON_AddArrayToObject(par, "methods");
   for (int k = 0; k < p->method_count; k++)
-    cJSON_AddItemToArray(ms, cJSON_CreateString(iris_method_name(p->methods[k])));
+  {
+    char label[64];
+    cJSON_AddItemToArray(ms, cJSON_CreateString(iris_bench_method_label(p, k, label, sizeof label)));
+  }
   if (res->cycles_done) cJSON_AddItemToArray(ms, cJSON_CreateString("cycles"));
   cJSON *ts = cJSON_AddArrayToObject(par, "times");
   double times[IRIS_BENCH_MAX_TIMES];

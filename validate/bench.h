@@ -24,6 +24,7 @@ extern "C" {
 #define IRIS_BENCH_MAX_SCENES 16
 #define IRIS_BENCH_MAX_TIMES 16
 #define IRIS_BENCH_MAX_SEEDS 64
+#define IRIS_BENCH_MAX_METHODS 16
 #define IRIS_BENCH_DEFAULT_REFERENCE_SPP 4096
 
 /* What the progress callback is told before each run and after each pass. */
@@ -42,10 +43,13 @@ typedef struct iris_bench_params {
   const char *const *inputs;  /* files or built-in scene names (validate.h's loader) */
   int input_count;
   iris_world_override world;  /* zeroed: each scene's own world (validate.h) */
-  iris_method methods[IRIS_METHOD_COUNT];
+  /* The timed iris runs: method k with sampler samplers[k] and emitter
+   * triangle sampling light_samplings[k] (variants such as mis@independent
+   * compare samplers in one run; iris_bench_method_label names them). */
+  iris_method methods[IRIS_BENCH_MAX_METHODS];
+  iris_sampler_kind samplers[IRIS_BENCH_MAX_METHODS];
+  iris_triangle_sampling light_samplings[IRIS_BENCH_MAX_METHODS];
   int method_count;
-  iris_sampler_kind sampler;  /* of the timed iris runs (the reference's is fixed) */
-  iris_triangle_sampling light_sampling; /* of the timed iris runs */
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
   int seeds;                  /* seeds 0 .. seeds-1 (default 1) */
@@ -70,6 +74,14 @@ typedef struct iris_bench_params {
 
 iris_bench_params iris_bench_params_default(void);
 
+/* Name of run variant k in results, tables and charts: the method's name,
+ * followed by "@independent" and/or "@area" ("+area" after a sampler) when it
+ * does not use the defaults (sobol, solid-angle): "mis", "mis@independent",
+ * "mis@area", "mis@independent+area". iris_bench_method_parse reads it back. */
+const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size);
+bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
+                             iris_triangle_sampling *light);
+
 /* One render: a line of results.csv. method is a method name or "cycles". */
 typedef struct iris_bench_row {
   char scene[128];
@@ -93,7 +105,7 @@ typedef struct iris_bench_scene {
   double reference_relmse; /* the reference's own expected relMSE, from its variance channels
                               (contained in every measured relMSE); < 0 unknown */
   double target_relmse;  /* used for the time-to-target column */
-  char images[IRIS_METHOD_COUNT + 2][64]; /* preview PNG names in DIR/images: reference, methods, cycles */
+  char images[IRIS_BENCH_MAX_METHODS + 2][64]; /* preview PNG names in DIR/images: reference, methods, cycles */
   int image_count;
 } iris_bench_scene;
 

@@ -85,7 +85,8 @@ static int collect(const iris_bench_params *p, const iris_bench_result *res, con
                    const double *budgets, method_curve *mc) {
   int n = 0;
   for (int k = 0; k <= p->method_count; k++) {
-    const char *name = k < p->method_count ? iris_method_name(p->methods[k]) : "cycles";
+    char label[64];
+    const char *name = k < p->method_count ? iris_bench_method_label(p, k, label, sizeof label) : "cycles";
     snprintf(mc[n].name, sizeof mc[n].name, "%s", name);
     mc[n].count = iris_bench_curve(res->rows, res->row_count, scene, name, budgets, p->time_count,
                                    mc[n].pts);
@@ -198,7 +199,7 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
              "from its variance), which pulls the speed-ups towards 1 unless it is far below the values.</p>\n");
   for (int s = 0; s < res->scene_count; s++) {
     iris_bench_scene *sc = &res->scenes[s];
-    method_curve mc[IRIS_METHOD_COUNT + 1];
+    method_curve mc[IRIS_BENCH_MAX_METHODS + 1];
     int n = collect(p, res, sc->name, budgets, mc);
     const method_curve *base = NULL;
     for (int k = 0; k < n; k++)

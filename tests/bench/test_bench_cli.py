@@ -112,9 +112,12 @@ def main(argv):
     if check(isinstance(own, float) and own > 0, f"reference own_relmse: {own}"):
         check("its own relMSE" in sc["reference"]["description"], "own relMSE in the description")
         for b, r in mis.items():
+            # the reference is independent-sampled; the timed sobol runs do better
+            # than its per-sample variance predicts (on this scene about 1.5-2.5x
+            # at these spp), so the lower bound is wider than the upper one
             predicted = own * (2048 / int(r["spp"]) + 1)
             q = float(r["relmse"]) / predicted
-            check(0.5 < q < 2.0, f"mis at {b} s: relMSE {r['relmse']} vs predicted {predicted:.4g} from "
+            check(0.2 < q < 2.0, f"mis at {b} s: relMSE {r['relmse']} vs predicted {predicted:.4g} from "
                   f"the reference's own {own:.4g} ({r['spp']} spp)")
     check(js["outputs"]["charts"] is True, "charts drawn")
 
@@ -144,12 +147,26 @@ def main(argv):
     check(rc == 0 and "cached reference" in se and "rendering the reference" not in se,
           f"second run uses the cache: {rc} {se}")
 
+    # variants in one run: the sampler and the emitter sampling per method name
+    out3 = os.path.join(work, "out3")
+    rc, so, se = run(iris, common + ["--out", out3, "--times", "0.2", "--no-charts", "--sampler", "independent",
+                                     "--methods", "mis,mis@sobol+area,nee@independent"], work)
+    if check(rc == 0, f"bench with variants: {rc} {se}"):
+        with open(os.path.join(out3, "results.csv"), newline="") as f:
+            names = [r["method"] for r in csv.DictReader(f)]
+        # plain "mis" follows --sampler independent; an explicit @sobol is the default, not named
+        check(names == ["mis@independent", "mis@area", "nee@independent"], f"variant names: {names}")
+
     # usage and input errors: exit 2, one line, no output folder
     bad = os.path.join(work, "bad")
     cases = [
         (["cornell-box", "--methods", "mis", "--times", "1", "--reference", "auto"], "--out"),
         (["cornell-box", "--methods", "foo", "--times", "1", "--reference", "auto", "--out", bad],
          "unknown method"),
+        (["cornell-box", "--methods", "mis@bogus", "--times", "1", "--reference", "auto", "--out", bad],
+         "unknown method"),
+        (["cornell-box", "--methods", "mis,mis@sobol", "--times", "1", "--reference", "auto", "--out", bad],
+         "twice"),
         (["cornell-box", "--methods", "mis", "--times", "0,1", "--reference", "auto", "--out", bad],
          "--times"),
         (["cornell-box", "--methods", "mis", "--times", "1,1", "--reference", "auto", "--out", bad],
