@@ -162,30 +162,6 @@ static int find_channel(const iris_image *img, const char *name) {
   return -1;
 }
 
-/* The expected relMSE of an image against the exact one, from its variance
- * channels (var.R/G/B: variance of each pixel's mean): mean over pixels of
- * (1/3) sum_c var_c / (value_c^2 + eps). Every relMSE measured against a
- * reference contains about this much of the reference's own noise. -1 when
- * the image has no variance channels. */
-static double own_relmse(const iris_image *img) {
-  static const char *const names[3] = {"R", "G", "B"}, *const vnames[3] = {"var.R", "var.G", "var.B"};
-  int c0[3], v0[3];
-  for (int c = 0; c < 3; c++) {
-    c0[c] = iris_image_channel(img, names[c]);
-    v0[c] = iris_image_channel(img, vnames[c]);
-    if (c0[c] < 0 || v0[c] < 0) return -1.0;
-  }
-  size_t n = (size_t)img->width * (size_t)img->height;
-  double sum = 0.0;
-  for (size_t i = 0; i < n; i++)
-    for (int c = 0; c < 3; c++) {
-      double r = img->data[i * (size_t)img->channel_count + (size_t)c0[c]];
-      double v = img->data[i * (size_t)img->channel_count + (size_t)v0[c]];
-      if (isfinite(v) && v > 0.0) sum += v / (r * r + IRIS_METRIC_EPS) / 3.0;
-    }
-  return n ? sum / (double)n : -1.0;
-}
-
 /* Appends "; own relMSE X" to a reference description (X from own_relmse). */
 static void describe_own_relmse(iris_bench_scene *sc, double own) {
   sc->reference_relmse = own;
@@ -217,7 +193,7 @@ static iris_status read_rgb(const char *path, iris_image *out, char *renderer, s
     if (spp && strcmp(meta[i].key, "iris:spp") == 0) *spp = atoi(meta[i].value);
   }
   free(meta);
-  if (own) *own = own_relmse(&raw);
+  if (own) *own = iris_metric_own_relmse(&raw);
   static const char *const names[3] = {"R", "G", "B"};
   int src[3];
   for (int c = 0; c < 3; c++) src[c] = find_channel(&raw, names[c]);
@@ -468,7 +444,7 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
   iris_error var_err;
   iris_error_clear(&var_err);
   if (st == IRIS_OK && iris_film_to_image(&rr.film, true, &with_var, &var_err) == IRIS_OK) {
-    own = own_relmse(&with_var);
+    own = iris_metric_own_relmse(&with_var);
     iris_image_destroy(&with_var);
   }
   iris_render_result_destroy(&rr);

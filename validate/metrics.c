@@ -330,3 +330,28 @@ iris_status iris_metric_pixel_ztest_floored(const iris_image *test, int tc0, int
   out->passed = out->bonferroni_passed && out->count_passed;
   return IRIS_OK;
 }
+
+/* The expected relMSE of an image against the exact one, from its variance
+ * channels (var.R/G/B: variance of each pixel's mean): mean over pixels of
+ * (1/3) sum_c var_c / (value_c^2 + eps). Every relMSE measured against a
+ * reference contains about this much of the reference's own noise. -1 when
+ * the image has no variance channels. */
+double iris_metric_own_relmse(const iris_image *img) {
+  static const char *const names[3] = {"R", "G", "B"}, *const vnames[3] = {"var.R", "var.G", "var.B"};
+  int c0[3], v0[3];
+  for (int c = 0; c < 3; c++) {
+    c0[c] = iris_image_channel(img, names[c]);
+    v0[c] = iris_image_channel(img, vnames[c]);
+    if (c0[c] < 0 || v0[c] < 0) return -1.0;
+  }
+  size_t n = (size_t)img->width * (size_t)img->height;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++) {
+      double r = img->data[i * (size_t)img->channel_count + (size_t)c0[c]];
+      double v = img->data[i * (size_t)img->channel_count + (size_t)v0[c]];
+      if (isfinite(v) && v > 0.0) sum += v / (r * r + IRIS_METRIC_EPS) / 3.0;
+    }
+  return n ? sum / (double)n : -1.0;
+}
+

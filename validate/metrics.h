@@ -53,6 +53,13 @@ double iris_metric_relmse(const iris_image *test, int tc0, const iris_image *ref
 double iris_metric_mape(const iris_image *test, int tc0, const iris_image *ref, int rc0,
                         double eps, double drop_fraction);
 
+/* The expected relMSE of an image against the exact one, from its variance
+ * channels var.R/G/B (variance of each pixel's mean): mean over pixels of
+ * (1/3) sum_c var_c / (value_c^2 + IRIS_METRIC_EPS). A relMSE measured
+ * against a reference contains about this much of the reference's own noise.
+ * -1 when the image has no variance channels. */
+double iris_metric_own_relmse(const iris_image *img);
+
 /* Upper tail probability of |Z| for a standard normal Z: P(|Z| > z) = erfc(z / sqrt 2). */
 double iris_metric_normal_two_sided_p(double z);
 /* The z with P(|Z| > z) = p (0 < p < 1), by bisection on erfc. */
