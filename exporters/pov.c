@@ -436,6 +436,7 @@ static iris_status write_pov(FILE *fp, const iris_scene *scene, const char *pov_
   put_comment_name(fp, scene->source_path ? scene->source_path : "(memory)");
   fprintf(fp,
           "%s\n// Render: povray +I<this> +O<out>.png +FN +W%d +H%d -D -V\n"
+          "// (+WT1 makes a radiosity image reproducible: its cache depends on the thread timing)\n"
           "// Approximations of iris's materials and lights: docs/export.md.\n"
           "#version 3.7;\n"
           "global_settings { assumed_gamma 1.0 charset utf8 ambient_light rgb 0 max_trace_level %d\n",

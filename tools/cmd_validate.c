@@ -19,7 +19,7 @@ static const char *const CMD = "validate";
 
 static void print_help(void) {
   printf(
-      "Usage: iris validate INPUT --out DIR [--reference REF.exr | --blender] [options]\n"
+      "Usage: iris validate INPUT --out DIR [--reference REF.exr | --blender | --blender-import[=FILE]] [options]\n"
       "       iris validate --refresh [SCENE...] [--blender-spp N] [--threads T] [--seed S]\n"
       "\n"
       "Renders INPUT (an iris scene .json, an OBJ/PLY/glTF file, or a built-in scene:\n"
