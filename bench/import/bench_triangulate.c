@@ -89,7 +89,7 @@ static double coverage(const float *pos, uint32_t n, const uint32_t *tris) {
 
 static void run(enum family f, uint32_t n, uint32_t budget, float *pos, uint32_t *corners, uint32_t *tris) {
   iris_polygon_triangulator *t = iris_polygon_triangulator_create();
-  iris_polygon_triangulator_set_budget(t, budget);
+  iris_polygon_triangulator_set_budget(t, budget, budget == UINT32_MAX ? UINT32_MAX : IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER);
   const uint64_t saved = rng;
   make(f, n, pos);
   rng = saved;
@@ -114,8 +114,9 @@ int main(int argc, char **argv) {
   float *pos = malloc(3 * sizeof(float) * NMAX);
   uint32_t *corners = malloc(sizeof(uint32_t) * NMAX), *tris = malloc(3 * sizeof(uint32_t) * NMAX);
   if (!pos || !corners || !tris) return 1;
-  printf("steps per corner: IRIS_TRIANGULATE_STEPS_PER_CORNER = %u (+ %u per polygon)\n\n",
-         IRIS_TRIANGULATE_STEPS_PER_CORNER, IRIS_TRIANGULATE_STEPS_BASE);
+  printf("budget: %u steps per corner + %u per polygon, %u per corner + %u per file (one polygon here)\n\n",
+         IRIS_TRIANGULATE_STEPS_PER_CORNER, IRIS_TRIANGULATE_STEPS_BASE, IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER,
+         IRIS_TRIANGULATE_FILE_STEPS_BASE);
   printf("| family | corners | budget | steps/corner | CPU ns/corner | ns/step | fanned | area covered |\n");
   printf("|---|---:|---|---:|---:|---:|---|---:|\n");
   for (int f = 0; f < FAMILY_COUNT; f++)

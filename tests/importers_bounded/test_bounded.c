@@ -303,11 +303,11 @@ static void check_findings(int count, char **paths) {
            (unsigned long long)stats.polygon_corners, (unsigned long long)stats.triangulation_steps, per_corner,
            (unsigned long long)stats.triangulation_fallbacks);
     CHECK(st == IRIS_OK || st == IRIS_ERR_PARSE || st == IRIS_ERR_INVALID || st == IRIS_ERR_UNSUPPORTED);
-    /* The budget: STEPS_PER_CORNER per corner + STEPS_BASE per polygon, plus
-     * what the last ear test may overrun it by (at most the polygon's corners)
-     * and the fan of the rest (a step per corner). */
-    const uint64_t bound = (uint64_t)(IRIS_TRIANGULATE_STEPS_PER_CORNER + 8) * stats.polygon_corners +
-                           (uint64_t)IRIS_TRIANGULATE_STEPS_BASE * stats.polygons;
+    /* The file's budget (triangulate.h), plus per corner what is done before
+     * any budget check (normal, projection, classification), what the last
+     * test may overrun it by and the fan of the rest: 8 steps. */
+    const uint64_t bound = (uint64_t)(IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER + 8) * stats.polygon_corners +
+                           IRIS_TRIANGULATE_FILE_STEPS_BASE;
     CHECK(stats.triangulation_steps <= bound);
   }
 }
