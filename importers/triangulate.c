@@ -222,16 +222,12 @@ uint32_t iris_polygon_triangulate(iris_polygon_triangulator *t, const float *pos
   }
   s.steps += n;
   if (n == 4) {
-    t->stats.steps += s.steps + 2;
     /* Cycles/Blender split quads along 0-2; keep that unless it leaves the quad. */
-    if (cross2(p[0], p[1], p[2]) > 0 && cross2(p[0], p[2], p[3]) > 0) {
-      const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-      memcpy(tris, q, sizeof q);
-      return 2;
-    }
-    if (cross2(p[1], p[2], p[3]) > 0 && cross2(p[1], p[3], p[0]) > 0) {
-      const uint32_t q[6] = {1, 2, 3, 1, 3, 0};
-      memcpy(tris, q, sizeof q);
+    const bool d02 = cross2(p[0], p[1], p[2]) > 0 && cross2(p[0], p[2], p[3]) > 0;
+    if (d02 || (cross2(p[1], p[2], p[3]) > 0 && cross2(p[1], p[3], p[0]) > 0)) {
+      const uint32_t q[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
+      memcpy(tris, q[d02 ? 0 : 1], sizeof q[0]);
+      t->stats.steps += s.steps + 2;
       return 2;
     }
   }
