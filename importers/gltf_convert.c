@@ -183,6 +183,7 @@ typedef struct ctx {
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
   size_t zero_normals;
   size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
+  size_t sparse_left;               /* sparse indices the validation may still read */
   uint32_t *vertex_mark, *vertex_remap; /* per accessor element, for primitive_vertices */
   size_t vertex_cap;
   uint32_t vertex_stamp;
@@ -398,12 +399,13 @@ static iris_status validate_accessors(ctx *c) {
         return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
                     k ? "values" : "indices", views[k]);
     }
-    /* Reading the indices is charged to the mesh-data budget: accessors that
-     * share one sparse index view would otherwise cost accessors x indices. */
-    if ((double)n * 4.0 > (double)c->budget_left)
-      return fail(c, IRIS_ERR_NOMEM, el, "sparse indices of all accessors would exceed %zu MiB",
-                  c->budget_total >> 20);
-    c->budget_left -= n * 4;
+    /* Accessors that share one sparse index view would each re-read it
+     * (accessors x indices): all of them together may read 4 indices per
+     * buffer byte plus 2^20. */
+    if (n > c->sparse_left)
+      return fail(c, IRIS_ERR_NOMEM, el,
+                  "sparse indices of all accessors exceed 4 per buffer byte (a sparse view shared by many accessors?)");
+    c->sparse_left -= n;
     const iris_gltf_view *iv = &d->views[a->sparse_index_view];
     const uint8_t *ip = d->buffers[iv->buffer].data + iv->offset + (size_t)a->sparse_index_offset;
     for (size_t k = 0; k < n; k++) {
@@ -1536,6 +1538,9 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
     c.budget_total = c.budget_total > SIZE_MAX / 2 - add ? SIZE_MAX / 2 : c.budget_total + add;
   }
   c.budget_left = c.budget_total;
+  c.sparse_left = (size_t)1 << 20;
+  for (size_t i = 0; i < doc->buffer_count; i++)
+    c.sparse_left += doc->buffers[i].size > SIZE_MAX / 8 ? SIZE_MAX / 8 : 4 * doc->buffers[i].size;
   /* Validate everything first (even what the scene does not use), then build. */
   if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = validate_textures(&c)) ||
       (st = validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||

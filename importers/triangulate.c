@@ -35,7 +35,7 @@ struct iris_polygon_triangulator {
   uint32_t *prev, *next;   /* the ring of corners left */
   uint32_t *lprev, *lnext; /* links in the reflex list or the ear list (never both: ears are convex) */
   uint8_t *flags;
-  uint32_t steps_per_corner;
+  uint32_t steps_per_corner, file_steps_per_corner;
   iris_triangulate_stats stats;
 };
 
@@ -61,12 +61,17 @@ static inline bool inside2(vec2 a, vec2 b, vec2 c, vec2 q) {
 
 iris_polygon_triangulator *iris_polygon_triangulator_create(void) {
   iris_polygon_triangulator *t = calloc(1, sizeof *t);
-  if (t) t->steps_per_corner = IRIS_TRIANGULATE_STEPS_PER_CORNER;
+  if (t) {
+    t->steps_per_corner = IRIS_TRIANGULATE_STEPS_PER_CORNER;
+    t->file_steps_per_corner = IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER;
+  }
   return t;
 }
 
-void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner) {
+void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner,
+                                          uint32_t file_steps_per_corner) {
   t->steps_per_corner = steps_per_corner;
+  t->file_steps_per_corner = file_steps_per_corner;
 }
 
 void iris_polygon_triangulator_destroy(iris_polygon_triangulator *t) {
@@ -177,9 +182,14 @@ uint32_t iris_polygon_triangulate(iris_polygon_triangulator *t, const float *pos
   t->stats.polygons++;
   t->stats.corners += n;
   if (!reserve(t, n)) return 0;
-  const uint64_t budget = t->steps_per_corner == UINT32_MAX
-                              ? UINT64_MAX
-                              : (uint64_t)t->steps_per_corner * n + IRIS_TRIANGULATE_STEPS_BASE;
+  uint64_t budget = t->steps_per_corner == UINT32_MAX
+                        ? UINT64_MAX
+                        : (uint64_t)t->steps_per_corner * n + IRIS_TRIANGULATE_STEPS_BASE;
+  if (t->file_steps_per_corner != UINT32_MAX) { /* what the file has left */
+    const uint64_t file = (uint64_t)t->file_steps_per_corner * t->stats.corners + IRIS_TRIANGULATE_FILE_STEPS_BASE;
+    const uint64_t left = file > t->stats.steps ? file - t->stats.steps : 0;
+    budget = left < budget ? left : budget;
+  }
   clip s = {t->p, t->prev, t->next, t->lprev, t->lnext, t->flags, NIL, NIL, 0, budget};
   /* Newell normal: robust for non-planar and concave polygons. */
   double nx = 0, ny = 0, nz = 0;
@@ -212,16 +222,12 @@ uint32_t iris_polygon_triangulate(iris_polygon_triangulator *t, const float *pos
   }
   s.steps += n;
   if (n == 4) {
-    t->stats.steps += s.steps + 2;
     /* Cycles/Blender split quads along 0-2; keep that unless it leaves the quad. */
-    if (cross2(p[0], p[1], p[2]) > 0 && cross2(p[0], p[2], p[3]) > 0) {
-      const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-      memcpy(tris, q, sizeof q);
-      return 2;
-    }
-    if (cross2(p[1], p[2], p[3]) > 0 && cross2(p[1], p[3], p[0]) > 0) {
-      const uint32_t q[6] = {1, 2, 3, 1, 3, 0};
-      memcpy(tris, q, sizeof q);
+    const bool d02 = cross2(p[0], p[1], p[2]) > 0 && cross2(p[0], p[2], p[3]) > 0;
+    if (d02 || (cross2(p[1], p[2], p[3]) > 0 && cross2(p[1], p[3], p[0]) > 0)) {
+      const uint32_t q[2][6] = {{0, 1, 2, 0, 2, 3}, {1, 2, 3, 1, 3, 0}};
+      memcpy(tris, q[d02 ? 0 : 1], sizeof q[0]);
+      t->stats.steps += s.steps + 2;
       return 2;
     }
   }

@@ -11,13 +11,20 @@
 extern "C" {
 #endif
 
-/* Work budget of one polygon of n corners, in steps (one step = one
- * point-in-triangle test, one corner visited or one triangle written):
- * IRIS_TRIANGULATE_STEPS_PER_CORNER * n + IRIS_TRIANGULATE_STEPS_BASE. When the
- * ear clipping would exceed it, the corners still left are fan-triangulated.
- * The value comes from bench/import/bench_triangulate (docs/performance.md). */
+/* Work budgets, in steps (one step = one point-in-triangle test, one corner
+ * visited or one triangle written). A polygon of n corners may take
+ * IRIS_TRIANGULATE_STEPS_PER_CORNER * n + IRIS_TRIANGULATE_STEPS_BASE, and all
+ * polygons of one triangulator (one file) together
+ * IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER per corner seen so far +
+ * IRIS_TRIANGULATE_FILE_STEPS_BASE: a few large concave polygons are exact,
+ * a file of them costs at most ~40 steps per corner. When the ear clipping
+ * would exceed either, the corners still left are fan-triangulated. The
+ * values come from bench/import/bench_triangulate and the fuzzers' timeouts
+ * (docs/import-obj-ply.md, "Mesh processing"). */
 #define IRIS_TRIANGULATE_STEPS_PER_CORNER 512u
 #define IRIS_TRIANGULATE_STEPS_BASE 4096u
+#define IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER 32u
+#define IRIS_TRIANGULATE_FILE_STEPS_BASE (1u << 21)
 
 /* Reusable scratch space and work counters (one per importer call). */
 typedef struct iris_polygon_triangulator iris_polygon_triangulator;
@@ -32,9 +39,11 @@ typedef struct iris_triangulate_stats {
   uint64_t fallbacks; /* polygons whose budget ran out (rest fan-triangulated) */
 } iris_triangulate_stats;
 iris_triangulate_stats iris_polygon_triangulator_stats(const iris_polygon_triangulator *t);
-/* Replaces IRIS_TRIANGULATE_STEPS_PER_CORNER for this triangulator (UINT32_MAX:
- * no budget); for the benchmark and the tests. */
-void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner);
+/* Replaces IRIS_TRIANGULATE_STEPS_PER_CORNER and
+ * IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER for this triangulator (UINT32_MAX: no
+ * such budget); for the benchmark and the tests. */
+void iris_polygon_triangulator_set_budget(iris_polygon_triangulator *t, uint32_t steps_per_corner,
+                                          uint32_t file_steps_per_corner);
 
 /* The importers' end of a file: adds t's counters to stats (when not NULL) and
  * warns once, naming path, when some polygons were partly fan-triangulated. */

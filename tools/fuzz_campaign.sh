@@ -15,6 +15,8 @@
 # on, and totals add up (tools/fuzz_campaign.sh --report prints them).
 # Every K slices of a harness (default 4) and at the end its corpus is
 # minimised with -merge=1 (the seeds are read again each slice, never written).
+# libFuzzer's timeout is wall-clock; a timeout whose input re-runs in less than
+# half the timeout of CPU time moves to slow-under-load/ instead of counting.
 #
 # Seeds per harness are those of the fuzz.<format>.short tests (docs/fuzzing.md):
 # tests/fuzz/corpus/<format>/, shared/assets/<format>/, shared/assets/bad/<format>/
@@ -116,6 +118,17 @@ while [ "$spent" -lt "$budget" ]; do
     cov=$(printf '%s' "$line" | sed -n 's/.* cov: \([0-9]*\).*/\1/p')
     ft=$(printf '%s' "$line" | sed -n 's/.* ft: \([0-9]*\).*/\1/p')
     [ -n "$execs" ] || execs=$(printf '%s' "$line" | sed -n 's/^#\([0-9]*\).*/\1/p')
+    # libFuzzer's timeout is wall-clock: re-run each new timeout and keep it as
+    # a finding only when its CPU time is at least half the timeout.
+    for t in "$dir"/artifacts/timeout-*; do
+      [ -f "$t" ] || continue
+      /usr/bin/time -f '%U' -o "$dir/.cpu" "$build/tests/fuzz/$h" "$t" >/dev/null 2>&1
+      cpu=$(tail -n 1 "$dir/.cpu" 2>/dev/null)
+      if awk -v c="${cpu:-999}" -v t="$timeout" 'BEGIN { exit !(c < t / 2) }'; then
+        mkdir -p "$dir/slow-under-load" && mv "$t" "$dir/slow-under-load/"
+        echo "fuzz_campaign: $h: $(basename "$t") takes ${cpu} s CPU: a timeout under load, not a finding"
+      fi
+    done
     units=$(ls "$dir/corpus" | wc -l)
     findings=$(ls "$dir/artifacts" | wc -l)
     printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' "$h" "$n" "$took" "${execs:-0}" "${cov:-}" \

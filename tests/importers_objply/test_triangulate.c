@@ -66,7 +66,7 @@ static double cross(uint32_t a, uint32_t b, uint32_t c) {
  * returns the stats of this one call. exact: also no overlap, none flipped. */
 static iris_triangulate_stats run(uint32_t n, uint32_t budget, bool exact, const char *what) {
   iris_polygon_triangulator *t = iris_polygon_triangulator_create();
-  if (budget) iris_polygon_triangulator_set_budget(t, budget);
+  if (budget) iris_polygon_triangulator_set_budget(t, budget, IRIS_TRIANGULATE_FILE_STEPS_PER_CORNER);
   for (uint32_t i = 0; i < n; i++) corners[i] = i;
   const uint32_t nt = iris_polygon_triangulate(t, pos, corners, n, tris);
   const iris_triangulate_stats st = iris_polygon_triangulator_stats(t);
