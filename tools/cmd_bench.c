@@ -99,7 +99,12 @@ int iris_cmd_bench(int argc, char **argv) {
   const char *plot_script = NULL;
   char methods_buf[256] = "", times_buf[512] = "";
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0};
+  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0, 0};
+  /* the shared rows bench takes (tools/options.h); its own flags are below */
+  iris_render_options ro;
+  memset(&ro, 0, sizeof ro);
+  iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
+                            iris_options_rows(&IRIS_RENDER_OPTIONS, "threads,width,height,max-depth")};
   for (int i = 1; i < argc; i++) {
     char name[64];
     const char *val;
@@ -118,7 +123,8 @@ int iris_cmd_bench(int argc, char **argv) {
     if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       print_help();
       printf("\n");
-      iris_options_help(&envb, 1);
+      iris_option_binding shared[2] = {rb, envb};
+      iris_options_help(shared, 2);
       return IRIS_EXIT_OK;
     } else if (iris_options_take(CMD, &envb, a, val, argc, argv, &i, &erc)) {
       if (erc) return erc;
@@ -132,22 +138,8 @@ int iris_cmd_bench(int argc, char **argv) {
       NEED_VALUE();
       if (!iris_cli_parse_int(CMD, a, val, 1, IRIS_BENCH_MAX_SEEDS, &lv)) return IRIS_EXIT_USAGE;
       p.seeds = (int)lv;
-    } else if (strcmp(a, "--threads") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 4096, &lv)) return IRIS_EXIT_USAGE;
-      p.threads = (int)lv;
-    } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0) {
-      bool w = strcmp(a, "--width") == 0;
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 16384, &lv)) return IRIS_EXIT_USAGE;
-      if (w)
-        p.width = (int)lv;
-      else
-        p.height = (int)lv;
-    } else if (strcmp(a, "--max-depth") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 0, 1000000, &lv)) return IRIS_EXIT_USAGE;
-      p.max_depth = (int)lv;
+    } else if (iris_options_take(CMD, &rb, a, val, argc, argv, &i, &erc)) {
+      if (erc) return erc;
     } else if (strcmp(a, "--reference") == 0) {
       NEED_VALUE();
       if (strcmp(val, "auto") == 0)
@@ -197,6 +189,13 @@ int iris_cmd_bench(int argc, char **argv) {
   }
   /* Everything that can be checked is checked before any work starts. */
   if (input_count == 0) return iris_cli_usage_error(CMD, "no input scene given");
+  if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
+  if (iris_options_seen(&rb, "max-depth")) p.max_depth = ro.max_depth;
+  if (iris_options_seen(&rb, "width")) p.width = ro.width;
+  if (iris_options_seen(&rb, "height")) p.height = ro.height;
+  if (p.width > 16384 || p.height > 16384)
+    return iris_cli_usage_error(CMD, "invalid value '%d' for --%s (a number in [1, 16384])",
+                                p.width > 16384 ? p.width : p.height, p.width > 16384 ? "width" : "height");
   int erc = iris_env_options_check(CMD, &envb, true);
   if (erc != IRIS_EXIT_OK) return erc;
   p.world.map = eo.map;
