@@ -152,9 +152,20 @@ size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float
     size_t j = fu > 0.0f ? (size_t)fu : 0;
     if (j >= d->guide_count) j = d->guide_count - 1;
     lo = d->guide[j];
-    /* the guide entry is exact up to the rounding of u * m: walk to the answer */
+    /* The answer lies in [guide[j], guide[j + 1]] (up to the rounding of u * m,
+     * which the walks fix); a bucket can span many entries of tiny weight
+     * (the dark texels of an environment map's row), so the rest is a
+     * binary search rather than a walk. */
     while (lo > 0 && d->cdf[lo] > u) --lo;
-    while (lo + 1 < d->count && d->cdf[lo + 1] <= u) ++lo;
+    size_t hi = j + 1 < d->guide_count ? (size_t)d->guide[j + 1] + 1 : d->count;
+    if (hi > d->count) hi = d->count;
+    if (hi <= lo) hi = lo + 1;
+    while (hi < d->count && d->cdf[hi] <= u) ++hi;
+    while (hi - lo > 1) { /* invariant: cdf[lo] <= u < cdf[hi] (cdf[count] = 1 > u) */
+      size_t mid = lo + (hi - lo) / 2;
+      if (d->cdf[mid] <= u) lo = mid;
+      else hi = mid;
+    }
   } else {
     size_t hi = d->count; /* invariant: cdf[lo] <= u < cdf[hi] */
     lo = 0;

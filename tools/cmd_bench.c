@@ -32,9 +32,8 @@ static void print_help(void) {
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
-      "      --sampler S      sobol (default) | independent: what a plain method name uses\n"
-      "                       (the reference's is fixed: docs/benchmarks.md)\n"
-      "      --light-sampling M  solid-angle (default) | area: likewise\n"
+      "                       (--sampler and --light-sampling below: what a plain\n"
+      "                       name uses; the auto reference is always independent)\n"
       "      --width W, --height H   image size (default: the reference's, else the\n"
       "                       scene's; one of them: the other keeps the scene's aspect)\n"
       "      --max-depth B    bounces as Cycles counts them (default: the scene's, else 64)\n"
@@ -97,8 +96,6 @@ static int split_list(char *text, char **items, int max) {
 
 int iris_cmd_bench(int argc, char **argv) {
   iris_bench_params p = iris_bench_params_default();
-  iris_sampler_kind sampler = IRIS_SAMPLER_SOBOL;
-  iris_triangle_sampling light_sampling = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
   const char *inputs[IRIS_BENCH_MAX_SCENES + 1];
   const char *refs[IRIS_BENCH_MAX_SCENES + 1];
   int input_count = 0, ref_count = 0;
@@ -106,7 +103,13 @@ int iris_cmd_bench(int argc, char **argv) {
   const char *plot_script = NULL;
   char methods_buf[256] = "", times_buf[512] = "";
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0};
+  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0, 0};
+  /* the shared rows bench takes (tools/options.h); its own flags are below */
+  iris_render_options ro;
+  memset(&ro, 0, sizeof ro);
+  iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
+                            iris_options_rows(&IRIS_RENDER_OPTIONS,
+                                             "threads,width,height,max-depth,sampler,light-sampling")};
   for (int i = 1; i < argc; i++) {
     char name[64];
     const char *val;
@@ -125,7 +128,8 @@ int iris_cmd_bench(int argc, char **argv) {
     if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       print_help();
       printf("\n");
-      iris_options_help(&envb, 1);
+      iris_option_binding shared[2] = {rb, envb};
+      iris_options_help(shared, 2);
       return IRIS_EXIT_OK;
     } else if (iris_options_take(CMD, &envb, a, val, argc, argv, &i, &erc)) {
       if (erc) return erc;
@@ -139,30 +143,8 @@ int iris_cmd_bench(int argc, char **argv) {
       NEED_VALUE();
       if (!iris_cli_parse_int(CMD, a, val, 1, IRIS_BENCH_MAX_SEEDS, &lv)) return IRIS_EXIT_USAGE;
       p.seeds = (int)lv;
-    } else if (strcmp(a, "--light-sampling") == 0) {
-      NEED_VALUE();
-      if (!iris_triangle_sampling_parse(val, &light_sampling))
-        return iris_cli_usage_error(CMD, "unknown light sampling '%s' (solid-angle, area)", val);
-    } else if (strcmp(a, "--sampler") == 0) {
-      NEED_VALUE();
-      if (!iris_sampler_kind_parse(val, &sampler))
-        return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", val);
-    } else if (strcmp(a, "--threads") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 4096, &lv)) return IRIS_EXIT_USAGE;
-      p.threads = (int)lv;
-    } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0) {
-      bool w = strcmp(a, "--width") == 0;
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 1, 16384, &lv)) return IRIS_EXIT_USAGE;
-      if (w)
-        p.width = (int)lv;
-      else
-        p.height = (int)lv;
-    } else if (strcmp(a, "--max-depth") == 0) {
-      NEED_VALUE();
-      if (!iris_cli_parse_int(CMD, a, val, 0, 1000000, &lv)) return IRIS_EXIT_USAGE;
-      p.max_depth = (int)lv;
+    } else if (iris_options_take(CMD, &rb, a, val, argc, argv, &i, &erc)) {
+      if (erc) return erc;
     } else if (strcmp(a, "--reference") == 0) {
       NEED_VALUE();
       if (strcmp(val, "auto") == 0)
@@ -212,6 +194,16 @@ int iris_cmd_bench(int argc, char **argv) {
   }
   /* Everything that can be checked is checked before any work starts. */
   if (input_count == 0) return iris_cli_usage_error(CMD, "no input scene given");
+  if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
+  /* what a method named without @variant uses */
+  iris_sampler_kind sampler = (iris_sampler_kind)ro.sampler;
+  iris_triangle_sampling light_sampling = (iris_triangle_sampling)ro.light_sampling;
+  if (iris_options_seen(&rb, "max-depth")) p.max_depth = ro.max_depth;
+  if (iris_options_seen(&rb, "width")) p.width = ro.width;
+  if (iris_options_seen(&rb, "height")) p.height = ro.height;
+  if (p.width > 16384 || p.height > 16384)
+    return iris_cli_usage_error(CMD, "invalid value '%d' for --%s (a number in [1, 16384])",
+                                p.width > 16384 ? p.width : p.height, p.width > 16384 ? "width" : "height");
   int erc = iris_env_options_check(CMD, &envb, true);
   if (erc != IRIS_EXIT_OK) return erc;
   p.world.map = eo.map;

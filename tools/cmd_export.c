@@ -16,8 +16,7 @@
 static const char *const CMD = "export";
 
 typedef struct export_cli {
-  const char *to, *output, *camera;
-  int width, height, spp, seed, max_depth;
+  const char *to, *output;
   int radiosity; /* index into POV_RADIOSITY */
   bool embed, coverage, quiet;
 } export_cli;
@@ -28,17 +27,6 @@ static const iris_option EXPORT_ROWS[] = {
     {"to", 0, IRIS_OPT_STRING, "FORMAT", 0, 0, offsetof(export_cli, to), "blender or pov (required)", NULL},
     {"output", 'o', IRIS_OPT_STRING, "FILE", 0, 0, offsetof(export_cli, output),
      "the script (.py) or scene (.pov) to write (required)", NULL},
-    {"camera", 0, IRIS_OPT_STRING, "NAME", 0, 0, offsetof(export_cli, camera),
-     "scene camera to use (default: the first; none: framed\n"
-     "automatically, as `iris render` does)", NULL},
-    {"width", 0, IRIS_OPT_INT, "W", 1, 65536, offsetof(export_cli, width), "image width (default: as `iris render`)", NULL},
-    {"height", 0, IRIS_OPT_INT, "H", 1, 65536, offsetof(export_cli, height), "image height (default: as `iris render`)", NULL},
-    {"spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, offsetof(export_cli, spp), "blender: default samples per pixel of the script", NULL},
-    /* Cycles' seed is a non-negative 32-bit int. */
-    {"seed", 0, IRIS_OPT_INT, "N", 0, 2147483647.0, offsetof(export_cli, seed), "blender: default Cycles seed of the script", NULL},
-    {"max-depth", 0, IRIS_OPT_INT, "B", 0, 1024, offsetof(export_cli, max_depth),
-     "bounces as Cycles counts them (default: the scene's, else 64);\n"
-     "pov: max_trace_level B+1", NULL},
     {"embed", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(export_cli, embed), "blender: put the mesh data inside the script", NULL},
     {"pov-coverage", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(export_cli, coverage),
      "pov: every object a pure white emitter on black, no lights", NULL},
@@ -64,6 +52,8 @@ static void print_help(const iris_option_binding *b, size_t n) {
          "             povray +IOUT.pov +OIMG.png +FN +W<w> +H<h> -D -V\n"
          "In-memory textures are written to <stem>.textures/ next to OUT.\n"
          "\n");
+  printf("blender: --spp and --seed are the script's defaults; --max-depth is Cycles'\n"
+         "bounce count (pov: max_trace_level B+1, at most 1024); --seed at most 2^31-1.\n\n");
   iris_options_help(b, n);
   printf("  -h, --help              show this help\n"
          "\n"
@@ -76,26 +66,40 @@ int iris_cmd_export(int argc, char **argv) {
   export_cli ec;
   memset(&ec, 0, sizeof ec);
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding bind[] = {{&EXPORT_OPTIONS, &ec, 0}, {&IRIS_ENV_OPTIONS, &eo, 0}};
+  iris_render_options ro;
+  memset(&ro, 0, sizeof ro);
+  /* the shared sampling/camera rows export means something by: the script's defaults */
+  iris_option_binding bind[] = {
+      {&EXPORT_OPTIONS, &ec, 0, 0},
+      {&IRIS_RENDER_OPTIONS, &ro, 0, iris_options_rows(&IRIS_RENDER_OPTIONS, "spp,seed,max-depth,camera,width,height")},
+      {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
+  const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int ninputs = 0;
-  int prc = iris_options_parse(CMD, argc, argv, bind, 2, &input, 1, &ninputs);
+  int prc = iris_options_parse(CMD, argc, argv, bind, nbind, &input, 1, &ninputs);
   if (prc < 0) {
-    print_help(bind, 2);
+    print_help(bind, nbind);
     return IRIS_EXIT_OK;
   }
   if (prc != 0) return prc;
+  const iris_option_binding *rb = &bind[1];
+  /* Cycles' seed is a non-negative 32-bit int; Cycles' bounce counts stop at 1024 */
+  if (iris_options_seen(rb, "seed") && ro.seed > 2147483647u)
+    return iris_cli_usage_error(CMD, "invalid value '%llu' for --seed (a number in [0, 2147483647])",
+                                (unsigned long long)ro.seed);
+  if (iris_options_seen(rb, "max-depth") && ro.max_depth > 1024)
+    return iris_cli_usage_error(CMD, "invalid value '%d' for --max-depth (a number in [0, 1024])", ro.max_depth);
   const char *to = ec.to, *output = ec.output;
   bool quiet = ec.quiet;
-  params.camera_name = ec.camera;
-  if (iris_options_seen(&bind[0], "width")) params.width = ec.width;
-  if (iris_options_seen(&bind[0], "height")) params.height = ec.height;
-  if (iris_options_seen(&bind[0], "spp")) params.spp = ec.spp;
-  if (iris_options_seen(&bind[0], "seed")) {
-    params.seed = (uint64_t)ec.seed;
+  params.camera_name = ro.camera;
+  if (iris_options_seen(rb, "width")) params.width = ro.width;
+  if (iris_options_seen(rb, "height")) params.height = ro.height;
+  if (iris_options_seen(rb, "spp")) params.spp = ro.spp;
+  if (iris_options_seen(rb, "seed")) {
+    params.seed = ro.seed;
     params.has_seed = true;
   }
-  if (iris_options_seen(&bind[0], "max-depth")) params.max_depth = ec.max_depth;
+  if (iris_options_seen(rb, "max-depth")) params.max_depth = ro.max_depth;
   params.embed_meshes = ec.embed;
   params.coverage = ec.coverage;
   const bool radiosity = iris_options_seen(&bind[0], "pov-radiosity");
@@ -126,12 +130,12 @@ int iris_cmd_export(int argc, char **argv) {
   if (iris_path_exists(input) && iris_cli_same_file(input, output))
     return iris_cli_usage_error(CMD, "output '%s' is also the input", output);
 
-  int rc = iris_env_options_check(CMD, &bind[1], true);
+  int rc = iris_env_options_check(CMD, &bind[2], true);
   if (rc != IRIS_EXIT_OK) return rc;
   iris_scene *scene = NULL;
   rc = iris_cli_load_scene(CMD, input, params.camera_name, NULL, &scene);
   if (rc != IRIS_EXIT_OK) return rc;
-  if ((rc = iris_env_options_apply(CMD, &bind[1], scene)) != IRIS_EXIT_OK) {
+  if ((rc = iris_env_options_apply(CMD, &bind[2], scene)) != IRIS_EXIT_OK) {
     iris_scene_destroy(scene);
     return rc;
   }

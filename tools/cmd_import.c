@@ -75,7 +75,7 @@ int iris_cmd_import(int argc, char **argv) {
   import_cli ic;
   memset(&ic, 0, sizeof ic);
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding bind[] = {{&IMPORT_OPTIONS, &ic, 0}, {&IRIS_ENV_OPTIONS, &eo, 0}};
+  iris_option_binding bind[] = {{&IMPORT_OPTIONS, &ic, 0, 0}, {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
   const char *inputs[256];
   int ninputs = 0;
   int prc = iris_options_parse(CMD, argc, argv, bind, 2, inputs, 256, &ninputs);

@@ -198,9 +198,9 @@ int iris_cmd_render(int argc, char **argv) {
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0},
-                                {&PARTITION_OPTIONS, &rc_opts, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0},
-                                {&IRIS_ENV_OPTIONS, &eo, 0}};
+  iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0, 0},
+                                {&PARTITION_OPTIONS, &rc_opts, 0, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0, 0},
+                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
   const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int operands = 0;

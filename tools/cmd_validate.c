@@ -142,7 +142,7 @@ int iris_cmd_validate(int argc, char **argv) {
   memcpy(longopts, own_opts, sizeof own_opts);
   iris_options_getopt_rows(&IRIS_ENV_OPTIONS, OPT_ENV, longopts + sizeof own_opts / sizeof own_opts[0]);
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0};
+  iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0, 0};
   int erc = 0;
   iris_validate_params p = iris_validate_params_default();
   bool blender = false, refresh = false, have_blender_spp = false, blender_import = false;

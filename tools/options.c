@@ -105,6 +105,24 @@ const iris_option_group IRIS_GUIDING_OPTIONS = {
 
 /* ---- parser ---------------------------------------------------------------- */
 
+static bool row_taken(const iris_option_binding *b, size_t r) {
+  return b->rows == 0 || ((b->rows >> r) & 1u);
+}
+
+uint64_t iris_options_rows(const iris_option_group *g, const char *names) {
+  uint64_t mask = 0;
+  for (size_t r = 0; r < g->count; r++) {
+    size_t n = strlen(g->rows[r].name);
+    for (const char *p = names; *p;) {
+      const char *end = strchr(p, ',');
+      size_t len = end ? (size_t)(end - p) : strlen(p);
+      if (len == n && strncmp(p, g->rows[r].name, n) == 0) mask |= 1ull << r;
+      p += len + (end ? 1 : 0);
+    }
+  }
+  return mask;
+}
+
 /* "R,G,B": three finite numbers in [lo, hi]. */
 static bool parse_rgb(const char *text, double lo, double hi, float out[3]) {
   const char *q = text;
@@ -190,10 +208,15 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
   for (size_t b = 0; b < binding_count; b++)
     for (size_t r = 0; r < bindings[b].group->count; r++, k++) {
       const iris_option *o = &bindings[b].group->rows[r];
+      if (!row_taken(&bindings[b], r)) { /* a name no command-line flag matches */
+        longopts[k].name = "\x01";
+        longopts[k].val = 256 + (int)k;
+        continue;
+      }
       longopts[k].name = o->name;
       longopts[k].has_arg = o->type == IRIS_OPT_FLAG ? no_argument : required_argument;
       longopts[k].val = 256 + (int)k;
-      if (o->short_name && sl + 3 < sizeof shorts) {
+      if (o->short_name && sl + 3 < sizeof shorts) { /* (rows not taken have none here) */
         shorts[sl++] = o->short_name;
         if (o->type != IRIS_OPT_FLAG) shorts[sl++] = ':';
         shorts[sl] = 0;
@@ -220,7 +243,7 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
       for (size_t i = 0; i < total && !found; i++) {
         size_t b = 0, r = i;
         while (r >= bindings[b].group->count) r -= bindings[b++].group->count;
-        if (bindings[b].group->rows[r].short_name == c) index = i, found = true;
+        if (bindings[b].group->rows[r].short_name == c && row_taken(&bindings[b], r)) index = i, found = true;
       }
     }
     if (!found) {
@@ -252,7 +275,7 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
 }
 
 size_t iris_options_getopt_rows(const iris_option_group *g, int base, struct option *out) {
-  for (size_t r = 0; r < g->count; r++) {
+  for (size_t r = 0; r < g->count; r++) { /* all rows: commands that take a subset use iris_options_parse */
     out[r].name = g->rows[r].name;
     out[r].has_arg = g->rows[r].type == IRIS_OPT_FLAG ? no_argument : required_argument;
     out[r].flag = NULL;
@@ -284,7 +307,7 @@ bool iris_options_take(const char *cmd, iris_option_binding *b, const char *name
   if (strncmp(name, "--", 2) != 0) return false;
   for (size_t r = 0; r < b->group->count; r++) {
     const iris_option *o = &b->group->rows[r];
-    if (strcmp(name + 2, o->name) != 0) continue;
+    if (!row_taken(b, r) || strcmp(name + 2, o->name) != 0) continue;
     if (o->type == IRIS_OPT_FLAG) {
       if (val) {
         *rc = iris_cli_usage_error(cmd, "option %s takes no value", name);
@@ -305,6 +328,7 @@ void iris_options_help(const iris_option_binding *bindings, size_t binding_count
     if (g->title) printf("%s:\n", g->title);
     for (size_t r = 0; r < g->count; r++) {
       const iris_option *o = &g->rows[r];
+      if (!row_taken(&bindings[b], r)) continue;
       char head[96];
       int n = o->short_name ? snprintf(head, sizeof head, "  -%c, --%s", o->short_name, o->name)
                             : snprintf(head, sizeof head, "      --%s", o->name);
@@ -330,6 +354,7 @@ bool iris_options_seen(const iris_option_binding *b, const char *name) {
 /* ---- environment ----------------------------------------------------------- */
 
 int iris_env_options_check(const char *cmd, const iris_option_binding *b, bool check_map) {
+  if (b->group != &IRIS_ENV_OPTIONS) __builtin_trap(); /* a binding of another group: a bug */
   const iris_env_options *e = (const iris_env_options *)b->target;
   bool color = iris_options_seen(b, "env-color");
   if (color && e->map) return iris_cli_usage_error(cmd, "--env and --env-color exclude each other");
@@ -344,6 +369,7 @@ int iris_env_options_check(const char *cmd, const iris_option_binding *b, bool c
 }
 
 int iris_env_options_apply(const char *cmd, const iris_option_binding *b, iris_scene *scene) {
+  if (b->group != &IRIS_ENV_OPTIONS) __builtin_trap(); /* a binding of another group: a bug */
   const iris_env_options *e = (const iris_env_options *)b->target;
   if (e->map) {
     /* absolute, so that a scene written elsewhere still finds it */

@@ -44,12 +44,19 @@ typedef struct iris_option_group {
   size_t count;
 } iris_option_group;
 
-/* A group bound to the struct its rows fill; `seen` gets bit i for row i given. */
+/* A group bound to the struct its rows fill; `seen` gets bit i for row i
+ * given; `rows` (0 = all) selects the rows this command takes
+ * (iris_options_rows), so that commands share a group's declarations without
+ * taking flags that mean nothing to them. */
 typedef struct iris_option_binding {
   const iris_option_group *group;
   void *target;
   uint64_t seen;
+  uint64_t rows;
 } iris_option_binding;
+
+/* The mask of the rows named in a comma-separated list ("spp,seed,width"). */
+uint64_t iris_options_rows(const iris_option_group *g, const char *names);
 
 /* Parses argv[1..] against the bindings with getopt_long (GNU long options,
  * "--name=value" or "--name value", options and operands in any order).

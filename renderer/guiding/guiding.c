@@ -481,7 +481,11 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   /* With light sampling the direct light needs no guide: photons straight
    * from a light leave the photon tree, so every cache's k photons describe
    * the indirect light (measured in docs/guiding.md). */
-  const bool direct = p->direct_photons > 0 || (p->direct_photons < 0 && !p->use_nee);
+  /* A sky seen through openings is the exception: light sampling of the map
+   * mostly hits walls, and the direct photons are what teaches the guide
+   * where the openings are (docs/guiding.md, "Budget"). */
+  const bool direct = p->direct_photons > 0 ||
+                      (p->direct_photons < 0 && (!p->use_nee || environment_share(s->lights) >= 0.5));
   normal_cone cones[NORMAL_GROUPS];
   uint32_t *group = st == IRIS_OK ? malloc(sizeof(uint32_t) * (photons.count ? photons.count : 1)) : NULL;
   if (st == IRIS_OK && (!group || !group_photons(photons.photons, photons.count, direct, s->threads, group, cones)))
