@@ -76,6 +76,7 @@ static void print_help(const iris_option_binding *b, size_t n) {
   printf("\n\n");
   iris_options_help(b, n);
   printf(
+      "  -h, --help            show this help\n"
       "\n"
       "Exit status: 0 done, 2 bad usage or input, 1 other failure, 130 (SIGINT) or\n"
       "143 (SIGTERM) when interrupted: the image of the passes done is still written.\n");

@@ -41,7 +41,6 @@ static void print_help(void) {
       "      --spp N               iris samples per pixel (default %d)\n"
       "      --seed N              seed of iris and Cycles (default 0)\n"
       "      --threads N           threads of iris and Cycles (default: all cores)\n"
-      "      --sampler S           iris's sampler: sobol (default) | independent\n"
       "      --width W --height H  image size (must match a given reference)\n"
       "      --max-depth B         bounces as Cycles counts them (default: scene's, else 64)\n"
       "      --camera NAME         scene camera to use\n"
@@ -110,39 +109,38 @@ int iris_cmd_validate(int argc, char **argv) {
   enum {
     OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
     OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
-    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_SAMPLER, OPT_BLENDER_IMPORT,
-    OPT_ENV = 512
+    OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_BLENDER_IMPORT, OPT_ENV = 512,
+    OPT_RENDER = 640
   };
   static const struct option own_opts[] = {
       {"method", required_argument, NULL, OPT_METHOD},
-      {"spp", required_argument, NULL, OPT_SPP},
       {"reference", required_argument, NULL, OPT_REFERENCE},
       {"blender", no_argument, NULL, OPT_BLENDER},
       {"blender-import", optional_argument, NULL, OPT_BLENDER_IMPORT},
       {"tolerance", required_argument, NULL, OPT_TOLERANCE},
       {"blender-spp", required_argument, NULL, OPT_BLENDER_SPP},
-      {"threads", required_argument, NULL, OPT_THREADS},
-      {"seed", required_argument, NULL, OPT_SEED},
-      {"width", required_argument, NULL, OPT_WIDTH},
-      {"height", required_argument, NULL, OPT_HEIGHT},
       {"out", required_argument, NULL, OPT_OUT},
       {"refresh", no_argument, NULL, OPT_REFRESH},
       {"references", required_argument, NULL, OPT_REFERENCES},
-      {"max-depth", required_argument, NULL, OPT_DEPTH},
-      {"camera", required_argument, NULL, OPT_CAMERA},
       {"alpha", required_argument, NULL, OPT_ALPHA},
       {"blender-exe", required_argument, NULL, OPT_BLENDER_EXE},
       {"strict-pixels", no_argument, NULL, OPT_STRICT},
-      {"sampler", required_argument, NULL, OPT_SAMPLER},
       {"quiet", no_argument, NULL, 'q'},
       {"help", no_argument, NULL, 'h'}};
-  /* the shared environment rows (tools/options.h) after validate's own */
-  struct option longopts[sizeof own_opts / sizeof own_opts[0] + IRIS_OPTIONS_MAX_ROWS + 1];
-  memset(longopts, 0, sizeof longopts);
-  memcpy(longopts, own_opts, sizeof own_opts);
-  iris_options_getopt_rows(&IRIS_ENV_OPTIONS, OPT_ENV, longopts + sizeof own_opts / sizeof own_opts[0]);
+  /* the shared sampling/camera and environment rows (tools/options.h) after validate's own */
   iris_env_options eo = iris_env_options_default();
   iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0, 0};
+  iris_render_options ro;
+  memset(&ro, 0, sizeof ro);
+  iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
+                            iris_options_rows(&IRIS_RENDER_OPTIONS,
+                                             "spp,seed,threads,width,height,max-depth,camera,sampler")};
+  struct option longopts[sizeof own_opts / sizeof own_opts[0] + 2 * IRIS_OPTIONS_MAX_ROWS + 1];
+  memset(longopts, 0, sizeof longopts);
+  memcpy(longopts, own_opts, sizeof own_opts);
+  size_t nl = sizeof own_opts / sizeof own_opts[0];
+  nl += iris_options_getopt_rows(&rb, OPT_RENDER, longopts + nl);
+  iris_options_getopt_rows(&envb, OPT_ENV, longopts + nl);
   int erc = 0;
   iris_validate_params p = iris_validate_params_default();
   bool blender = false, refresh = false, have_blender_spp = false, blender_import = false;
@@ -157,14 +155,6 @@ int iris_cmd_validate(int argc, char **argv) {
     switch (c) {
       case OPT_METHOD:
         if (!add_methods(&p, optarg)) return IRIS_EXIT_USAGE;
-        break;
-      case OPT_SAMPLER:
-        if (!iris_sampler_kind_parse(optarg, &p.sampler))
-          return iris_cli_usage_error(CMD, "unknown sampler '%s' (sobol, independent)", optarg);
-        break;
-      case OPT_SPP:
-        if (!iris_cli_parse_int(CMD, "--spp", optarg, 1, 1 << 24, &v)) return IRIS_EXIT_USAGE;
-        p.spp = (int)v;
         break;
       case OPT_REFERENCE:
         if (!iris_cli_set_once(CMD, "--reference", &p.reference_path, optarg)) return IRIS_EXIT_USAGE;
@@ -188,33 +178,8 @@ int iris_cmd_validate(int argc, char **argv) {
         p.blender_spp = (int)v;
         have_blender_spp = true;
         break;
-      case OPT_THREADS:
-        if (!iris_cli_parse_int(CMD, "--threads", optarg, 1, 4096, &v)) return IRIS_EXIT_USAGE;
-        p.threads = (int)v;
-        break;
-      case OPT_SEED:
-        /* Cycles' seed is a non-negative 32-bit int; both renderers get the same. */
-        if (!iris_cli_parse_int(CMD, "--seed", optarg, 0, 2147483647L, &v)) return IRIS_EXIT_USAGE;
-        p.seed = (uint64_t)v;
-        break;
-      case OPT_WIDTH:
-        if (!iris_cli_parse_int(CMD, "--width", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
-        p.width = (int)v;
-        break;
-      case OPT_HEIGHT:
-        if (!iris_cli_parse_int(CMD, "--height", optarg, 1, 65536, &v)) return IRIS_EXIT_USAGE;
-        p.height = (int)v;
-        break;
-      case OPT_DEPTH:
-        if (!iris_cli_parse_int(CMD, "--max-depth", optarg, 0, 1024, &v)) return IRIS_EXIT_USAGE;
-        p.max_depth = (int)v;
-        break;
       case OPT_OUT:
         if (!iris_cli_set_once(CMD, "--out", &p.out_dir, optarg)) return IRIS_EXIT_USAGE;
-        break;
-      case OPT_CAMERA:
-        if (!optarg[0]) return iris_cli_usage_error(CMD, "--camera needs a non-empty name");
-        p.camera_name = optarg;
         break;
       case OPT_REFRESH: refresh = true; break;
       case OPT_REFERENCES: references = optarg; break;
@@ -223,7 +188,8 @@ int iris_cmd_validate(int argc, char **argv) {
       case 'q': p.quiet = true; break;
       case 'h': print_help(); return IRIS_EXIT_OK;
       default:
-        if (iris_options_getopt_take(CMD, &envb, OPT_ENV, c, optarg, &erc)) {
+        if (iris_options_getopt_take(CMD, &envb, OPT_ENV, c, optarg, &erc) ||
+            iris_options_getopt_take(CMD, &rb, OPT_RENDER, c, optarg, &erc)) {
           if (erc) return erc;
           break;
         }
@@ -231,6 +197,25 @@ int iris_cmd_validate(int argc, char **argv) {
     }
   }
   if (p.quiet) iris_log_set_level(IRIS_LOG_QUIET);
+  if (iris_options_seen(&rb, "spp")) p.spp = ro.spp;
+  p.sampler = (iris_sampler_kind)ro.sampler; /* 0 (sobol) unless given */
+  if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
+  if (iris_options_seen(&rb, "width")) p.width = ro.width;
+  if (iris_options_seen(&rb, "height")) p.height = ro.height;
+  if (iris_options_seen(&rb, "camera")) p.camera_name = ro.camera;
+  /* Cycles' seed is a non-negative 32-bit int (both renderers get the same);
+   * Cycles' bounce counts stop at 1024 */
+  if (iris_options_seen(&rb, "seed")) {
+    if (ro.seed > 2147483647u)
+      return iris_cli_usage_error(CMD, "invalid value '%llu' for --seed (a number in [0, 2147483647])",
+                                  (unsigned long long)ro.seed);
+    p.seed = ro.seed;
+  }
+  if (iris_options_seen(&rb, "max-depth")) {
+    if (ro.max_depth > 1024)
+      return iris_cli_usage_error(CMD, "invalid value '%d' for --max-depth (a number in [0, 1024])", ro.max_depth);
+    p.max_depth = ro.max_depth;
+  }
   if ((erc = iris_env_options_check(CMD, &envb, true)) != IRIS_EXIT_OK) return erc;
   p.world.map = eo.map;
   p.world.strength = eo.strength;

@@ -274,14 +274,17 @@ int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_bindi
   return 0;
 }
 
-size_t iris_options_getopt_rows(const iris_option_group *g, int base, struct option *out) {
-  for (size_t r = 0; r < g->count; r++) { /* all rows: commands that take a subset use iris_options_parse */
-    out[r].name = g->rows[r].name;
-    out[r].has_arg = g->rows[r].type == IRIS_OPT_FLAG ? no_argument : required_argument;
-    out[r].flag = NULL;
-    out[r].val = base + (int)r;
+size_t iris_options_getopt_rows(const iris_option_binding *b, int base, struct option *out) {
+  size_t n = 0;
+  for (size_t r = 0; r < b->group->count; r++) {
+    if (!row_taken(b, r)) continue;
+    out[n].name = b->group->rows[r].name;
+    out[n].has_arg = b->group->rows[r].type == IRIS_OPT_FLAG ? no_argument : required_argument;
+    out[n].flag = NULL;
+    out[n].val = base + (int)r;
+    n++;
   }
-  return g->count;
+  return n;
 }
 
 static bool take_row(const char *cmd, iris_option_binding *b, size_t r, const char *arg, int *rc) {
@@ -298,7 +301,7 @@ static bool take_row(const char *cmd, iris_option_binding *b, size_t r, const ch
 
 bool iris_options_getopt_take(const char *cmd, iris_option_binding *b, int base, int c,
                               const char *arg, int *rc) {
-  if (c < base || (size_t)(c - base) >= b->group->count) return false;
+  if (c < base || (size_t)(c - base) >= b->group->count || !row_taken(b, (size_t)(c - base))) return false;
   return take_row(cmd, b, (size_t)(c - base), arg, rc);
 }
 

@@ -68,11 +68,12 @@ uint64_t iris_options_rows(const iris_option_group *g, const char *names);
 int iris_options_parse(const char *cmd, int argc, char **argv, iris_option_binding *bindings,
                        size_t binding_count, const char **operands, int max_operands,
                        int *operand_count);
-/* For a command that keeps its own getopt_long loop: writes the group's rows
- * as struct option entries with val = base + row (returns how many), and
- * takes such a value c (with optarg) into the binding; *rc gets 0 or 2. */
+/* For a command that keeps its own getopt_long loop: writes the binding's
+ * (selected) rows as struct option entries with val = base + row (returns
+ * how many), and takes such a value c (with optarg) into the binding; *rc
+ * gets 0 or 2. */
 struct option;
-size_t iris_options_getopt_rows(const iris_option_group *g, int base, struct option *out);
+size_t iris_options_getopt_rows(const iris_option_binding *b, int base, struct option *out);
 bool iris_options_getopt_take(const char *cmd, iris_option_binding *b, int base, int c,
                               const char *arg, int *rc);
 /* For a command with a hand-rolled loop: when argv[*i] (already split into

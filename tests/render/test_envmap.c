@@ -138,9 +138,8 @@ static void test_sampling(const char *path) {
   CHECK(r.lost == 0);
   /* the map's texels times the strength are the radiance */
   iris_vec3 L = iris_envmap_radiance(&env, iris_envmap_st_to_dir(&env, 0.9f, 0.5f));
-  int x = (int)(0.9f * 64), y = 16;
-  float expect = 2.0f * (0.05f + 0.5f * (float)x / 64.0f);
-  (void)y;
+  int x = (int)(0.9f * 32);
+  float expect = 2.0f * (0.05f + 0.5f * (float)x / 32.0f);
   CHECK_NEAR(L.x, expect, 1e-5);
 
   /* As a light of a scene (a small quad that does not block the reference point). */
@@ -307,7 +306,7 @@ int main(void) {
   char patterned[1200], uniform[1200];
   snprintf(patterned, sizeof patterned, "%s/pattern.exr", g_dir);
   snprintf(uniform, sizeof uniform, "%s/uniform.exr", g_dir);
-  write_map(patterned, 64, 32, 1);
+  write_map(patterned, 32, 16, 1); /* small: the adaptive quadrature of its edges is the cost */
   write_map(uniform, 32, 16, 0);
   test_mapping(patterned);
   test_sampling(patterned);
