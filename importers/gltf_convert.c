@@ -597,7 +597,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
       }
       n[0] /= len, n[1] /= len, n[2] /= len;
     }
-    if (zero) { /* unusable: drop them so they get recomputed */
+    if (zero) { /* unusable: drop them, the primitive is shaded flat */
       free(m->normals);
       m->normals = NULL;
       c->zero_normals++;
@@ -670,10 +670,12 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   }
   free(idx);
   m->triangle_count = (uint32_t)kept;
-  /* Shared last step (meshproc.h): zero-area triangles out, angle-weighted
-   * normals where the file has none, optional welding. */
+  /* Shared last step (meshproc.h): zero-area triangles out, optional welding.
+   * Never computed normals: glTF 2.0 section 3.7.2.1 says "When normals are not
+   * specified, client implementations MUST calculate flat normals", and a mesh
+   * without normals is shaded with its geometric (flat) normal. */
   uint32_t removed = 0;
-  if (kept > 0 && !iris_mesh_finish(m, c->opts->compute_normals, c->opts->weld, &removed))
+  if (kept > 0 && !iris_mesh_finish(m, false, c->opts->weld, &removed))
     return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   c->degenerate_dropped += removed;
   if (m->triangle_count == 0) {
@@ -1388,7 +1390,7 @@ static void report_ignored(ctx *c) {
     iris_warnf("%s: dropped %zu degenerate triangle(s) (repeated vertex or zero area)", f,
                c->degenerate_dropped);
   if (c->zero_normals)
-    iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped", f, c->zero_normals);
+    iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
   if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_1 or higher are ignored", f);
   if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
   if (c->warned_normal_occlusion) iris_warnf("%s: normal and occlusion textures are ignored", f);

@@ -16,7 +16,8 @@ extern "C" {
 typedef struct iris_import_options {
   const char *camera_name; /* glTF: pick this camera (default: the first one) */
   bool weld;               /* weld coincident vertices (OpenMesh) */
-  bool compute_normals;    /* compute angle-weighted normals where absent (default true) */
+  bool compute_normals;    /* OBJ, PLY: angle-weighted normals where absent (default true);
+                              glTF is always shaded flat where NORMAL is absent (its spec) */
 } iris_import_options;
 
 iris_import_options iris_import_options_default(void);

@@ -26,7 +26,7 @@ static void print_help(void) {
          "      --camera NAME  make the camera called NAME the scene's camera (the\n"
          "                     first one, which render uses); error if there is none\n"
          "      --weld         weld coincident vertices of OBJ/PLY meshes\n"
-         "      --no-normals   do not compute normals for meshes that have none\n"
+         "      --no-normals   do not compute normals for OBJ/PLY meshes that have none\n"
          "  -q, --quiet        print no warnings or summary\n"
          "  -h, --help         show this help\n"
          "\n"
