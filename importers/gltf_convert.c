@@ -1,7 +1,7 @@
 /* glTF 2.0 import, C side: validates the document the tinygltf shim filled
  * (every index, byte range and number) and turns it into an iris_scene.
  * Mapping decisions are documented in docs/import-gltf.md. */
-#include "importers/gltf_convert.h"
+#include "importers/gltf_private.h"
 
 #include <limits.h>
 #include <math.h>
@@ -15,15 +15,6 @@
 #include "core/log.h"
 #include "importers/meshproc.h"
 
-/* glTF constants (the numeric codes of the spec; tinygltf uses the same). */
-enum {
-  CT_BYTE = 5120, CT_UBYTE = 5121, CT_SHORT = 5122, CT_USHORT = 5123, CT_UINT = 5125, CT_FLOAT = 5126,
-  TYPE_VEC2 = 2, TYPE_VEC3 = 3, TYPE_VEC4 = 4, TYPE_MAT2 = 34, TYPE_MAT3 = 35, TYPE_MAT4 = 36,
-  TYPE_SCALAR = 65,
-  MODE_TRIANGLES = 4, MODE_STRIP = 5, MODE_FAN = 6,
-  WRAP_REPEAT = 10497, WRAP_CLAMP = 33071, WRAP_MIRROR = 33648,
-  FILTER_NEAREST = 9728, FILTER_LINEAR = 9729
-};
 
 /* Accessors without a bufferView are zero-filled from nothing but their
  * declared count; cap them so a tiny file cannot demand gigabytes. */
@@ -37,10 +28,6 @@ static const char *const supported_extensions[] = {
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
 
 /* ---- small helpers ------------------------------------------------------ */
-
-typedef struct dmat4 {
-  double m[4][4]; /* row-major, column vectors (as iris_mat4) */
-} dmat4;
 
 static dmat4 dmat4_identity(void) {
   dmat4 r;
@@ -151,53 +138,13 @@ static float load_component(const uint8_t *p, int ct, bool normalized) {
   }
 }
 
-/* ---- conversion context ------------------------------------------------- */
-
-typedef struct converted_prim {
-  iris_mesh mesh;     /* arrays owned here until handed to the scene */
-  bool valid;         /* false: skipped (points/lines, no POSITION) */
-  int gltf_material;  /* -1: glTF default material */
-  int32_t scene_mesh; /* index in the scene once instanced, else -1 */
-} converted_prim;
-
-typedef struct ctx {
-  const iris_gltf_doc *doc;
-  const iris_import_options *opts;
-  const char *file;
-  iris_error *err;
-  iris_scene *scene;
-
-  converted_prim **prims; /* [mesh][primitive] */
-  iris_material *materials; /* validated, textures still glTF indices */
-  int32_t *material_map;    /* glTF material -> scene index, -1 not yet */
-  int32_t default_material;
-  int32_t *texture_map;     /* glTF texture -> scene index, -1 not yet, -2 dropped */
-
-  int *parent;
-  dmat4 *world;
-
-  /* Present-but-ignored features, reported once each at the end. */
-  char ignored_attributes[256];
-  size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
-  bool warned_texcoord, warned_alpha, warned_normal_occlusion, warned_spec_tex, warned_trans_tex;
-  bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
-  size_t zero_normals;
-  size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
-  int32_t *image_texture;           /* image -> last scene texture made from it */
-  int *image_sampler;               /* ... and that texture's sampler */
-} ctx;
 
 /* Converted mesh data may use 16 bytes per byte of buffer plus this much. */
 #define MESH_BUDGET_SLACK ((size_t)256 << 20)
 /* Instances (nodes x primitives) are not bounded by the file size; cap them. */
 #define MAX_INSTANCES ((size_t)1 << 22)
 
-static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...) {
+iris_status gltf_fail(gltf_ctx *c, iris_status st, const char *element, const char *fmt, ...) {
   char msg[512];
   va_list ap;
   va_start(ap, fmt);
@@ -205,8 +152,6 @@ static iris_status fail(ctx *c, iris_status st, const char *element, const char 
   va_end(ap);
   return iris_error_set(c->err, st, c->file, 0, element, "%s", msg);
 }
-
-#define ELEMENT(buf, ...) snprintf(buf, sizeof buf, __VA_ARGS__)
 
 /* ---- container pre-checks ----------------------------------------------- */
 
@@ -304,23 +249,23 @@ iris_status iris_gltf_check_required(const char *const *names, size_t count, con
 
 /* ---- buffers, views, accessors ------------------------------------------ */
 
-static iris_status validate_views(ctx *c) {
+static iris_status validate_views(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   for (size_t i = 0; i < d->view_count; i++) {
     const iris_gltf_view *v = &d->views[i];
     ELEMENT(el, "bufferView %zu", i);
     if (v->buffer < 0 || (size_t)v->buffer >= d->buffer_count)
-      return fail(c, IRIS_ERR_INVALID, el, "buffer %d does not exist (%zu buffers)", v->buffer,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "buffer %d does not exist (%zu buffers)", v->buffer,
                   d->buffer_count);
     size_t bsize = d->buffers[v->buffer].size;
-    if (v->length < 1) return fail(c, IRIS_ERR_INVALID, el, "byteLength must be at least 1");
+    if (v->length < 1) return gltf_fail(c, IRIS_ERR_INVALID, el, "byteLength must be at least 1");
     if (v->offset > bsize || v->length > bsize - v->offset)
-      return fail(c, IRIS_ERR_INVALID, el,
+      return gltf_fail(c, IRIS_ERR_INVALID, el,
                   "byteOffset %zu + byteLength %zu exceeds buffer %d's %zu bytes", v->offset,
                   v->length, v->buffer, bsize);
     if (v->stride != 0 && (v->stride < 4 || v->stride > 252 || v->stride % 4 != 0))
-      return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is not a multiple of 4 in [4, 252]",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is not a multiple of 4 in [4, 252]",
                   v->stride);
   }
   return IRIS_OK;
@@ -335,62 +280,62 @@ static bool range_fits(const iris_gltf_view *v, size_t offset, size_t elem, size
   return stride == 0 ? true : (count - 1) <= room / stride;
 }
 
-static iris_status validate_accessors(ctx *c) {
+static iris_status validate_accessors(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   for (size_t i = 0; i < d->accessor_count; i++) {
     const iris_gltf_accessor *a = &d->accessors[i];
     ELEMENT(el, "accessor %zu", i);
     if (component_size(a->component_type) == 0)
-      return fail(c, IRIS_ERR_INVALID, el, "invalid componentType %d", a->component_type);
-    if (type_components(a->type) == 0) return fail(c, IRIS_ERR_INVALID, el, "invalid type");
-    if (a->count < 1) return fail(c, IRIS_ERR_INVALID, el, "count must be at least 1");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid componentType %d", a->component_type);
+    if (type_components(a->type) == 0) return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type");
+    if (a->count < 1) return gltf_fail(c, IRIS_ERR_INVALID, el, "count must be at least 1");
     if (a->normalized && (a->component_type == CT_FLOAT || a->component_type == CT_UINT))
-      return fail(c, IRIS_ERR_INVALID, el, "normalized is only allowed for 8- and 16-bit integers");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "normalized is only allowed for 8- and 16-bit integers");
     size_t elem = element_size(a->component_type, a->type);
     if (a->view >= 0) {
       if ((size_t)a->view >= d->view_count)
-        return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist (%zu views)", a->view,
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist (%zu views)", a->view,
                     d->view_count);
       const iris_gltf_view *v = &d->views[a->view];
       if (v->stride != 0 && v->stride < elem)
-        return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is smaller than the %zu-byte element",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is smaller than the %zu-byte element",
                     v->stride, elem);
       size_t stride = v->stride ? v->stride : elem;
       if (!range_fits(v, a->offset, elem, stride, a->count))
-        return fail(c, IRIS_ERR_INVALID, el,
+        return gltf_fail(c, IRIS_ERR_INVALID, el,
                     "byteOffset %zu + %zu elements of %zu bytes (stride %zu) exceed bufferView "
                     "%d's %zu bytes",
                     a->offset, a->count, elem, stride, a->view, v->length);
     } else if (a->view != -1) {
-      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", a->view);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", a->view);
     } else if (a->count > ZERO_ACCESSOR_MAX_COUNT) {
-      return fail(c, IRIS_ERR_NOMEM, el, "count %zu without a bufferView exceeds the limit %zu",
+      return gltf_fail(c, IRIS_ERR_NOMEM, el, "count %zu without a bufferView exceeds the limit %zu",
                   a->count, ZERO_ACCESSOR_MAX_COUNT);
     }
     if (!a->sparse) continue;
     if (a->sparse_count < 1 || (unsigned long long)a->sparse_count > a->count)
-      return fail(c, IRIS_ERR_INVALID, el, "sparse count %lld not in [1, %zu]", a->sparse_count,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse count %lld not in [1, %zu]", a->sparse_count,
                   a->count);
     size_t n = (size_t)a->sparse_count;
     size_t isize = component_size(a->sparse_index_type);
     if (a->sparse_index_type != CT_UBYTE && a->sparse_index_type != CT_USHORT &&
         a->sparse_index_type != CT_UINT)
-      return fail(c, IRIS_ERR_INVALID, el, "sparse indices componentType %d is not unsigned",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse indices componentType %d is not unsigned",
                   a->sparse_index_type);
     int views[2] = {a->sparse_index_view, a->sparse_value_view};
     long long offsets[2] = {a->sparse_index_offset, a->sparse_value_offset};
     size_t sizes[2] = {isize, elem};
     for (int k = 0; k < 2; k++) {
       if (views[k] < 0 || (size_t)views[k] >= d->view_count)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d does not exist",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d does not exist",
                     k ? "values" : "indices", views[k]);
       const iris_gltf_view *v = &d->views[views[k]];
       if (v->stride != 0)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d must not have byteStride",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d must not have byteStride",
                     k ? "values" : "indices", views[k]);
       if (offsets[k] < 0 || !range_fits(v, (size_t)offsets[k], sizes[k], sizes[k], n))
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
                     k ? "values" : "indices", views[k]);
     }
     const iris_gltf_view *iv = &d->views[a->sparse_index_view];
@@ -398,7 +343,7 @@ static iris_status validate_accessors(ctx *c) {
     for (size_t k = 0; k < n; k++) {
       uint32_t idx = load_u32(ip + k * isize, a->sparse_index_type);
       if (idx >= a->count)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse index %u >= count %zu", idx, a->count);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse index %u >= count %zu", idx, a->count);
     }
   }
   return IRIS_OK;
@@ -450,7 +395,7 @@ static void read_indices(const iris_gltf_doc *d, const iris_gltf_accessor *a, ui
 
 /* ---- meshes -------------------------------------------------------------- */
 
-static void note_ignored_attribute(ctx *c, const char *name) {
+static void note_ignored_attribute(gltf_ctx *c, const char *name) {
   /* Keep one entry per name; group numbered sets (TEXCOORD_1, JOINTS_0) as-is. */
   const char *p = c->ignored_attributes;
   size_t n = strlen(name);
@@ -475,7 +420,7 @@ static void free_mesh_arrays(iris_mesh *m) {
 }
 
 /* Looks up an attribute accessor; checks its type and vertex count. */
-static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, const char *name,
+static iris_status attribute_accessor(gltf_ctx *c, const iris_gltf_primitive *p, const char *name,
                                       const char *el, int want_type, int alt_type, size_t want_count,
                                       const iris_gltf_accessor **out) {
   *out = NULL;
@@ -483,10 +428,10 @@ static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, cons
     if (strcmp(p->attributes[i].name, name) != 0) continue;
     const iris_gltf_accessor *a = &c->doc->accessors[p->attributes[i].accessor];
     if (a->type != want_type && a->type != alt_type)
-      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has type %s", name,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has type %s", name,
                   p->attributes[i].accessor, type_name(a->type));
     if (want_count && a->count != want_count)
-      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has %zu elements but POSITION has %zu",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has %zu elements but POSITION has %zu",
                   name, p->attributes[i].accessor, a->count, want_count);
     *out = a;
     return IRIS_OK;
@@ -494,16 +439,16 @@ static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, cons
   return IRIS_OK;
 }
 
-static iris_status check_finite_array(ctx *c, const float *v, size_t n, const char *el,
+static iris_status check_finite_array(gltf_ctx *c, const float *v, size_t n, const char *el,
                                       const char *what) {
   for (size_t i = 0; i < n; i++)
     if (!isfinite(v[i]))
-      return fail(c, IRIS_ERR_INVALID, el, "non-finite %s value %g at element %zu", what, (double)v[i],
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "non-finite %s value %g at element %zu", what, (double)v[i],
                   i);
   return IRIS_OK;
 }
 
-static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_prim *out) {
+static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converted_prim *out) {
   const iris_gltf_doc *d = c->doc;
   const iris_gltf_mesh *gm = &d->meshes[mi];
   const iris_gltf_primitive *p = &gm->primitives[pi];
@@ -516,20 +461,20 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   for (size_t i = 0; i < p->attribute_count; i++) {
     int ai = p->attributes[i].accessor;
     if (ai < 0 || (size_t)ai >= d->accessor_count)
-      return fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
                   p->attributes[i].name, ai);
     const char *n = p->attributes[i].name;
     if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0"))
       note_ignored_attribute(c, n);
   }
   if (p->indices != -1 && (p->indices < 0 || (size_t)p->indices >= d->accessor_count))
-    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d does not exist (%zu accessors)",
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "indices accessor %d does not exist (%zu accessors)",
                 p->indices, d->accessor_count);
   if (p->material != -1 && (p->material < 0 || (size_t)p->material >= d->material_count))
-    return fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
                 d->material_count);
   int mode = p->mode < 0 ? MODE_TRIANGLES : p->mode;
-  if (mode > MODE_FAN) return fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
+  if (mode > MODE_FAN) return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
   if (p->target_count) c->warned_morph = true;
   if (mode < MODE_TRIANGLES) {
     c->skipped_points_lines++;
@@ -542,7 +487,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     c->skipped_no_position++;
     return IRIS_OK;
   }
-  if (pos->count > UINT32_MAX) return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 vertices");
+  if (pos->count > UINT32_MAX) return gltf_fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 vertices");
   size_t nv = pos->count;
   if ((st = attribute_accessor(c, p, "NORMAL", el, TYPE_VEC3, TYPE_VEC3, nv, &nrm)) ||
       (st = attribute_accessor(c, p, "TEXCOORD_0", el, TYPE_VEC2, TYPE_VEC2, nv, &uv)) ||
@@ -552,11 +497,11 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   if (ia && (ia->type != TYPE_SCALAR || ia->normalized ||
              (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT &&
               ia->component_type != CT_UINT)))
-    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d must be unsigned integer SCALAR",
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "indices accessor %d must be unsigned integer SCALAR",
                 p->indices);
   size_t ni = ia ? ia->count : nv;
   if (mode == MODE_TRIANGLES && ni % 3 != 0)
-    return fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
 
   /* Budget: converted data may exceed the file's buffers only by the expansion of
    * small types (u8 -> float, strip -> list), unless accessors are reused by many
@@ -565,7 +510,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
   if (need > (double)c->budget_left)
-    return fail(c, IRIS_ERR_NOMEM, el,
+    return gltf_fail(c, IRIS_ERR_NOMEM, el,
                 "mesh data would exceed %zu MiB (%g MiB for this primitive; accessors reused by "
                 "many primitives or without a bufferView?)",
                 c->budget_total >> 20, need / 1048576.0);
@@ -576,7 +521,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   m->material = -1;
   m->vertex_count = (uint32_t)nv;
   m->positions = malloc(nv * 3 * sizeof(float));
-  if (!m->positions) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (!m->positions) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   read_floats(d, pos, 3, m->positions);
   char ael[128];
   ELEMENT(ael, "accessor %d", (int)(pos - d->accessors));
@@ -584,7 +529,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
 
   if (nrm) {
     m->normals = malloc(nv * 3 * sizeof(float));
-    if (!m->normals) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!m->normals) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     read_floats(d, nrm, 3, m->normals);
     if ((st = check_finite_array(c, m->normals, nv * 3, el, "NORMAL"))) return st;
     bool zero = false;
@@ -605,7 +550,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   }
   if (uv) {
     m->uvs = malloc(nv * 2 * sizeof(float));
-    if (!m->uvs) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!m->uvs) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     read_floats(d, uv, 2, m->uvs);
     if ((st = check_finite_array(c, m->uvs, nv * 2, el, "TEXCOORD_0"))) return st;
   }
@@ -615,7 +560,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     m->colors = malloc(nv * 3 * sizeof(float));
     if (!tmp || !m->colors) {
       free(tmp);
-      return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     }
     read_floats(d, col, nc, tmp);
     for (size_t i = 0; i < nv; i++) /* alpha dropped: iris is opaque */
@@ -625,14 +570,14 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   }
 
   uint32_t *idx = malloc((ni ? ni : 1) * sizeof(uint32_t));
-  if (!idx) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (!idx) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   if (ia) {
     read_indices(d, ia, idx);
     for (size_t i = 0; i < ni; i++)
       if (idx[i] >= nv) {
         char iel[64];
         ELEMENT(iel, "accessor %d", p->indices);
-        st = fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i,
+        st = gltf_fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i,
                   nv, el);
         free(idx);
         return st;
@@ -644,12 +589,12 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   size_t nt = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
   if (nt > UINT32_MAX) {
     free(idx);
-    return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
   }
   m->indices = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
   if (!m->indices) {
     free(idx);
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   }
   size_t kept = 0;
   for (size_t t = 0; t < nt; t++) {
@@ -676,7 +621,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
    * without normals is shaded with its geometric (flat) normal. */
   uint32_t removed = 0;
   if (kept > 0 && !iris_mesh_finish(m, false, c->opts->weld, &removed))
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   c->degenerate_dropped += removed;
   if (m->triangle_count == 0) {
     c->skipped_empty++;
@@ -694,19 +639,19 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   return IRIS_OK;
 }
 
-static iris_status convert_meshes(ctx *c) {
+static iris_status convert_meshes(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   c->prims = calloc(d->mesh_count ? d->mesh_count : 1, sizeof *c->prims);
-  if (!c->prims) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  if (!c->prims) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   for (size_t mi = 0; mi < d->mesh_count; mi++) {
     size_t np = d->meshes[mi].primitive_count;
     if (np == 0) {
       char el[32];
       ELEMENT(el, "mesh %zu", mi);
-      return fail(c, IRIS_ERR_INVALID, el, "has no primitives");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "has no primitives");
     }
     c->prims[mi] = calloc(np, sizeof **c->prims);
-    if (!c->prims[mi]) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    if (!c->prims[mi]) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     for (size_t pi = 0; pi < np; pi++) {
       iris_status st = convert_primitive(c, mi, pi, &c->prims[mi][pi]);
       if (st) return st;
@@ -715,297 +660,9 @@ static iris_status convert_meshes(ctx *c) {
   return IRIS_OK;
 }
 
-/* ---- textures and materials ---------------------------------------------- */
-
-static iris_status validate_textures(ctx *c) {
-  const iris_gltf_doc *d = c->doc;
-  char el[64];
-  for (size_t i = 0; i < d->sampler_count; i++) {
-    const iris_gltf_sampler *s = &d->samplers[i];
-    ELEMENT(el, "sampler %zu", i);
-    int wraps[2] = {s->wrap_s, s->wrap_t};
-    for (int k = 0; k < 2; k++)
-      if (wraps[k] != WRAP_REPEAT && wraps[k] != WRAP_CLAMP && wraps[k] != WRAP_MIRROR)
-        return fail(c, IRIS_ERR_INVALID, el, "invalid wrap mode %d", wraps[k]);
-    if (s->mag_filter != -1 && s->mag_filter != FILTER_NEAREST && s->mag_filter != FILTER_LINEAR)
-      return fail(c, IRIS_ERR_INVALID, el, "invalid magFilter %d", s->mag_filter);
-  }
-  for (size_t i = 0; i < d->image_count; i++) {
-    const iris_gltf_image *im = &d->images[i];
-    ELEMENT(el, "image %zu", i);
-    if (im->view != -1 && (im->view < 0 || (size_t)im->view >= d->view_count))
-      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", im->view);
-  }
-  for (size_t i = 0; i < d->texture_count; i++) {
-    const iris_gltf_texture *t = &d->textures[i];
-    ELEMENT(el, "texture %zu", i);
-    if (t->source != -1 && (t->source < 0 || (size_t)t->source >= d->image_count))
-      return fail(c, IRIS_ERR_INVALID, el, "image %d does not exist (%zu images)", t->source,
-                  d->image_count);
-    if (t->sampler != -1 && (t->sampler < 0 || (size_t)t->sampler >= d->sampler_count))
-      return fail(c, IRIS_ERR_INVALID, el, "sampler %d does not exist (%zu samplers)", t->sampler,
-                  d->sampler_count);
-  }
-  return IRIS_OK;
-}
-
-static int hexval(char ch) {
-  if (ch >= '0' && ch <= '9') return ch - '0';
-  if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
-  if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
-  return -1;
-}
-
-/* Percent-decoding of a relative URI reference (RFC 3986). */
-static void uri_decode(const char *in, char *out, size_t size) {
-  size_t o = 0;
-  for (size_t i = 0; in[i] && o + 1 < size; i++) {
-    int h, l;
-    if (in[i] == '%' && (h = hexval(in[i + 1])) >= 0 && (l = hexval(in[i + 2])) >= 0) {
-      out[o++] = (char)(h * 16 + l);
-      i += 2;
-    } else {
-      out[o++] = in[i];
-    }
-  }
-  out[o] = '\0';
-}
-
-static void warn_dropped_image(ctx *c, size_t image, const char *why) {
-  iris_warnf("%s: image %zu: %s; the texture is ignored", c->file, image, why);
-  c->warned_bad_image = true;
-}
-
-/* Scene texture for glTF texture `ti`, created on first use; -2 when dropped with a warning. */
-static iris_status resolve_texture(ctx *c, int ti, int32_t *out) {
-  const iris_gltf_doc *d = c->doc;
-  if (c->texture_map[ti] != -1) {
-    *out = c->texture_map[ti];
-    return IRIS_OK;
-  }
-  *out = c->texture_map[ti] = -2;
-  const iris_gltf_texture *t = &d->textures[ti];
-  char el[64];
-  /* Textures naming the same image and sampler share one scene texture. */
-  if (t->source >= 0 && c->image_texture[t->source] >= 0 && c->image_sampler[t->source] == t->sampler) {
-    *out = c->texture_map[ti] = c->image_texture[t->source];
-    return IRIS_OK;
-  }
-  if (t->source < 0) {
-    iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
-    return IRIS_OK;
-  }
-  const iris_gltf_image *im = &d->images[t->source];
-  ELEMENT(el, "image %d", t->source);
-  iris_texture tex;
-  memset(&tex, 0, sizeof tex);
-  const uint8_t *bytes = NULL;
-  size_t size = 0;
-  char mime[16] = "";
-  if (im->view >= 0) {
-    const iris_gltf_view *v = &d->views[im->view];
-    bytes = d->buffers[v->buffer].data + v->offset;
-    size = v->length;
-  } else if (im->data) {
-    bytes = im->data;
-    size = im->size;
-  }
-  if (bytes) {
-    if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
-    else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
-      snprintf(mime, sizeof mime, "image/jpeg");
-    if (!mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG image");
-      return IRIS_OK;
-    }
-    tex.data = malloc(size);
-    if (!tex.data) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    memcpy(tex.data, bytes, size);
-    tex.data_size = size;
-  } else if (im->uri) {
-    if (strstr(im->uri, "://"))
-      return fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
-    if (!d->base_dir)
-      return fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
-    char rel[1024], joined[2048], abs_path[4096];
-    uri_decode(im->uri, rel, sizeof rel);
-    iris_path_join(d->base_dir, rel, joined, sizeof joined);
-    if (!im->file_found) return fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
-    /* Absolute, so the scene stays valid wherever it is written. */
-    char cwd[2048];
-    if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
-      snprintf(abs_path, sizeof abs_path, "%s", joined);
-    else
-      snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
-    if (!im->file_mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG file");
-      return IRIS_OK;
-    }
-    snprintf(mime, sizeof mime, "%s", im->file_mime);
-    tex.path = iris_strdup(abs_path);
-    if (!tex.path) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  } else {
-    return fail(c, IRIS_ERR_INVALID, el, "has no data");
-  }
-  snprintf(tex.mime, sizeof tex.mime, "%s", mime);
-  tex.name = im->name && im->name[0] ? iris_strdup(im->name) : NULL;
-  tex.wrap_s = tex.wrap_t = IRIS_WRAP_REPEAT;
-  if (t->sampler >= 0) {
-    const iris_gltf_sampler *s = &d->samplers[t->sampler];
-    int w[2] = {s->wrap_s, s->wrap_t};
-    iris_wrap *dst[2] = {&tex.wrap_s, &tex.wrap_t};
-    for (int k = 0; k < 2; k++)
-      *dst[k] = w[k] == WRAP_CLAMP ? IRIS_WRAP_CLAMP : w[k] == WRAP_MIRROR ? IRIS_WRAP_MIRROR : IRIS_WRAP_REPEAT;
-    tex.nearest = s->mag_filter == FILTER_NEAREST;
-  }
-  int32_t id = iris_scene_add_texture(c->scene, &tex);
-  if (id < 0) {
-    free(tex.name), free(tex.path), free(tex.data);
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  }
-  *out = c->texture_map[ti] = id;
-  c->image_texture[t->source] = id;
-  c->image_sampler[t->source] = t->sampler;
-  return IRIS_OK;
-}
-
-static iris_status check_range(ctx *c, const char *el, const char *what, double v, double lo, double hi) {
-  if (!isfinite(v) || v < lo || v > hi)
-    return fail(c, IRIS_ERR_INVALID, el, "%s %g is not in [%g, %g]", what, v, lo, hi);
-  return IRIS_OK;
-}
-
-/* Texture reference check: index in range; non-zero texCoord sets are not supported. */
-static iris_status texture_ref(ctx *c, const char *el, const char *what, iris_gltf_texture_ref r,
-                               int32_t *out) {
-  *out = -1;
-  if (r.texture == -1) return IRIS_OK;
-  if (r.texture < 0 || (size_t)r.texture >= c->doc->texture_count)
-    return fail(c, IRIS_ERR_INVALID, el, "%s: texture %d does not exist (%zu textures)", what,
-                r.texture, c->doc->texture_count);
-  if (r.texcoord < 0) return fail(c, IRIS_ERR_INVALID, el, "%s: negative texCoord", what);
-  if (r.texcoord != 0) {
-    c->warned_texcoord = true;
-    return IRIS_OK;
-  }
-  *out = r.texture; /* glTF index; turned into a scene index when the material is used */
-  return IRIS_OK;
-}
-
-/* glTF 2.0 Appendix B metallic-roughness material (+ the KHR_materials_* above). */
-static iris_status validate_materials(ctx *c) {
-  const iris_gltf_doc *d = c->doc;
-  c->materials = calloc(d->material_count ? d->material_count : 1, sizeof *c->materials);
-  if (!c->materials) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-  char el[64];
-  iris_status st;
-  for (size_t i = 0; i < d->material_count; i++) {
-    const iris_gltf_material *g = &d->materials[i];
-    iris_material *m = &c->materials[i];
-    ELEMENT(el, "material %zu", i);
-    *m = iris_material_default(IRIS_MATERIAL_GLTF);
-    if (g->bad_extension)
-      return fail(c, IRIS_ERR_INVALID, el, "%s: a value has the wrong JSON type", g->bad_extension);
-    if (g->base_color_len != 4)
-      return fail(c, IRIS_ERR_INVALID, el, "baseColorFactor has %zu values (4 expected)", g->base_color_len);
-    if (g->emissive_len != 3)
-      return fail(c, IRIS_ERR_INVALID, el, "emissiveFactor has %zu values (3 expected)", g->emissive_len);
-    for (int k = 0; k < 4; k++)
-      if ((st = check_range(c, el, "baseColorFactor component", g->base_color[k], 0, 1))) return st;
-    for (int k = 0; k < 3; k++)
-      if ((st = check_range(c, el, "emissiveFactor component", g->emissive[k], 0, 1))) return st;
-    if ((st = check_range(c, el, "metallicFactor", g->metallic, 0, 1)) ||
-        (st = check_range(c, el, "roughnessFactor", g->roughness, 0, 1)) ||
-        (st = check_range(c, el, "KHR_materials_emissive_strength emissiveStrength",
-                          g->emissive_strength, 0, HUGE_VAL)) ||
-        (st = check_range(c, el, "KHR_materials_specular specularFactor", g->specular, 0, 1)) ||
-        (st = check_range(c, el, "KHR_materials_transmission transmissionFactor", g->transmission, 0, 1)))
-      return st;
-    for (int k = 0; k < 3; k++)
-      if ((st = check_range(c, el, "KHR_materials_specular specularColorFactor component",
-                            g->specular_color[k], 0, HUGE_VAL)))
-        return st;
-    if (!isfinite(g->ior) || (g->ior != 0.0 && g->ior < 1.0))
-      return fail(c, IRIS_ERR_INVALID, el, "KHR_materials_ior ior %g is neither 0 nor >= 1", g->ior);
-
-    if (g->name && g->name[0]) m->name = (char *)g->name; /* copied when added */
-    for (int k = 0; k < 3; k++) {
-      m->color[k] = (float)g->base_color[k];
-      m->emission[k] = (float)(g->emissive[k] * g->emissive_strength);
-      m->specular_color[k] = (float)g->specular_color[k];
-    }
-    m->metallic = (float)g->metallic;
-    m->roughness = (float)g->roughness;
-    m->specular = (float)g->specular;
-    m->transmission = (float)g->transmission;
-    /* ior 0 is the extension's "F0 = 1" special case, which a dielectric cannot express. */
-    if (g->ior == 0.0) iris_warnf("%s: material %zu: KHR_materials_ior ior 0 is not supported; using 1.5", c->file, i);
-    m->ior = g->ior == 0.0 ? 1.5f : (float)g->ior;
-    m->double_sided = g->double_sided;
-    m->emission_two_sided = g->double_sided;
-    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &m->color_texture)) ||
-        (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
-                          &m->metallic_roughness_texture)) ||
-        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &m->emission_texture)))
-      return st;
-    if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
-      if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
-        return fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
-      c->warned_alpha = true;
-    }
-    if (g->has_normal_texture || g->has_occlusion_texture) c->warned_normal_occlusion = true;
-    if (g->has_specular_textures) c->warned_spec_tex = true;
-    if (g->has_transmission_texture) c->warned_trans_tex = true;
-  }
-  return IRIS_OK;
-}
-
-/* Scene material for glTF material `gi` (-1: the glTF default material). */
-static iris_status resolve_material(ctx *c, int gi, int32_t *out) {
-  if (gi < 0) {
-    if (c->default_material < 0) {
-      /* glTF 2.0 section 3.9.6: no material = base colour 1, metallic 1, roughness 1. */
-      iris_material m = iris_material_default(IRIS_MATERIAL_GLTF);
-      m.color[0] = m.color[1] = m.color[2] = 1.0f;
-      m.metallic = 1.0f;
-      m.roughness = 1.0f;
-      m.emission_two_sided = false;
-      m.name = iris_strdup("glTF default");
-      c->default_material = iris_scene_add_material(c->scene, &m);
-      if (c->default_material < 0) {
-        free(m.name);
-        return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-      }
-    }
-    *out = c->default_material;
-    return IRIS_OK;
-  }
-  if (c->material_map[gi] >= 0) {
-    *out = c->material_map[gi];
-    return IRIS_OK;
-  }
-  iris_material m = c->materials[gi];
-  iris_status st;
-  int32_t *slots[3] = {&m.color_texture, &m.metallic_roughness_texture, &m.emission_texture};
-  for (int k = 0; k < 3; k++) {
-    if (*slots[k] < 0) continue;
-    int32_t id;
-    if ((st = resolve_texture(c, *slots[k], &id))) return st;
-    *slots[k] = id >= 0 ? id : -1;
-  }
-  m.name = m.name ? iris_strdup(m.name) : NULL;
-  int32_t id = iris_scene_add_material(c->scene, &m);
-  if (id < 0) {
-    free(m.name);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-  }
-  *out = c->material_map[gi] = id;
-  return IRIS_OK;
-}
-
 /* ---- nodes, cameras, lights ---------------------------------------------- */
 
-static iris_status validate_cameras_lights(ctx *c) {
+static iris_status validate_cameras_lights(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   iris_status st;
@@ -1014,47 +671,47 @@ static iris_status validate_cameras_lights(ctx *c) {
     ELEMENT(el, "camera %zu", i);
     if (strcmp(cam->type, "perspective") == 0) {
       if (!isfinite(cam->yfov) || cam->yfov <= 0.0 || cam->yfov >= IRIS_PI)
-        return fail(c, IRIS_ERR_INVALID, el, "yfov %g is not in (0, pi)", cam->yfov);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "yfov %g is not in (0, pi)", cam->yfov);
       if (!isfinite(cam->aspect) || cam->aspect < 0.0)
-        return fail(c, IRIS_ERR_INVALID, el, "aspectRatio %g is not positive", cam->aspect);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "aspectRatio %g is not positive", cam->aspect);
     } else if (strcmp(cam->type, "orthographic") != 0) {
-      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", cam->type);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", cam->type);
     }
   }
   for (size_t i = 0; i < d->light_count; i++) {
     const iris_gltf_light *l = &d->lights[i];
     ELEMENT(el, "KHR_lights_punctual light %zu", i);
     if (strcmp(l->type, "point") && strcmp(l->type, "spot") && strcmp(l->type, "directional"))
-      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", l->type);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", l->type);
     if (l->color_len != 0 && l->color_len != 3)
-      return fail(c, IRIS_ERR_INVALID, el, "color has %zu values (3 expected)", l->color_len);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "color has %zu values (3 expected)", l->color_len);
     for (size_t k = 0; k < l->color_len; k++)
-      if ((st = check_range(c, el, "color component", l->color[k], 0, 1))) return st;
-    if ((st = check_range(c, el, "intensity", l->intensity, 0, HUGE_VAL)) ||
-        (st = check_range(c, el, "range", l->range, 0, HUGE_VAL)))
+      if ((st = gltf_check_range(c, el, "color component", l->color[k], 0, 1))) return st;
+    if ((st = gltf_check_range(c, el, "intensity", l->intensity, 0, HUGE_VAL)) ||
+        (st = gltf_check_range(c, el, "range", l->range, 0, HUGE_VAL)))
       return st;
     if (strcmp(l->type, "spot") == 0) {
-      if ((st = check_range(c, el, "spot.outerConeAngle", l->outer_cone, 0, IRIS_PI / 2 + 1e-6)) ||
-          (st = check_range(c, el, "spot.innerConeAngle", l->inner_cone, 0, l->outer_cone)))
+      if ((st = gltf_check_range(c, el, "spot.outerConeAngle", l->outer_cone, 0, IRIS_PI / 2 + 1e-6)) ||
+          (st = gltf_check_range(c, el, "spot.innerConeAngle", l->inner_cone, 0, l->outer_cone)))
         return st;
       if (l->inner_cone >= l->outer_cone)
-        return fail(c, IRIS_ERR_INVALID, el, "innerConeAngle must be less than outerConeAngle");
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "innerConeAngle must be less than outerConeAngle");
     }
   }
   return IRIS_OK;
 }
 
 /* Local matrix of a node: `matrix` (column-major) or T * R * S. */
-static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
+static iris_status node_local(gltf_ctx *c, size_t ni, dmat4 *out) {
   const iris_gltf_node *n = &c->doc->nodes[ni];
   char el[32];
   ELEMENT(el, "node %zu", ni);
   if ((n->matrix_len != 0 && n->matrix_len != 16) || (n->translation_len != 0 && n->translation_len != 3) ||
       (n->rotation_len != 0 && n->rotation_len != 4) || (n->scale_len != 0 && n->scale_len != 3))
-    return fail(c, IRIS_ERR_INVALID, el, "matrix/translation/rotation/scale has the wrong length");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "matrix/translation/rotation/scale has the wrong length");
   if (!all_finite(n->matrix, n->matrix_len) || !all_finite(n->translation, n->translation_len) ||
       !all_finite(n->rotation, n->rotation_len) || !all_finite(n->scale, n->scale_len))
-    return fail(c, IRIS_ERR_INVALID, el, "non-finite transform value");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "non-finite transform value");
   *out = dmat4_identity();
   if (n->matrix_len == 16) {
     if (n->translation_len || n->rotation_len || n->scale_len) c->warned_matrix_trs = true;
@@ -1068,7 +725,7 @@ static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
   if (n->scale_len) memcpy(s, n->scale, sizeof s);
   double len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!(len > 1e-12) || !isfinite(len))
-    return fail(c, IRIS_ERR_INVALID, el, "rotation quaternion has zero length");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "rotation quaternion has zero length");
   for (int k = 0; k < 4; k++) q[k] /= len;
   double x = q[0], y = q[1], z = q[2], w = q[3];
   double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
@@ -1082,7 +739,7 @@ static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
 }
 
 /* Parents, single-parent rule and cycles (nodes unreachable from any root). */
-static iris_status validate_node_graph(ctx *c) {
+static iris_status validate_node_graph(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   size_t nn = d->node_count;
   char el[32];
@@ -1091,7 +748,7 @@ static iris_status validate_node_graph(ctx *c) {
   bool *seen = calloc(nn ? nn : 1, sizeof *seen);
   if (!c->parent || !stack || !seen) {
     free(stack), free(seen);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   iris_status st = IRIS_OK;
   for (size_t i = 0; i < nn; i++) c->parent[i] = -1;
@@ -1099,20 +756,20 @@ static iris_status validate_node_graph(ctx *c) {
     const iris_gltf_node *n = &d->nodes[i];
     ELEMENT(el, "node %zu", i);
     if (n->mesh != -1 && (n->mesh < 0 || (size_t)n->mesh >= d->mesh_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "mesh %d does not exist (%zu meshes)", n->mesh, d->mesh_count);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "mesh %d does not exist (%zu meshes)", n->mesh, d->mesh_count);
     else if (n->camera != -1 && (n->camera < 0 || (size_t)n->camera >= d->camera_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "camera %d does not exist (%zu cameras)", n->camera, d->camera_count);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "camera %d does not exist (%zu cameras)", n->camera, d->camera_count);
     else if (n->light != -1 && (n->light < 0 || (size_t)n->light >= d->light_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "KHR_lights_punctual light %d does not exist (%zu lights)",
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "KHR_lights_punctual light %d does not exist (%zu lights)",
                 n->light, d->light_count);
     for (size_t k = 0; k < n->child_count && !st; k++) {
       int ch = n->children[k];
       if (ch < 0 || (size_t)ch >= nn)
-        st = fail(c, IRIS_ERR_INVALID, el, "child %d does not exist (%zu nodes)", ch, nn);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "child %d does not exist (%zu nodes)", ch, nn);
       else if ((size_t)ch == i)
-        st = fail(c, IRIS_ERR_INVALID, el, "is its own child");
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "is its own child");
       else if (c->parent[ch] >= 0)
-        st = fail(c, IRIS_ERR_INVALID, el, "child %d already has parent node %d (a node may have one parent)",
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "child %d already has parent node %d (a node may have one parent)",
                   ch, c->parent[ch]);
       else
         c->parent[ch] = (int)i;
@@ -1132,7 +789,7 @@ static iris_status validate_node_graph(ctx *c) {
   for (size_t i = 0; i < nn && !st; i++)
     if (!seen[i]) {
       ELEMENT(el, "node %zu", i);
-      st = fail(c, IRIS_ERR_INVALID, el, "is part of a cycle in the node hierarchy");
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "is part of a cycle in the node hierarchy");
     }
   free(stack);
   free(seen);
@@ -1143,30 +800,30 @@ typedef struct camera_hit {
   int node, camera;
 } camera_hit;
 
-static iris_status add_instance_prims(ctx *c, int mesh, const dmat4 *world) {
+static iris_status add_instance_prims(gltf_ctx *c, int mesh, const dmat4 *world) {
   const iris_gltf_mesh *gm = &c->doc->meshes[mesh];
   iris_status st;
   for (size_t pi = 0; pi < gm->primitive_count; pi++) {
     converted_prim *cp = &c->prims[mesh][pi];
     if (!cp->valid) continue;
     if (cp->scene_mesh < 0) {
-      if ((st = resolve_material(c, cp->gltf_material, &cp->mesh.material))) return st;
+      if ((st = gltf_resolve_material(c, cp->gltf_material, &cp->mesh.material))) return st;
       int32_t id = iris_scene_add_mesh(c->scene, &cp->mesh);
-      if (id < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      if (id < 0) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
       memset(&cp->mesh, 0, sizeof cp->mesh); /* the scene owns the arrays now */
       cp->scene_mesh = id;
     }
     if (c->scene->instance_count >= MAX_INSTANCES)
-      return fail(c, IRIS_ERR_NOMEM, NULL, "more than %zu mesh instances", MAX_INSTANCES);
+      return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "more than %zu mesh instances", MAX_INSTANCES);
     iris_instance inst;
     inst.mesh = (uint32_t)cp->scene_mesh;
     inst.transform = dmat4_to_float(world);
-    if (iris_scene_add_instance(c->scene, &inst) < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    if (iris_scene_add_instance(c->scene, &inst) < 0) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   return IRIS_OK;
 }
 
-static iris_status add_light(ctx *c, int node, const dmat4 *w) {
+static iris_status add_light(gltf_ctx *c, int node, const dmat4 *w) {
   const iris_gltf_light *g = &c->doc->lights[c->doc->nodes[node].light];
   iris_light l;
   memset(&l, 0, sizeof l);
@@ -1191,7 +848,7 @@ static iris_status add_light(ctx *c, int node, const dmat4 *w) {
   l.name = name && name[0] ? iris_strdup(name) : NULL;
   if (iris_scene_add_light(c->scene, &l) < 0) {
     free(l.name);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   return IRIS_OK;
 }
@@ -1215,14 +872,14 @@ static bool camera_frame(const dmat4 *w, iris_mat4 *out) {
   return true;
 }
 
-static const char *camera_label(ctx *c, const camera_hit *h) {
+static const char *camera_label(gltf_ctx *c, const camera_hit *h) {
   const char *n = c->doc->cameras[h->camera].name;
   if (n && n[0]) return n;
   n = c->doc->nodes[h->node].name;
   return n && n[0] ? n : NULL;
 }
 
-static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
+static iris_status add_cameras(gltf_ctx *c, const camera_hit *hits, size_t n) {
   size_t chosen = 0;
   const char *want = c->opts ? c->opts->camera_name : NULL;
   if (want && want[0]) {
@@ -1239,7 +896,7 @@ static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
         int w = snprintf(list + used, sizeof list - used, "%s'%s'", k ? ", " : "", l ? l : "(unnamed)");
         if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
       }
-      return fail(c, IRIS_ERR_USAGE, "cameras", "no perspective camera named '%s' (available: %s)", want,
+      return gltf_fail(c, IRIS_ERR_USAGE, "cameras", "no perspective camera named '%s' (available: %s)", want,
                   n ? list : "none");
     }
     chosen = i;
@@ -1260,13 +917,13 @@ static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
     cam.name = l ? iris_strdup(l) : NULL;
     if (iris_scene_add_camera(c->scene, &cam) < 0) {
       free(cam.name);
-      return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     }
   }
   return IRIS_OK;
 }
 
-static iris_status traverse(ctx *c) {
+static iris_status traverse(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   size_t nn = d->node_count;
   char el[32];
@@ -1281,11 +938,11 @@ static iris_status traverse(ctx *c) {
   iris_status st = IRIS_OK;
   size_t hit_count = 0;
   if (!all_roots || !stack || !hits || !listed || !c->world) {
-    st = fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    st = gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   if (d->default_scene != -1 && (d->default_scene < 0 || (size_t)d->default_scene >= d->scene_count)) {
-    st = fail(c, IRIS_ERR_INVALID, "scene", "default scene %d does not exist (%zu scenes)",
+    st = gltf_fail(c, IRIS_ERR_INVALID, "scene", "default scene %d does not exist (%zu scenes)",
               d->default_scene, d->scene_count);
     goto done;
   }
@@ -1294,11 +951,11 @@ static iris_status traverse(ctx *c) {
       int r = d->scenes[s].nodes[k];
       ELEMENT(el, "scene %zu", s);
       if (r < 0 || (size_t)r >= nn) {
-        st = fail(c, IRIS_ERR_INVALID, el, "node %d does not exist (%zu nodes)", r, nn);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "node %d does not exist (%zu nodes)", r, nn);
         goto done;
       }
       if (c->parent[r] >= 0) {
-        st = fail(c, IRIS_ERR_INVALID, el, "node %d is not a root (child of node %d)", r, c->parent[r]);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "node %d is not a root (child of node %d)", r, c->parent[r]);
         goto done;
       }
     }
@@ -1318,7 +975,7 @@ static iris_status traverse(ctx *c) {
     int root = roots[r];
     if (listed[root]) {
       ELEMENT(el, "scene");
-      st = fail(c, IRIS_ERR_INVALID, el, "root node %d is listed twice", root);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "root node %d is listed twice", root);
       goto done;
     }
     listed[root] = true;
@@ -1357,13 +1014,13 @@ done:
 
 /* ---- top level ----------------------------------------------------------- */
 
-static iris_status check_asset(ctx *c) {
+static iris_status check_asset(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   const char *v = d->version ? d->version : "";
   if (strncmp(v, "2.", 2) != 0)
-    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "version '%s' is not glTF 2.x", v);
+    return gltf_fail(c, IRIS_ERR_UNSUPPORTED, "asset", "version '%s' is not glTF 2.x", v);
   if (d->min_version && d->min_version[0] && strcmp(d->min_version, "2.0") != 0)
-    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "minVersion '%s' is newer than 2.0", d->min_version);
+    return gltf_fail(c, IRIS_ERR_UNSUPPORTED, "asset", "minVersion '%s' is newer than 2.0", d->min_version);
   iris_status st = iris_gltf_check_required(d->extensions_required, d->extensions_required_count,
                                             c->file, c->err);
   if (st) return st;
@@ -1378,7 +1035,7 @@ static iris_status check_asset(ctx *c) {
   return IRIS_OK;
 }
 
-static void report_ignored(ctx *c) {
+static void report_ignored(gltf_ctx *c) {
   const char *f = c->file;
   if (c->ignored_attributes[0]) iris_warnf("%s: ignoring vertex attributes: %s", f, c->ignored_attributes);
   if (c->skipped_points_lines)
@@ -1404,7 +1061,7 @@ static void report_ignored(ctx *c) {
   if (c->scene->instance_count == 0) iris_warnf("%s: the scene has no mesh instances", f);
 }
 
-static void ctx_free(ctx *c) {
+static void ctx_free(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   if (c->prims) {
     for (size_t mi = 0; mi < d->mesh_count; mi++) {
@@ -1425,7 +1082,7 @@ static void ctx_free(ctx *c) {
 
 iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_options *opts,
                               iris_scene **out, iris_error *err) {
-  ctx c;
+  gltf_ctx c;
   memset(&c, 0, sizeof c);
   iris_import_options defaults = iris_import_options_default();
   c.doc = doc;
@@ -1442,7 +1099,7 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   c.image_texture = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_texture);
   c.image_sampler = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_sampler);
   if (!c.scene || !c.material_map || !c.texture_map || !c.image_texture || !c.image_sampler) {
-    st = fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    st = gltf_fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   for (size_t i = 0; i < doc->material_count; i++) c.material_map[i] = -1;
@@ -1455,8 +1112,8 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   }
   c.budget_left = c.budget_total;
   /* Validate everything first (even what the scene does not use), then build. */
-  if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = validate_textures(&c)) ||
-      (st = validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
+  if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = gltf_validate_textures(&c)) ||
+      (st = gltf_validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
       (st = validate_node_graph(&c)) || (st = convert_meshes(&c)) || (st = traverse(&c)))
     goto done;
   snprintf(c.scene->units, sizeof c.scene->units, "m"); /* glTF 2.0: metres */

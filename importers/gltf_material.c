@@ -1,0 +1,299 @@
+/* glTF 2.0 import, materials: samplers, images and textures, and the
+ * metallic-roughness material of Appendix B with the KHR_materials_* and
+ * KHR_texture_transform extensions, into iris materials and textures.
+ * Mapping decisions are documented in docs/import-gltf.md. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/fileio.h"
+#include "core/log.h"
+#include "importers/gltf_private.h"
+
+iris_status gltf_validate_textures(gltf_ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  for (size_t i = 0; i < d->sampler_count; i++) {
+    const iris_gltf_sampler *s = &d->samplers[i];
+    ELEMENT(el, "sampler %zu", i);
+    int wraps[2] = {s->wrap_s, s->wrap_t};
+    for (int k = 0; k < 2; k++)
+      if (wraps[k] != WRAP_REPEAT && wraps[k] != WRAP_CLAMP && wraps[k] != WRAP_MIRROR)
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid wrap mode %d", wraps[k]);
+    if (s->mag_filter != -1 && s->mag_filter != FILTER_NEAREST && s->mag_filter != FILTER_LINEAR)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid magFilter %d", s->mag_filter);
+  }
+  for (size_t i = 0; i < d->image_count; i++) {
+    const iris_gltf_image *im = &d->images[i];
+    ELEMENT(el, "image %zu", i);
+    if (im->view != -1 && (im->view < 0 || (size_t)im->view >= d->view_count))
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", im->view);
+  }
+  for (size_t i = 0; i < d->texture_count; i++) {
+    const iris_gltf_texture *t = &d->textures[i];
+    ELEMENT(el, "texture %zu", i);
+    if (t->source != -1 && (t->source < 0 || (size_t)t->source >= d->image_count))
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "image %d does not exist (%zu images)", t->source,
+                  d->image_count);
+    if (t->sampler != -1 && (t->sampler < 0 || (size_t)t->sampler >= d->sampler_count))
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "sampler %d does not exist (%zu samplers)", t->sampler,
+                  d->sampler_count);
+  }
+  return IRIS_OK;
+}
+
+static int hexval(char ch) {
+  if (ch >= '0' && ch <= '9') return ch - '0';
+  if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
+  if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
+  return -1;
+}
+
+/* Percent-decoding of a relative URI reference (RFC 3986). */
+static void uri_decode(const char *in, char *out, size_t size) {
+  size_t o = 0;
+  for (size_t i = 0; in[i] && o + 1 < size; i++) {
+    int h, l;
+    if (in[i] == '%' && (h = hexval(in[i + 1])) >= 0 && (l = hexval(in[i + 2])) >= 0) {
+      out[o++] = (char)(h * 16 + l);
+      i += 2;
+    } else {
+      out[o++] = in[i];
+    }
+  }
+  out[o] = '\0';
+}
+
+static void warn_dropped_image(gltf_ctx *c, size_t image, const char *why) {
+  iris_warnf("%s: image %zu: %s; the texture is ignored", c->file, image, why);
+  c->warned_bad_image = true;
+}
+
+/* Scene texture for glTF texture `ti`, created on first use; -2 when dropped with a warning. */
+static iris_status resolve_texture(gltf_ctx *c, int ti, int32_t *out) {
+  const iris_gltf_doc *d = c->doc;
+  if (c->texture_map[ti] != -1) {
+    *out = c->texture_map[ti];
+    return IRIS_OK;
+  }
+  *out = c->texture_map[ti] = -2;
+  const iris_gltf_texture *t = &d->textures[ti];
+  char el[64];
+  /* Textures naming the same image and sampler share one scene texture. */
+  if (t->source >= 0 && c->image_texture[t->source] >= 0 && c->image_sampler[t->source] == t->sampler) {
+    *out = c->texture_map[ti] = c->image_texture[t->source];
+    return IRIS_OK;
+  }
+  if (t->source < 0) {
+    iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
+    return IRIS_OK;
+  }
+  const iris_gltf_image *im = &d->images[t->source];
+  ELEMENT(el, "image %d", t->source);
+  iris_texture tex;
+  memset(&tex, 0, sizeof tex);
+  const uint8_t *bytes = NULL;
+  size_t size = 0;
+  char mime[16] = "";
+  if (im->view >= 0) {
+    const iris_gltf_view *v = &d->views[im->view];
+    bytes = d->buffers[v->buffer].data + v->offset;
+    size = v->length;
+  } else if (im->data) {
+    bytes = im->data;
+    size = im->size;
+  }
+  if (bytes) {
+    if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
+    else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
+      snprintf(mime, sizeof mime, "image/jpeg");
+    if (!mime[0]) {
+      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG image");
+      return IRIS_OK;
+    }
+    tex.data = malloc(size);
+    if (!tex.data) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    memcpy(tex.data, bytes, size);
+    tex.data_size = size;
+  } else if (im->uri) {
+    if (strstr(im->uri, "://"))
+      return gltf_fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
+    if (!d->base_dir)
+      return gltf_fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
+    char rel[1024], joined[2048], abs_path[4096];
+    uri_decode(im->uri, rel, sizeof rel);
+    iris_path_join(d->base_dir, rel, joined, sizeof joined);
+    if (!im->file_found) return gltf_fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
+    /* Absolute, so the scene stays valid wherever it is written. */
+    char cwd[2048];
+    if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
+      snprintf(abs_path, sizeof abs_path, "%s", joined);
+    else
+      snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
+    if (!im->file_mime[0]) {
+      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG file");
+      return IRIS_OK;
+    }
+    snprintf(mime, sizeof mime, "%s", im->file_mime);
+    tex.path = iris_strdup(abs_path);
+    if (!tex.path) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  } else {
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "has no data");
+  }
+  snprintf(tex.mime, sizeof tex.mime, "%s", mime);
+  tex.name = im->name && im->name[0] ? iris_strdup(im->name) : NULL;
+  tex.wrap_s = tex.wrap_t = IRIS_WRAP_REPEAT;
+  if (t->sampler >= 0) {
+    const iris_gltf_sampler *s = &d->samplers[t->sampler];
+    int w[2] = {s->wrap_s, s->wrap_t};
+    iris_wrap *dst[2] = {&tex.wrap_s, &tex.wrap_t};
+    for (int k = 0; k < 2; k++)
+      *dst[k] = w[k] == WRAP_CLAMP ? IRIS_WRAP_CLAMP : w[k] == WRAP_MIRROR ? IRIS_WRAP_MIRROR : IRIS_WRAP_REPEAT;
+    tex.nearest = s->mag_filter == FILTER_NEAREST;
+  }
+  int32_t id = iris_scene_add_texture(c->scene, &tex);
+  if (id < 0) {
+    free(tex.name), free(tex.path), free(tex.data);
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  }
+  *out = c->texture_map[ti] = id;
+  c->image_texture[t->source] = id;
+  c->image_sampler[t->source] = t->sampler;
+  return IRIS_OK;
+}
+
+iris_status gltf_check_range(gltf_ctx *c, const char *el, const char *what, double v, double lo, double hi) {
+  if (!isfinite(v) || v < lo || v > hi)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "%s %g is not in [%g, %g]", what, v, lo, hi);
+  return IRIS_OK;
+}
+
+/* Texture reference check: index in range; non-zero texCoord sets are not supported. */
+static iris_status texture_ref(gltf_ctx *c, const char *el, const char *what, iris_gltf_texture_ref r,
+                               int32_t *out) {
+  *out = -1;
+  if (r.texture == -1) return IRIS_OK;
+  if (r.texture < 0 || (size_t)r.texture >= c->doc->texture_count)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: texture %d does not exist (%zu textures)", what,
+                r.texture, c->doc->texture_count);
+  if (r.texcoord < 0) return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: negative texCoord", what);
+  if (r.texcoord != 0) {
+    c->warned_texcoord = true;
+    return IRIS_OK;
+  }
+  *out = r.texture; /* glTF index; turned into a scene index when the material is used */
+  return IRIS_OK;
+}
+
+/* glTF 2.0 Appendix B metallic-roughness material (+ the KHR_materials_* above). */
+iris_status gltf_validate_materials(gltf_ctx *c) {
+  const iris_gltf_doc *d = c->doc;
+  c->materials = calloc(d->material_count ? d->material_count : 1, sizeof *c->materials);
+  if (!c->materials) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  char el[64];
+  iris_status st;
+  for (size_t i = 0; i < d->material_count; i++) {
+    const iris_gltf_material *g = &d->materials[i];
+    iris_material *m = &c->materials[i];
+    ELEMENT(el, "material %zu", i);
+    *m = iris_material_default(IRIS_MATERIAL_GLTF);
+    if (g->bad_extension)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: a value has the wrong JSON type", g->bad_extension);
+    if (g->base_color_len != 4)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "baseColorFactor has %zu values (4 expected)", g->base_color_len);
+    if (g->emissive_len != 3)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "emissiveFactor has %zu values (3 expected)", g->emissive_len);
+    for (int k = 0; k < 4; k++)
+      if ((st = gltf_check_range(c, el, "baseColorFactor component", g->base_color[k], 0, 1))) return st;
+    for (int k = 0; k < 3; k++)
+      if ((st = gltf_check_range(c, el, "emissiveFactor component", g->emissive[k], 0, 1))) return st;
+    if ((st = gltf_check_range(c, el, "metallicFactor", g->metallic, 0, 1)) ||
+        (st = gltf_check_range(c, el, "roughnessFactor", g->roughness, 0, 1)) ||
+        (st = gltf_check_range(c, el, "KHR_materials_emissive_strength emissiveStrength",
+                          g->emissive_strength, 0, HUGE_VAL)) ||
+        (st = gltf_check_range(c, el, "KHR_materials_specular specularFactor", g->specular, 0, 1)) ||
+        (st = gltf_check_range(c, el, "KHR_materials_transmission transmissionFactor", g->transmission, 0, 1)))
+      return st;
+    for (int k = 0; k < 3; k++)
+      if ((st = gltf_check_range(c, el, "KHR_materials_specular specularColorFactor component",
+                            g->specular_color[k], 0, HUGE_VAL)))
+        return st;
+    if (!isfinite(g->ior) || (g->ior != 0.0 && g->ior < 1.0))
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "KHR_materials_ior ior %g is neither 0 nor >= 1", g->ior);
+
+    if (g->name && g->name[0]) m->name = (char *)g->name; /* copied when added */
+    for (int k = 0; k < 3; k++) {
+      m->color[k] = (float)g->base_color[k];
+      m->emission[k] = (float)(g->emissive[k] * g->emissive_strength);
+      m->specular_color[k] = (float)g->specular_color[k];
+    }
+    m->metallic = (float)g->metallic;
+    m->roughness = (float)g->roughness;
+    m->specular = (float)g->specular;
+    m->transmission = (float)g->transmission;
+    /* ior 0 is the extension's "F0 = 1" special case, which a dielectric cannot express. */
+    if (g->ior == 0.0) iris_warnf("%s: material %zu: KHR_materials_ior ior 0 is not supported; using 1.5", c->file, i);
+    m->ior = g->ior == 0.0 ? 1.5f : (float)g->ior;
+    m->double_sided = g->double_sided;
+    m->emission_two_sided = g->double_sided;
+    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &m->color_texture)) ||
+        (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
+                          &m->metallic_roughness_texture)) ||
+        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &m->emission_texture)))
+      return st;
+    if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
+      if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
+      c->warned_alpha = true;
+    }
+    if (g->has_normal_texture || g->has_occlusion_texture) c->warned_normal_occlusion = true;
+    if (g->has_specular_textures) c->warned_spec_tex = true;
+    if (g->has_transmission_texture) c->warned_trans_tex = true;
+  }
+  return IRIS_OK;
+}
+
+/* Scene material for glTF material `gi` (-1: the glTF default material). */
+iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out) {
+  if (gi < 0) {
+    if (c->default_material < 0) {
+      /* glTF 2.0 section 3.9.6: no material = base colour 1, metallic 1, roughness 1. */
+      iris_material m = iris_material_default(IRIS_MATERIAL_GLTF);
+      m.color[0] = m.color[1] = m.color[2] = 1.0f;
+      m.metallic = 1.0f;
+      m.roughness = 1.0f;
+      m.emission_two_sided = false;
+      m.name = iris_strdup("glTF default");
+      c->default_material = iris_scene_add_material(c->scene, &m);
+      if (c->default_material < 0) {
+        free(m.name);
+        return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      }
+    }
+    *out = c->default_material;
+    return IRIS_OK;
+  }
+  if (c->material_map[gi] >= 0) {
+    *out = c->material_map[gi];
+    return IRIS_OK;
+  }
+  iris_material m = c->materials[gi];
+  iris_status st;
+  int32_t *slots[3] = {&m.color_texture, &m.metallic_roughness_texture, &m.emission_texture};
+  for (int k = 0; k < 3; k++) {
+    if (*slots[k] < 0) continue;
+    int32_t id;
+    if ((st = resolve_texture(c, *slots[k], &id))) return st;
+    *slots[k] = id >= 0 ? id : -1;
+  }
+  m.name = m.name ? iris_strdup(m.name) : NULL;
+  int32_t id = iris_scene_add_material(c->scene, &m);
+  if (id < 0) {
+    free(m.name);
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  }
+  *out = c->material_map[gi] = id;
+  return IRIS_OK;
+}
