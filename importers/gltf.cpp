@@ -148,10 +148,42 @@ struct DocStorage {
   std::vector<const char *> used, required;
 };
 
-iris_gltf_texture_ref texture_ref(const tinygltf::TextureInfo &t) {
+// textureInfo (any of tinygltf's three kinds) with its KHR_texture_transform.
+template <class Info>
+iris_gltf_texture_ref texture_ref(const Info &t, double scale) {
   iris_gltf_texture_ref r;
+  std::memset(&r, 0, sizeof r);
   r.texture = t.index;
   r.texcoord = t.texCoord;
+  r.scale = scale;
+  r.tscale[0] = r.tscale[1] = 1.0;
+  r.transform_texcoord = -1;
+  auto it = t.extensions.find("KHR_texture_transform");
+  if (it == t.extensions.end()) return r;
+  const tinygltf::Value &v = it->second;
+  r.has_transform = true;
+  if (!v.IsObject()) {
+    r.bad_transform = true;
+    return r;
+  }
+  auto vec2 = [&](const char *key, double *out) {
+    if (!v.Has(key)) return;
+    const tinygltf::Value &a = v.Get(key);
+    if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
+      r.bad_transform = true;
+      return;
+    }
+    out[0] = a.Get(0).GetNumberAsDouble();
+    out[1] = a.Get(1).GetNumberAsDouble();
+  };
+  vec2("offset", r.offset);
+  vec2("scale", r.tscale);
+  if (!get_number(v, "rotation", &r.rotation, nullptr)) r.bad_transform = true;
+  double tc = -1;
+  if (!get_number(v, "texCoord", &tc, nullptr) || (tc != -1 && (tc < 0 || tc != (double)(int)tc)))
+    r.bad_transform = true;
+  else
+    r.transform_texcoord = (int)tc;
   return r;
 }
 
@@ -160,16 +192,16 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   o->name = m.name.c_str();
   o->base_color = m.pbrMetallicRoughness.baseColorFactor.data();
   o->base_color_len = m.pbrMetallicRoughness.baseColorFactor.size();
-  o->base_color_texture = texture_ref(m.pbrMetallicRoughness.baseColorTexture);
+  o->base_color_texture = texture_ref(m.pbrMetallicRoughness.baseColorTexture, 1.0);
   o->metallic = m.pbrMetallicRoughness.metallicFactor;
   o->roughness = m.pbrMetallicRoughness.roughnessFactor;
-  o->metallic_roughness_texture = texture_ref(m.pbrMetallicRoughness.metallicRoughnessTexture);
+  o->metallic_roughness_texture = texture_ref(m.pbrMetallicRoughness.metallicRoughnessTexture, 1.0);
   o->emissive = m.emissiveFactor.data();
   o->emissive_len = m.emissiveFactor.size();
-  o->emissive_texture = texture_ref(m.emissiveTexture);
+  o->emissive_texture = texture_ref(m.emissiveTexture, 1.0);
   o->double_sided = m.doubleSided;
   o->alpha_mode = m.alphaMode.c_str();
-  o->has_normal_texture = m.normalTexture.index >= 0;
+  o->normal_texture = texture_ref(m.normalTexture, m.normalTexture.scale);
   o->has_occlusion_texture = m.occlusionTexture.index >= 0;
   o->emissive_strength = 1.0;
   o->specular = 1.0;

@@ -25,7 +25,7 @@
 /* Extensions whose content iris maps (anything else used produces one warning). */
 static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
-    "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+    "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform"};
 
 /* ---- small helpers ------------------------------------------------------ */
 
@@ -415,6 +415,8 @@ static void free_mesh_arrays(iris_mesh *m) {
   free(m->normals);
   free(m->uvs);
   free(m->colors);
+  free(m->uvs1);
+  free(m->tangents);
   free(m->indices);
   memset(m, 0, sizeof *m);
 }
@@ -464,7 +466,8 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
       return gltf_fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
                   p->attributes[i].name, ai);
     const char *n = p->attributes[i].name;
-    if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0"))
+    if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0") &&
+        strcmp(n, "TEXCOORD_1"))
       note_ignored_attribute(c, n);
   }
   if (p->indices != -1 && (p->indices < 0 || (size_t)p->indices >= d->accessor_count))
@@ -480,7 +483,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     c->skipped_points_lines++;
     return IRIS_OK;
   }
-  const iris_gltf_accessor *pos, *nrm, *uv, *col;
+  const iris_gltf_accessor *pos, *nrm, *uv, *col, *uv1;
   iris_status st = attribute_accessor(c, p, "POSITION", el, TYPE_VEC3, TYPE_VEC3, 0, &pos);
   if (st) return st;
   if (!pos) {
@@ -491,8 +494,16 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   size_t nv = pos->count;
   if ((st = attribute_accessor(c, p, "NORMAL", el, TYPE_VEC3, TYPE_VEC3, nv, &nrm)) ||
       (st = attribute_accessor(c, p, "TEXCOORD_0", el, TYPE_VEC2, TYPE_VEC2, nv, &uv)) ||
-      (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)))
+      (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)) ||
+      (st = attribute_accessor(c, p, "TEXCOORD_1", el, TYPE_VEC2, TYPE_VEC2, nv, &uv1)))
     return st;
+  /* The second uv set is kept only when the material reads it (and must then exist:
+   * the glTF validator's "material needs TEXCOORD_1" error). */
+  if (!gltf_material_uses_uv1(c, p->material)) uv1 = NULL;
+  else if (!uv1)
+    return gltf_fail(c, IRIS_ERR_INVALID, el,
+                     "material %d reads a texture through texCoord 1 but the primitive has no TEXCOORD_1",
+                     p->material);
   const iris_gltf_accessor *ia = p->indices >= 0 ? &d->accessors[p->indices] : NULL;
   if (ia && (ia->type != TYPE_SCALAR || ia->normalized ||
              (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT &&
@@ -507,7 +518,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
    * small types (u8 -> float, strip -> list), unless accessors are reused by many
    * primitives or are zero-filled; both could otherwise demand unbounded memory. */
   size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
-  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0)) +
+  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0) + (uv1 ? 8 : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
   if (need > (double)c->budget_left)
     return gltf_fail(c, IRIS_ERR_NOMEM, el,
@@ -553,6 +564,12 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     if (!m->uvs) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     read_floats(d, uv, 2, m->uvs);
     if ((st = check_finite_array(c, m->uvs, nv * 2, el, "TEXCOORD_0"))) return st;
+  }
+  if (uv1) {
+    m->uvs1 = malloc(nv * 2 * sizeof(float));
+    if (!m->uvs1) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    read_floats(d, uv1, 2, m->uvs1);
+    if ((st = check_finite_array(c, m->uvs1, nv * 2, el, "TEXCOORD_1"))) return st;
   }
   if (col) {
     int nc = col->type == TYPE_VEC4 ? 4 : 3;
@@ -1048,7 +1065,7 @@ static void report_ignored(gltf_ctx *c) {
                c->degenerate_dropped);
   if (c->zero_normals)
     iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
-  if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_1 or higher are ignored", f);
+  if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_2 or higher are ignored", f);
   if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
   if (c->warned_normal_occlusion) iris_warnf("%s: normal and occlusion textures are ignored", f);
   if (c->warned_spec_tex) iris_warnf("%s: KHR_materials_specular textures are ignored", f);
@@ -1073,9 +1090,8 @@ static void ctx_free(gltf_ctx *c) {
   }
   free(c->materials);
   free(c->material_map);
-  free(c->texture_map);
-  free(c->image_texture);
-  free(c->image_sampler);
+  free(c->slots);
+  free(c->tex_keys);
   free(c->parent);
   free(c->world);
 }
@@ -1095,16 +1111,11 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   if (st) return st;
   c.scene = iris_scene_create();
   c.material_map = malloc((doc->material_count ? doc->material_count : 1) * sizeof *c.material_map);
-  c.texture_map = malloc((doc->texture_count ? doc->texture_count : 1) * sizeof *c.texture_map);
-  c.image_texture = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_texture);
-  c.image_sampler = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_sampler);
-  if (!c.scene || !c.material_map || !c.texture_map || !c.image_texture || !c.image_sampler) {
+  if (!c.scene || !c.material_map) {
     st = gltf_fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   for (size_t i = 0; i < doc->material_count; i++) c.material_map[i] = -1;
-  for (size_t i = 0; i < doc->texture_count; i++) c.texture_map[i] = -1;
-  for (size_t i = 0; i < doc->image_count; i++) c.image_texture[i] = -1, c.image_sampler[i] = -2;
   c.budget_total = MESH_BUDGET_SLACK;
   for (size_t i = 0; i < doc->buffer_count; i++) {
     size_t add = doc->buffers[i].size > SIZE_MAX / 32 ? SIZE_MAX / 32 : doc->buffers[i].size * 16;

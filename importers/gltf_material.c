@@ -71,25 +71,40 @@ static void warn_dropped_image(gltf_ctx *c, size_t image, const char *why) {
   c->warned_bad_image = true;
 }
 
-/* Scene texture for glTF texture `ti`, created on first use; -2 when dropped with a warning. */
-static iris_status resolve_texture(gltf_ctx *c, int ti, int32_t *out) {
+static bool same_mapping(const gltf_slot *a, const gltf_slot *b) {
+  if (a->uv_set != b->uv_set || a->has_transform != b->has_transform) return false;
+  return !a->has_transform || (a->offset[0] == b->offset[0] && a->offset[1] == b->offset[1] &&
+                               a->rotation == b->rotation && a->scale[0] == b->scale[0] &&
+                               a->scale[1] == b->scale[1]);
+}
+
+/* Scene texture for a material slot, created on first use: one per (image,
+ * sampler, uv set, transform); -2 when dropped with a warning. */
+static iris_status resolve_texture(gltf_ctx *c, const gltf_slot *slot, int32_t *out) {
   const iris_gltf_doc *d = c->doc;
-  if (c->texture_map[ti] != -1) {
-    *out = c->texture_map[ti];
-    return IRIS_OK;
-  }
-  *out = c->texture_map[ti] = -2;
+  int ti = slot->texture;
   const iris_gltf_texture *t = &d->textures[ti];
-  char el[64];
-  /* Textures naming the same image and sampler share one scene texture. */
-  if (t->source >= 0 && c->image_texture[t->source] >= 0 && c->image_sampler[t->source] == t->sampler) {
-    *out = c->texture_map[ti] = c->image_texture[t->source];
-    return IRIS_OK;
-  }
+  *out = -2;
   if (t->source < 0) {
     iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
     return IRIS_OK;
   }
+  for (size_t k = 0; k < c->tex_key_count; k++) {
+    const gltf_tex_key *key = &c->tex_keys[k];
+    if (key->source == t->source && key->sampler == t->sampler && same_mapping(&key->map, slot)) {
+      *out = key->id;
+      return IRIS_OK;
+    }
+  }
+  if (c->tex_key_count == c->tex_key_cap) {
+    size_t cap = c->tex_key_cap ? 2 * c->tex_key_cap : 8;
+    gltf_tex_key *grown = realloc(c->tex_keys, cap * sizeof *grown);
+    if (!grown) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    c->tex_keys = grown, c->tex_key_cap = cap;
+  }
+  gltf_tex_key *key = &c->tex_keys[c->tex_key_count++];
+  key->source = t->source, key->sampler = t->sampler, key->map = *slot, key->id = -2;
+  char el[64];
   const iris_gltf_image *im = &d->images[t->source];
   ELEMENT(el, "image %d", t->source);
   iris_texture tex;
@@ -153,14 +168,17 @@ static iris_status resolve_texture(gltf_ctx *c, int ti, int32_t *out) {
       *dst[k] = w[k] == WRAP_CLAMP ? IRIS_WRAP_CLAMP : w[k] == WRAP_MIRROR ? IRIS_WRAP_MIRROR : IRIS_WRAP_REPEAT;
     tex.nearest = s->mag_filter == FILTER_NEAREST;
   }
+  tex.uv_set = slot->uv_set;
+  tex.has_transform = slot->has_transform;
+  memcpy(tex.offset, slot->offset, sizeof tex.offset);
+  tex.rotation = slot->rotation;
+  memcpy(tex.scale, slot->scale, sizeof tex.scale);
   int32_t id = iris_scene_add_texture(c->scene, &tex);
   if (id < 0) {
     free(tex.name), free(tex.path), free(tex.data);
     return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   }
-  *out = c->texture_map[ti] = id;
-  c->image_texture[t->source] = id;
-  c->image_sampler[t->source] = t->sampler;
+  *out = key->id = id;
   return IRIS_OK;
 }
 
@@ -170,28 +188,58 @@ iris_status gltf_check_range(gltf_ctx *c, const char *el, const char *what, doub
   return IRIS_OK;
 }
 
-/* Texture reference check: index in range; non-zero texCoord sets are not supported. */
+/* Texture reference check: index in range, texCoord 0 or 1 (higher sets are
+ * dropped with a warning), KHR_texture_transform values finite (its texCoord
+ * overrides the textureInfo's). Fills the slot and *out (the glTF index, or -1). */
 static iris_status texture_ref(gltf_ctx *c, const char *el, const char *what, iris_gltf_texture_ref r,
-                               int32_t *out) {
+                               gltf_slot *slot, int32_t *out) {
   *out = -1;
+  memset(slot, 0, sizeof *slot);
+  slot->texture = -1;
   if (r.texture == -1) return IRIS_OK;
   if (r.texture < 0 || (size_t)r.texture >= c->doc->texture_count)
     return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: texture %d does not exist (%zu textures)", what,
                 r.texture, c->doc->texture_count);
   if (r.texcoord < 0) return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: negative texCoord", what);
-  if (r.texcoord != 0) {
+  if (r.bad_transform)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: KHR_texture_transform: a value has the wrong JSON type",
+                     what);
+  int set = r.has_transform && r.transform_texcoord >= 0 ? r.transform_texcoord : r.texcoord;
+  if (r.has_transform) {
+    double v[5] = {r.offset[0], r.offset[1], r.rotation, r.tscale[0], r.tscale[1]};
+    for (int k = 0; k < 5; k++)
+      if (!isfinite(v[k]) || fabs(v[k]) > 3.4e38)
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: KHR_texture_transform value %g is not finite", what,
+                         v[k]);
+    slot->has_transform = r.offset[0] != 0 || r.offset[1] != 0 || r.rotation != 0 || r.tscale[0] != 1 ||
+                          r.tscale[1] != 1;
+    slot->offset[0] = (float)r.offset[0], slot->offset[1] = (float)r.offset[1];
+    slot->rotation = (float)r.rotation;
+    slot->scale[0] = (float)r.tscale[0], slot->scale[1] = (float)r.tscale[1];
+  }
+  if (set > 1) { /* valid glTF, but iris keeps two uv sets */
     c->warned_texcoord = true;
     return IRIS_OK;
   }
+  slot->uv_set = (uint8_t)set;
+  slot->texture = r.texture;
   *out = r.texture; /* glTF index; turned into a scene index when the material is used */
   return IRIS_OK;
+}
+
+bool gltf_material_uses_uv1(const gltf_ctx *c, int gi) {
+  if (gi < 0) return false;
+  for (int k = 0; k < GLTF_SLOT_COUNT; k++)
+    if (c->slots[gi][k].texture >= 0 && c->slots[gi][k].uv_set == 1) return true;
+  return false;
 }
 
 /* glTF 2.0 Appendix B metallic-roughness material (+ the KHR_materials_* above). */
 iris_status gltf_validate_materials(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   c->materials = calloc(d->material_count ? d->material_count : 1, sizeof *c->materials);
-  if (!c->materials) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  c->slots = calloc(d->material_count ? d->material_count : 1, sizeof *c->slots);
+  if (!c->materials || !c->slots) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   char el[64];
   iris_status st;
   for (size_t i = 0; i < d->material_count; i++) {
@@ -238,17 +286,26 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
     m->ior = g->ior == 0.0 ? 1.5f : (float)g->ior;
     m->double_sided = g->double_sided;
     m->emission_two_sided = g->double_sided;
-    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &m->color_texture)) ||
+    gltf_slot *slots = c->slots[i];
+    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &slots[GLTF_SLOT_COLOR],
+                          &m->color_texture)) ||
         (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
-                          &m->metallic_roughness_texture)) ||
-        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &m->emission_texture)))
+                          &slots[GLTF_SLOT_METALLIC_ROUGHNESS], &m->metallic_roughness_texture)) ||
+        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &slots[GLTF_SLOT_EMISSION],
+                          &m->emission_texture)))
       return st;
+    /* normal maps: the next step; the slot is validated already */
+    int32_t normal_texture;
+    if ((st = texture_ref(c, el, "normalTexture", g->normal_texture, &slots[GLTF_SLOT_NORMAL],
+                          &normal_texture)))
+      return st;
+    slots[GLTF_SLOT_NORMAL].texture = -1;
     if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
       if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
         return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
       c->warned_alpha = true;
     }
-    if (g->has_normal_texture || g->has_occlusion_texture) c->warned_normal_occlusion = true;
+    if (g->normal_texture.texture >= 0 || g->has_occlusion_texture) c->warned_normal_occlusion = true;
     if (g->has_specular_textures) c->warned_spec_tex = true;
     if (g->has_transmission_texture) c->warned_trans_tex = true;
   }
@@ -281,12 +338,13 @@ iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out) {
   }
   iris_material m = c->materials[gi];
   iris_status st;
-  int32_t *slots[3] = {&m.color_texture, &m.metallic_roughness_texture, &m.emission_texture};
-  for (int k = 0; k < 3; k++) {
-    if (*slots[k] < 0) continue;
+  int32_t *fields[GLTF_SLOT_COUNT] = {&m.color_texture, &m.metallic_roughness_texture,
+                                      &m.emission_texture, NULL};
+  for (int k = 0; k < GLTF_SLOT_COUNT; k++) {
+    if (!fields[k] || c->slots[gi][k].texture < 0) continue;
     int32_t id;
-    if ((st = resolve_texture(c, *slots[k], &id))) return st;
-    *slots[k] = id >= 0 ? id : -1;
+    if ((st = resolve_texture(c, &c->slots[gi][k], &id))) return st;
+    *fields[k] = id >= 0 ? id : -1;
   }
   m.name = m.name ? iris_strdup(m.name) : NULL;
   int32_t id = iris_scene_add_material(c->scene, &m);

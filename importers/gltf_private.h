@@ -25,6 +25,28 @@ typedef struct dmat4 {
 
 /* ---- conversion context ------------------------------------------------- */
 
+/* The texture references of a material, in this order. */
+enum {
+  GLTF_SLOT_COLOR, GLTF_SLOT_METALLIC_ROUGHNESS, GLTF_SLOT_EMISSION, GLTF_SLOT_NORMAL,
+  GLTF_SLOT_COUNT
+};
+
+/* How a material slot places a texture: the glTF texture, the uv set and
+ * KHR_texture_transform (as iris_texture's mapping fields). */
+typedef struct gltf_slot {
+  int texture; /* glTF texture index, -1 none */
+  uint8_t uv_set;
+  bool has_transform;
+  float offset[2], rotation, scale[2];
+} gltf_slot;
+
+/* One scene texture: (image, sampler, mapping) -> scene index. */
+typedef struct gltf_tex_key {
+  int source, sampler;
+  gltf_slot map; /* texture field unused */
+  int32_t id;
+} gltf_tex_key;
+
 typedef struct converted_prim {
   iris_mesh mesh;     /* arrays owned here until handed to the scene */
   bool valid;         /* false: skipped (points/lines, no POSITION) */
@@ -43,7 +65,9 @@ typedef struct gltf_ctx {
   iris_material *materials; /* validated, textures still glTF indices */
   int32_t *material_map;    /* glTF material -> scene index, -1 not yet */
   int32_t default_material;
-  int32_t *texture_map;     /* glTF texture -> scene index, -1 not yet, -2 dropped */
+  struct gltf_slot (*slots)[GLTF_SLOT_COUNT]; /* per glTF material: its texture references */
+  struct gltf_tex_key *tex_keys;  /* scene textures made so far (id -2: dropped) */
+  size_t tex_key_count, tex_key_cap;
 
   int *parent;
   dmat4 *world;
@@ -55,8 +79,6 @@ typedef struct gltf_ctx {
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
   size_t zero_normals;
   size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
-  int32_t *image_texture;           /* image -> last scene texture made from it */
-  int *image_sampler;               /* ... and that texture's sampler */
 } gltf_ctx;
 
 iris_status gltf_fail(gltf_ctx *c, iris_status st, const char *element, const char *fmt, ...)
@@ -81,5 +103,7 @@ iris_status gltf_validate_materials(gltf_ctx *c);
 /* Scene material for glTF material `gi` (-1: the glTF default material),
  * created on first use together with its textures. */
 iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out);
+/* Whether (validated) glTF material `gi` reads textures through TEXCOORD_1. */
+bool gltf_material_uses_uv1(const gltf_ctx *c, int gi);
 
 #endif

@@ -240,6 +240,13 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
   } else {
     si->uv[0] = si->uv[1] = 0.0f;
   }
+  if (m->uvs1) {
+    const float *t = m->uvs1;
+    si->uv1[0] = b0 * t[2 * idx[0]] + b1 * t[2 * idx[1]] + b2 * t[2 * idx[2]];
+    si->uv1[1] = b0 * t[2 * idx[0] + 1] + b1 * t[2 * idx[1] + 1] + b2 * t[2 * idx[2] + 1];
+  } else {
+    si->uv1[0] = si->uv[0], si->uv1[1] = si->uv[1];
+  }
   if (m->colors) {
     const float *c = m->colors;
     si->color = iris_add(iris_add(iris_scale(iris_v3_load(c + 3 * (size_t)idx[0]), b0),

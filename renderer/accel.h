@@ -39,6 +39,7 @@ typedef struct iris_interaction {
   iris_vec3 ng;      /* unit geometric normal of the front (counter-clockwise) face */
   iris_vec3 ns;      /* unit shading normal, flipped onto ng's side */
   float uv[2];       /* (0, 0) when the mesh has none */
+  float uv1[2];      /* second uv set; = uv when the mesh has none */
   iris_vec3 color;   /* vertex colour; (1, 1, 1) when the mesh has none */
   int32_t material;  /* index into scene->materials, -1 = default */
   uint32_t prim;     /* global triangle index */

@@ -53,13 +53,13 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   iris_vec3 color = iris_mul(iris_v3_load(m->color), si->color);
   if (m->color_texture >= 0) {
     float t[4];
-    iris_texture_lookup(it->textures, m->color_texture, si->uv[0], si->uv[1], true, t);
+    iris_texture_sample(it->textures, m->color_texture, si->uv, si->uv1, true, t);
     color = iris_mul(color, iris_v3(t[0], t[1], t[2]));
   }
   float roughness = m->roughness, metallic = m->metallic;
   if (m->type == IRIS_MATERIAL_GLTF && m->metallic_roughness_texture >= 0) {
     float t[4];
-    iris_texture_lookup(it->textures, m->metallic_roughness_texture, si->uv[0], si->uv[1], false, t);
+    iris_texture_sample(it->textures, m->metallic_roughness_texture, si->uv, si->uv1, false, t);
     roughness *= t[1];
     metallic *= t[2];
   }

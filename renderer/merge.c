@@ -54,6 +54,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     if (t->data) hash_bytes(&s, t->data, t->data_size);
     hash_str(&s, t->mime);
     hash_u64(&s, ((uint64_t)t->wrap_s << 16) | ((uint64_t)t->wrap_t << 8) | (t->nearest ? 1u : 0u));
+    if (t->uv_set || t->has_transform) { /* (scenes without them hash as before) */
+      float x[] = {t->offset[0], t->offset[1], t->rotation, t->scale[0], t->scale[1]};
+      hash_u64(&s, ((uint64_t)t->uv_set << 8) | (t->has_transform ? 1u : 0u));
+      if (t->has_transform) hash_floats(&s, x, 5);
+    }
   }
   hash_u64(&s, scene->material_count);
   for (size_t i = 0; i < scene->material_count; i++) {
@@ -76,6 +81,8 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_floats(&s, m->normals, 3 * (size_t)m->vertex_count);
     hash_floats(&s, m->uvs, 2 * (size_t)m->vertex_count);
     hash_floats(&s, m->colors, 3 * (size_t)m->vertex_count);
+    if (m->uvs1) hash_floats(&s, m->uvs1, 2 * (size_t)m->vertex_count);
+    if (m->tangents) hash_floats(&s, m->tangents, 4 * (size_t)m->vertex_count);
     if (m->indices) hash_bytes(&s, m->indices, 3 * (size_t)m->triangle_count * sizeof(uint32_t));
     hash_u64(&s, (uint64_t)(int64_t)m->material);
   }

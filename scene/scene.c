@@ -25,6 +25,8 @@ static void free_mesh(iris_mesh *m) {
     free(m->normals);
     free(m->uvs);
     free(m->colors);
+    free(m->uvs1);
+    free(m->tangents);
     free(m->indices);
   }
 }
@@ -276,6 +278,16 @@ static iris_status validate_mesh(const iris_scene *s, const iris_mesh *m, const 
     FAIL("uv of vertex %zu is not finite", bad / 2);
   if (m->colors && (bad = first_nonfinite(m->colors, 3 * nv)) < 3 * nv)
     FAIL("color of vertex %zu is not finite", bad / 3);
+  if (m->uvs1 && (bad = first_nonfinite(m->uvs1, 2 * nv)) < 2 * nv)
+    FAIL("uv1 of vertex %zu is not finite", bad / 2);
+  if (m->tangents) {
+    if (!m->normals) FAIL("mesh has tangents but no normals");
+    if ((bad = first_nonfinite(m->tangents, 4 * nv)) < 4 * nv)
+      FAIL("tangent of vertex %zu is not finite", bad / 4);
+    for (size_t v = 0; v < nv; v++)
+      if (m->tangents[4 * v + 3] != 1.0f && m->tangents[4 * v + 3] != -1.0f)
+        FAIL("tangent of vertex %zu: w %g is not +1 or -1", v, (double)m->tangents[4 * v + 3]);
+  }
   size_t ni = 3 * (size_t)m->triangle_count;
   for (size_t i = 0; i < ni; i++)
     if (m->indices[i] >= m->vertex_count)
@@ -319,6 +331,9 @@ iris_status iris_scene_validate(const iris_scene *s, const char *file, iris_erro
     if (t->data && t->data_size == 0) FAIL("texture data is empty");
     if ((unsigned)t->wrap_s > IRIS_WRAP_MIRROR || (unsigned)t->wrap_t > IRIS_WRAP_MIRROR)
       FAIL("unknown wrap mode");
+    if (t->uv_set > 1) FAIL("uv_set %u is not 0 or 1", (unsigned)t->uv_set);
+    if (t->has_transform && !(finite_n(t->offset, 2) && isfinite(t->rotation) && finite_n(t->scale, 2)))
+      FAIL("transform is not finite");
     if (t->data && strcmp(t->mime, "image/png") != 0 && strcmp(t->mime, "image/jpeg") != 0)
       FAIL("unsupported image type '%.16s' (PNG and JPEG are supported)", t->mime);
   }

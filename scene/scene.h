@@ -35,6 +35,13 @@ typedef struct iris_texture {
   char mime[16];        /* "image/png" or "image/jpeg" */
   iris_wrap wrap_s, wrap_t;
   bool nearest;         /* magnification filter NEAREST instead of bilinear */
+  /* Where the image lies on the surface (glTF textureInfo.texCoord and
+   * KHR_texture_transform): uv' = T(offset) R(rotation) S(scale) uv of set
+   * `uv_set`, i.e. u' = ox + c sx u + s sy v, v' = oy - s sx u + c sy v with
+   * c, s = cos, sin(rotation). Defaults: set 0, identity. */
+  uint8_t uv_set;       /* 0: mesh uvs, 1: mesh uvs1 (the uvs when a mesh has no uvs1) */
+  bool has_transform;   /* false: offset 0, rotation 0, scale 1 (not read) */
+  float offset[2], rotation, scale[2];
 } iris_texture;
 
 /* ---- materials --------------------------------------------------------- */
@@ -77,6 +84,10 @@ typedef struct iris_mesh {
   float *normals;     /* 3 * vertex_count or NULL */
   float *uvs;         /* 2 * vertex_count or NULL (glTF convention: v down, (0,0) top-left of the image) */
   float *colors;      /* 3 * vertex_count or NULL (linear RGB) */
+  float *uvs1;        /* 2 * vertex_count or NULL: a second uv set (glTF TEXCOORD_1) */
+  float *tangents;    /* 4 * vertex_count or NULL: xyz unit tangent along +u, w = +-1 the
+                         bitangent sign, B = w (N x T) (glTF TANGENT or generated; only
+                         with normals, for normal maps) */
   uint32_t *indices;  /* 3 * triangle_count, counter-clockwise = front */
   int32_t material;   /* index or -1 for the default material (diffuse 0.8) */
   bool owned;

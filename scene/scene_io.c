@@ -27,7 +27,9 @@
 static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
 static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
 static const char *const WRAP_MODES[] = {"repeat", "clamp", "mirror"};
-static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors"};
+/* In IRIS_MESH_HAS_* bit order. */
+static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors", "uvs1", "tangents"};
+#define ATTRIBUTE_COUNT 5
 
 /* ====================================================================== */
 /* Numbers                                                                 */
@@ -309,6 +311,13 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
       if (t->wrap_s != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_s", WRAP_MODES[t->wrap_s]);
       if (t->wrap_t != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_t", WRAP_MODES[t->wrap_t]);
       if (t->nearest) cJSON_AddStringToObject(o, "filter", "nearest");
+      if (t->uv_set) cJSON_AddNumberToObject(o, "uv_set", t->uv_set);
+      if (t->has_transform) {
+        cJSON *x = cJSON_AddObjectToObject(o, "transform");
+        add_floats(x, "offset", t->offset, 2);
+        add_float(x, "rotation", t->rotation);
+        add_floats(x, "scale", t->scale, 2);
+      }
       cJSON_AddItemToArray(a, o);
     }
   }
@@ -335,8 +344,8 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
     cJSON_AddNumberToObject(o, "vertices", m->vertex_count);
     cJSON_AddNumberToObject(o, "triangles", m->triangle_count);
     cJSON *attrs = cJSON_AddArrayToObject(o, "attributes");
-    const void *present[3] = {m->normals, m->uvs, m->colors};
-    for (int k = 0; k < 3; k++)
+    const void *present[ATTRIBUTE_COUNT] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents};
+    for (int k = 0; k < ATTRIBUTE_COUNT; k++)
       if (present[k]) cJSON_AddItemToArray(attrs, cJSON_CreateString(ATTRIBUTE_NAMES[k]));
     cJSON_AddItemToArray(meshes, o);
   }
@@ -647,7 +656,7 @@ static iris_status load_texture_file(jctx *c, const char *dir, const char *file,
 }
 
 static iris_status load_texture(jctx *c, const cJSON *o, const char *dir, iris_texture *t) {
-  static const char *const keys[] = {"name", "file", "wrap_s", "wrap_t", "filter"};
+  static const char *const keys[] = {"name", "file", "wrap_s", "wrap_t", "filter", "uv_set", "transform"};
   static const char *const filters[] = {"linear", "nearest"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(get_name(c, o, &t->name));
@@ -658,6 +667,19 @@ static iris_status load_texture(jctx *c, const cJSON *o, const char *dir, iris_t
   t->wrap_s = (iris_wrap)ws;
   t->wrap_t = (iris_wrap)wt;
   t->nearest = filter == 1;
+  int32_t uv_set = 0;
+  TRY(get_i32(c, o, "uv_set", 0, 1, &uv_set));
+  t->uv_set = (uint8_t)uv_set;
+  const cJSON *x = item(o, "transform");
+  if (x) {
+    static const char *const xkeys[] = {"offset", "rotation", "scale"};
+    TRY(check_keys(c, x, xkeys, sizeof xkeys / sizeof *xkeys));
+    t->has_transform = true;
+    t->scale[0] = t->scale[1] = 1.0f;
+    TRY(get_floats(c, x, "offset", t->offset, 2));
+    TRY(get_float(c, x, "rotation", &t->rotation));
+    TRY(get_floats(c, x, "scale", t->scale, 2));
+  }
   TRY(require(c, o, "file"));
   const char *file = NULL;
   TRY(get_string(c, o, "file", &file));
@@ -692,10 +714,11 @@ static iris_status load_mesh_desc(jctx *c, const cJSON *o, iris_mesh *m, mesh_de
     d->attributes = 0;
     for (const cJSON *e = a->child; e; e = e->next) {
       int k = 0;
-      while (k < 3 && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
-      if (k == 3)
+      while (k < ATTRIBUTE_COUNT && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
+      if (k == ATTRIBUTE_COUNT)
         return jfail(c, IRIS_ERR_INVALID,
-                     "'attributes' entries must be \"normals\", \"uvs\" or \"colors\"");
+                     "'attributes' entries must be \"normals\", \"uvs\", \"colors\", \"uvs1\" or "
+                     "\"tangents\"");
       if (d->attributes & (1 << k)) return jfail(c, IRIS_ERR_INVALID, "'%s' listed twice in 'attributes'", ATTRIBUTE_NAMES[k]);
       d->attributes |= 1 << k;
     }

@@ -521,6 +521,72 @@ static void check_synthetic(void) {
   o.camera_name = NULL;
   free(j);
 
+  /* Second uv set and KHR_texture_transform: one scene texture per (image, sampler,
+   * uv set, transform); TEXCOORD_1 stored only for a material that reads it. The
+   * image is an 8-byte PNG signature (images are not decoded on import). */
+  const char *tex =
+      "\"images\":[{\"uri\":\"data:image/png;base64,iVBORw0KGgo=\"}],\"textures\":[{\"source\":0}],"
+      "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1},"
+      "\"metallicRoughnessTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":"
+      "{\"offset\":[0.5,0],\"rotation\":0.25,\"scale\":[2,-3],\"texCoord\":1}}}},"
+      "\"emissiveTexture\":{\"index\":0},\"emissiveFactor\":[1,1,1]},"
+      "{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":"
+      "{\"offset\":[0.5,0],\"rotation\":0.25,\"scale\":[2,-3],\"texCoord\":1}}}}}],";
+  const char *uvacc =
+      "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"},"
+      "{\"bufferView\":1,\"componentType\":5121,\"count\":6,\"type\":\"SCALAR\"},"
+      "{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC2\"}],";
+  snprintf(rest, sizeof rest,
+           "%s%s\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"TEXCOORD_1\":2},\"mode\":6,"
+           "\"material\":0},{\"attributes\":{\"POSITION\":0,\"TEXCOORD_0\":2,\"TEXCOORD_1\":2},\"mode\":6}]}],"
+           "\"nodes\":[{\"mesh\":0}],\"extensionsUsed\":[\"KHR_texture_transform\"]",
+           uvacc, tex);
+  j = make_gltf(rest);
+  st = import_text(j, &o, &s, msg, sizeof msg);
+  EXPECT(st == IRIS_OK, "uv sets: %s", msg);
+  if (st == IRIS_OK && s->mesh_count == 2 && s->texture_count == 3 && s->material_count >= 1) {
+    const iris_material *m = &s->materials[s->meshes[0].material];
+    const iris_texture *c0 = &s->textures[m->color_texture], *mr = &s->textures[m->metallic_roughness_texture],
+                       *em = &s->textures[m->emission_texture];
+    EXPECT(c0->uv_set == 1 && !c0->has_transform, "baseColorTexture: set %u", c0->uv_set);
+    EXPECT(mr->uv_set == 1 && mr->has_transform && mr->offset[0] == 0.5f && mr->offset[1] == 0.0f &&
+               mr->rotation == 0.25f && mr->scale[0] == 2.0f && mr->scale[1] == -3.0f,
+           "metallicRoughnessTexture: set %u (texCoord override), transform", mr->uv_set);
+    EXPECT(em->uv_set == 0 && !em->has_transform, "emissiveTexture: set 0");
+    EXPECT(s->meshes[0].uvs1 && !s->meshes[0].uvs && s->meshes[0].uvs1[3] == 1.0f, "TEXCOORD_1 stored");
+    EXPECT(s->meshes[1].uvs && !s->meshes[1].uvs1, "TEXCOORD_1 of a primitive whose material does not read it: not stored");
+  } else {
+    EXPECT(0, "uv sets: %zu meshes, %zu textures", s ? s->mesh_count : 0, s ? s->texture_count : 0);
+  }
+  iris_scene_destroy(s);
+  free(j);
+  /* A material reading texCoord 1 on a primitive without TEXCOORD_1; a transform
+   * with a value of the wrong type; a non-finite one cannot be written in JSON. */
+  const char *uvbad[][2] = {
+      {"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":6,\"material\":1}]}],"
+       "\"nodes\":[{\"mesh\":0}]",
+       "no TEXCOORD_1"},
+      {"\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":6,\"material\":2}]}],"
+       "\"nodes\":[{\"mesh\":0}]",
+       "KHR_texture_transform"},
+  };
+  for (size_t i = 0; i < sizeof uvbad / sizeof *uvbad; i++) {
+    char mats[1600];
+    snprintf(mats, sizeof mats, "%s", tex);
+    /* material 2: rotation given as a string */
+    char *end = strstr(mats, "}}}}}],");
+    if (end && i == 1) snprintf(end, sizeof mats - (size_t)(end - mats),
+                      "}}}}},{\"emissiveTexture\":{\"index\":0,\"extensions\":{\"KHR_texture_transform\":"
+                      "{\"rotation\":\"x\"}}},\"emissiveFactor\":[1,1,1]}],");
+    snprintf(rest, sizeof rest, "%s%s%s", uvacc, mats, uvbad[i][0]);
+    j = make_gltf(rest);
+    st = import_text(j, &o, &s, msg, sizeof msg);
+    EXPECT(st == IRIS_ERR_INVALID && s == NULL && strstr(msg, uvbad[i][1]) && !strchr(msg, '\n') &&
+               strncmp(msg, "synthetic.gltf: ", 16) == 0,
+           "uv bad %zu: %s", i, msg);
+    free(j);
+  }
+
   /* Structural rejections. */
   const char *bad[][2] = {
       {"\"nodes\":[{\"children\":[2]},{\"children\":[2]},{}],\"scenes\":[{\"nodes\":[0,1]}]", "already has parent"},

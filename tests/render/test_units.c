@@ -28,7 +28,9 @@ static void test_lookup(void) {
   iris_textures tex;
   memset(&tex, 0, sizeof tex);
   for (int i = 0; i < 256; i++) tex.srgb_table[i] = iris_srgb_to_linear((float)i / 255.0f);
-  iris_texture_image img = {2, 1, px, IRIS_WRAP_CLAMP, IRIS_WRAP_CLAMP, false};
+  iris_texture_image img;
+  memset(&img, 0, sizeof img);
+  img.width = 2, img.height = 1, img.rgba = px, img.wrap_s = img.wrap_t = IRIS_WRAP_CLAMP;
   tex.images = &img;
   tex.count = 1;
   float c[4];
@@ -43,6 +45,27 @@ static void test_lookup(void) {
   CHECK_NEAR(c[0], 0.0, 1e-6);
   iris_texture_lookup(&tex, 0, 0.0f, 0.5f, true, c); /* clamp: the edge texel */
   CHECK_NEAR(c[0], 0.0, 1e-6);
+  /* clamp is not periodic: u = -0.5 and -3.5 read the left edge, 1.5 the right one */
+  iris_texture_lookup(&tex, 0, -0.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 0.0, 1e-6);
+  iris_texture_lookup(&tex, 0, -3.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 0.0, 1e-6);
+  iris_texture_lookup(&tex, 0, 1.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  /* uv set and transform: set 1 with offset (0.5, 0) reads u1 + 0.5 */
+  img.uv_set = 1;
+  iris_texture tdesc;
+  memset(&tdesc, 0, sizeof tdesc);
+  tdesc.has_transform = true, tdesc.offset[0] = 0.5f, tdesc.scale[0] = tdesc.scale[1] = 1.0f;
+  img.has_transform = true;
+  iris_texture_transform_matrix(&tdesc, img.xf);
+  const float uv0[2] = {0.5f, 0.5f}, uv1[2] = {0.25f, 0.5f};
+  iris_texture_sample(&tex, 0, uv0, uv1, false, c); /* u = 0.75: the white texel's centre */
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  img.uv_set = 0;
+  iris_texture_sample(&tex, 0, uv1, uv0, false, c); /* set 0 = (0.25, 0.5) + 0.5 */
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  img.uv_set = 0, img.has_transform = false;
   img.wrap_s = IRIS_WRAP_REPEAT; /* repeat: u = 0 is halfway between last and first */
   iris_texture_lookup(&tex, 0, 0.0f, 0.5f, false, c);
   CHECK_NEAR(c[0], 0.5, 1e-6);
@@ -53,6 +76,44 @@ static void test_lookup(void) {
   CHECK_NEAR(c[0], 1.0, 1e-6);
   iris_texture_lookup(&tex, 7, 0.6f, 0.5f, false, c); /* out of range: white */
   CHECK_NEAR(c[0], 1.0, 1e-6);
+}
+
+/* KHR_texture_transform against the Khronos TextureTransformTest model's markers:
+ * each quad spans uv (0,0)-(1,1) over its local [-0.5, 0.5]^2 (u = x + 0.5,
+ * v = 0.5 - y); the arrow's tip is at texture uv (0.7778, 0.7778) (the "not
+ * supported" marker, local (0.2778, -0.2778)); with the right transform the tip
+ * shows at the "correct" marker, with the rotation reversed at the "error" one. */
+static void test_texture_transform(void) {
+  const float tip[2] = {0.77781746f, 0.77781746f};
+  struct {
+    float offset[2], rotation, scale[2];
+    float x, y;   /* marker's local position */
+    double tol;   /* the marker quads are 0.1-0.15 wide */
+    bool hit;
+  } cases[] = {
+      {{0, 0}, 0.39269908f, {1, 1}, -0.07904822f, -0.51626749f, 1e-4, true},   /* Rotation - Correct */
+      {{0, 0}, 0.39269908f, {1, 1}, 0.51626749f, 0.07904822f, 0.1, false},     /* Rotation - Error */
+      {{0, 0}, 0, {1.5f, 1.5f}, 0.01854497f, -0.01854497f, 1e-4, true},        /* Scale - Correct */
+      {{-0.2f, -0.1f}, 0.3f, {1.5f, 1.5f}, -0.07f, -0.25f, 0.05, true},        /* All - Correct */
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    iris_texture t;
+    memset(&t, 0, sizeof t);
+    t.has_transform = true;
+    memcpy(t.offset, cases[i].offset, sizeof t.offset);
+    t.rotation = cases[i].rotation;
+    memcpy(t.scale, cases[i].scale, sizeof t.scale);
+    float xf[2][3];
+    iris_texture_transform_matrix(&t, xf);
+    float u = cases[i].x + 0.5f, v = 0.5f - cases[i].y;
+    float tu = xf[0][0] * u + xf[0][1] * v + xf[0][2], tv = xf[1][0] * u + xf[1][1] * v + xf[1][2];
+    double dist = hypot(tu - tip[0], tv - tip[1]);
+    if (cases[i].hit) {
+      if (!CHECK(dist < cases[i].tol)) printf("  case %zu: tip at (%g, %g), distance %g\n", i, tu, tv, dist);
+    } else {
+      CHECK(dist > cases[i].tol);
+    }
+  }
 }
 
 /* One triangle in the z = 0 plane, front +z, with a vertex normal field. */
@@ -189,6 +250,7 @@ static void test_camera(void) {
 int main(void) {
   test_wrap();
   test_lookup();
+  test_texture_transform();
   test_instances();
   test_offsets();
   test_camera();
