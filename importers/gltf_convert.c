@@ -14,6 +14,7 @@
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/meshproc.h"
+#include "importers/tangents.h"
 
 
 /* Accessors without a bufferView are zero-filled from nothing but their
@@ -467,7 +468,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
                   p->attributes[i].name, ai);
     const char *n = p->attributes[i].name;
     if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0") &&
-        strcmp(n, "TEXCOORD_1"))
+        strcmp(n, "TEXCOORD_1") && strcmp(n, "TANGENT"))
       note_ignored_attribute(c, n);
   }
   if (p->indices != -1 && (p->indices < 0 || (size_t)p->indices >= d->accessor_count))
@@ -483,7 +484,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     c->skipped_points_lines++;
     return IRIS_OK;
   }
-  const iris_gltf_accessor *pos, *nrm, *uv, *col, *uv1;
+  const iris_gltf_accessor *pos, *nrm, *uv, *col, *uv1, *tan;
   iris_status st = attribute_accessor(c, p, "POSITION", el, TYPE_VEC3, TYPE_VEC3, 0, &pos);
   if (st) return st;
   if (!pos) {
@@ -495,8 +496,20 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   if ((st = attribute_accessor(c, p, "NORMAL", el, TYPE_VEC3, TYPE_VEC3, nv, &nrm)) ||
       (st = attribute_accessor(c, p, "TEXCOORD_0", el, TYPE_VEC2, TYPE_VEC2, nv, &uv)) ||
       (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)) ||
-      (st = attribute_accessor(c, p, "TEXCOORD_1", el, TYPE_VEC2, TYPE_VEC2, nv, &uv1)))
+      (st = attribute_accessor(c, p, "TEXCOORD_1", el, TYPE_VEC2, TYPE_VEC2, nv, &uv1)) ||
+      (st = attribute_accessor(c, p, "TANGENT", el, TYPE_VEC4, TYPE_VEC4, nv, &tan)))
     return st;
+  /* Tangent frames only for a normal map, and only with NORMAL: "When normals are
+   * not specified, [...] the provided tangents (if present) MUST be ignored". */
+  int normal_set = gltf_material_normal_uv_set(c, p->material);
+  if (normal_set >= 0 && !nrm) {
+    c->normal_map_no_normal++;
+    normal_set = -1;
+  } else if (normal_set >= 0 && !(normal_set ? uv1 : uv) && !tan) {
+    c->normal_map_no_uv++;
+    normal_set = -1;
+  }
+  if (normal_set < 0) tan = NULL;
   /* The second uv set is kept only when the material reads it (and must then exist:
    * the glTF validator's "material needs TEXCOORD_1" error). */
   if (!gltf_material_uses_uv1(c, p->material)) uv1 = NULL;
@@ -518,7 +531,9 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
    * small types (u8 -> float, strip -> list), unless accessors are reused by many
    * primitives or are zero-filled; both could otherwise demand unbounded memory. */
   size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
-  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0) + (uv1 ? 8 : 0)) +
+  /* (tangents: 16 bytes, and generation may double the vertices at mirror seams) */
+  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0) + (uv1 ? 8 : 0) +
+                              (normal_set >= 0 ? 16.0 + 12 + 12 + (uv ? 8 : 0) + (col ? 12 : 0) + (uv1 ? 8 : 0) : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
   if (need > (double)c->budget_left)
     return gltf_fail(c, IRIS_ERR_NOMEM, el,
@@ -570,6 +585,23 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     if (!m->uvs1) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     read_floats(d, uv1, 2, m->uvs1);
     if ((st = check_finite_array(c, m->uvs1, nv * 2, el, "TEXCOORD_1"))) return st;
+  }
+  if (tan && m->normals) {
+    m->tangents = malloc(nv * 4 * sizeof(float));
+    if (!m->tangents) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    read_floats(d, tan, 4, m->tangents);
+    if ((st = check_finite_array(c, m->tangents, nv * 4, el, "TANGENT"))) return st;
+    for (size_t i = 0; i < nv; i++) {
+      float *t = m->tangents + 4 * i;
+      float len = sqrtf(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      if (!(len > 0.0f) || !isfinite(1.0f / len)) { /* unusable: generate instead */
+        free(m->tangents);
+        m->tangents = NULL;
+        break;
+      }
+      t[0] /= len, t[1] /= len, t[2] /= len;
+      t[3] = t[3] < 0.0f ? -1.0f : 1.0f;
+    }
   }
   if (col) {
     int nc = col->type == TYPE_VEC4 ? 4 : 3;
@@ -640,6 +672,12 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   if (kept > 0 && !iris_mesh_finish(m, false, c->opts->weld, &removed))
     return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   c->degenerate_dropped += removed;
+  if (normal_set >= 0 && m->normals && !m->tangents && m->triangle_count > 0 && (normal_set ? m->uvs1 : m->uvs)) {
+    uint32_t split = 0;
+    if (!iris_mesh_generate_tangents(m, normal_set, &split)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    c->tangents_generated++;
+    c->tangents_split += split;
+  }
   if (m->triangle_count == 0) {
     c->skipped_empty++;
     free_mesh_arrays(m);
@@ -1067,7 +1105,13 @@ static void report_ignored(gltf_ctx *c) {
     iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
   if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_2 or higher are ignored", f);
   if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
-  if (c->warned_normal_occlusion) iris_warnf("%s: normal and occlusion textures are ignored", f);
+  if (c->warned_occlusion) iris_warnf("%s: occlusion textures are ignored (a path tracer has its own)", f);
+  if (c->normal_map_no_normal)
+    iris_warnf("%s: %zu primitive(s) without NORMAL are shaded flat, without their normal map", f,
+               c->normal_map_no_normal);
+  if (c->normal_map_no_uv)
+    iris_warnf("%s: %zu primitive(s) lack the uv set of their normal map, which is not applied", f,
+               c->normal_map_no_uv);
   if (c->warned_spec_tex) iris_warnf("%s: KHR_materials_specular textures are ignored", f);
   if (c->warned_trans_tex) iris_warnf("%s: KHR_materials_transmission texture is ignored", f);
   if (c->warned_morph) iris_warnf("%s: morph targets ignored (base shape used)", f);

@@ -227,6 +227,11 @@ static iris_status texture_ref(gltf_ctx *c, const char *el, const char *what, ir
   return IRIS_OK;
 }
 
+int gltf_material_normal_uv_set(const gltf_ctx *c, int gi) {
+  if (gi < 0 || c->slots[gi][GLTF_SLOT_NORMAL].texture < 0) return -1;
+  return c->slots[gi][GLTF_SLOT_NORMAL].uv_set;
+}
+
 bool gltf_material_uses_uv1(const gltf_ctx *c, int gi) {
   if (gi < 0) return false;
   for (int k = 0; k < GLTF_SLOT_COUNT; k++)
@@ -294,18 +299,18 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
         (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &slots[GLTF_SLOT_EMISSION],
                           &m->emission_texture)))
       return st;
-    /* normal maps: the next step; the slot is validated already */
-    int32_t normal_texture;
     if ((st = texture_ref(c, el, "normalTexture", g->normal_texture, &slots[GLTF_SLOT_NORMAL],
-                          &normal_texture)))
+                          &m->normal_texture)))
       return st;
-    slots[GLTF_SLOT_NORMAL].texture = -1;
+    if (!isfinite(g->normal_texture.scale) || fabs(g->normal_texture.scale) > 3.4e38)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "normalTexture scale %g is not finite", g->normal_texture.scale);
+    m->normal_scale = (float)g->normal_texture.scale;
     if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
       if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
         return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
       c->warned_alpha = true;
     }
-    if (g->normal_texture.texture >= 0 || g->has_occlusion_texture) c->warned_normal_occlusion = true;
+    if (g->has_occlusion_texture) c->warned_occlusion = true;
     if (g->has_specular_textures) c->warned_spec_tex = true;
     if (g->has_transmission_texture) c->warned_trans_tex = true;
   }
@@ -339,7 +344,7 @@ iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out) {
   iris_material m = c->materials[gi];
   iris_status st;
   int32_t *fields[GLTF_SLOT_COUNT] = {&m.color_texture, &m.metallic_roughness_texture,
-                                      &m.emission_texture, NULL};
+                                      &m.emission_texture, &m.normal_texture};
   for (int k = 0; k < GLTF_SLOT_COUNT; k++) {
     if (!fields[k] || c->slots[gi][k].texture < 0) continue;
     int32_t id;

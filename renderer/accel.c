@@ -11,6 +11,7 @@ typedef struct accel_instance {
   const iris_mesh *mesh;
   float *positions;  /* world space, 3 * vertex_count (+ padding for Embree) */
   float nm[3][3];    /* normal matrix (cofactor form, sign kept for mirrors) */
+  float m3[3][3];    /* upper 3x3 of the transform (tangents are surface directions) */
   bool mirrored;     /* det < 0: object-space CCW is world-space CW */
   uint32_t first_prim;
 } accel_instance;
@@ -88,7 +89,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     ai->mirrored = iris_mat4_det3(&inst->transform) < 0.0f;
     iris_mat4 nm = iris_mat4_normal_matrix(&inst->transform);
     for (int r = 0; r < 3; r++)
-      for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c];
+      for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c], ai->m3[r][c] = inst->transform.m[r][c];
     /* Embree reads vertices with 16-byte loads: pad one float past the end. */
     ai->positions = malloc(sizeof(float) * (3 * (size_t)mesh->vertex_count + 4));
     if (!ai->positions) {
@@ -223,15 +224,34 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
                            ai->nm[1][0] * no.x + ai->nm[1][1] * no.y + ai->nm[1][2] * no.z,
                            ai->nm[2][0] * no.x + ai->nm[2][1] * no.y + ai->nm[2][2] * no.z);
     float len = iris_length(nw);
+    bool flipped = false;
     if (len > 0.0f && isfinite(len)) {
       nw = iris_scale(nw, 1.0f / len);
-      if (iris_dot(nw, ng) < 0.0f) nw = iris_neg(nw);
+      flipped = iris_dot(nw, ng) < 0.0f;
+      if (flipped) nw = iris_neg(nw);
       si->ns = nw;
     } else {
       si->ns = ng;
     }
+    si->has_tangent = m->tangents != NULL;
+    if (m->tangents) { /* B = w (n x t) in object space, both carried by the transform */
+      const float *tg = m->tangents;
+      iris_vec3 to = iris_add(iris_add(iris_scale(iris_v3_load(tg + 4 * (size_t)idx[0]), b0),
+                                       iris_scale(iris_v3_load(tg + 4 * (size_t)idx[1]), b1)),
+                              iris_scale(iris_v3_load(tg + 4 * (size_t)idx[2]), b2));
+      iris_vec3 bo = iris_scale(iris_cross(no, to), tg[4 * (size_t)idx[0] + 3]);
+      iris_vec3 tw = iris_v3(ai->m3[0][0] * to.x + ai->m3[0][1] * to.y + ai->m3[0][2] * to.z,
+                             ai->m3[1][0] * to.x + ai->m3[1][1] * to.y + ai->m3[1][2] * to.z,
+                             ai->m3[2][0] * to.x + ai->m3[2][1] * to.y + ai->m3[2][2] * to.z);
+      iris_vec3 bw = iris_v3(ai->m3[0][0] * bo.x + ai->m3[0][1] * bo.y + ai->m3[0][2] * bo.z,
+                             ai->m3[1][0] * bo.x + ai->m3[1][1] * bo.y + ai->m3[1][2] * bo.z,
+                             ai->m3[2][0] * bo.x + ai->m3[2][1] * bo.y + ai->m3[2][2] * bo.z);
+      si->tangent = flipped ? iris_neg(tw) : tw;
+      si->bitangent = flipped ? iris_neg(bw) : bw;
+    }
   } else {
     si->ns = ng;
+    si->has_tangent = false;
   }
   if (m->uvs) {
     const float *t = m->uvs;

@@ -45,6 +45,9 @@ typedef struct iris_interaction {
   uint32_t prim;     /* global triangle index */
   uint32_t instance; /* scene instance */
   bool front;        /* the ray arrived on the front side (dot(d, ng) < 0) */
+  bool has_tangent;  /* the mesh has tangents: the two vectors below are set */
+  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed),
+                                   interpolated, not normalised; flipped with ns */
 } iris_interaction;
 
 typedef struct iris_accel iris_accel;

@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "renderer/normal_map.h"
+
 static const char *const METHOD_NAMES[IRIS_METHOD_COUNT] = {"bsdf", "nee", "mis", "guided",
                                                              "guided-nee"};
 
@@ -64,6 +66,16 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
     metallic *= t[2];
   }
   sp->si = *si;
+  if (m->normal_texture >= 0 && si->has_tangent) { /* docs/rendering.md, "Normal maps" */
+    float t[4];
+    iris_texture_sample(it->textures, m->normal_texture, si->uv, si->uv1, false, t);
+    iris_vec3 n = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->normal_scale);
+    /* seen from wo's side, as the BSDF will see it */
+    bool back = iris_dot(wo, si->ng) < 0.0f;
+    iris_vec3 ngw = back ? iris_neg(si->ng) : si->ng;
+    n = iris_normal_make_valid(ngw, wo, back ? iris_neg(n) : n);
+    sp->si.ns = back ? iris_neg(n) : n;
+  }
   sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);

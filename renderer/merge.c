@@ -72,6 +72,10 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_u64(&s, (uint64_t)(int64_t)m->metallic_roughness_texture);
     hash_u64(&s, (uint64_t)(int64_t)m->emission_texture);
     hash_u64(&s, (m->emission_two_sided ? 2u : 0u) | (m->double_sided ? 1u : 0u));
+    if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
+      hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
+      hash_floats(&s, &m->normal_scale, 1);
+    }
   }
   hash_u64(&s, scene->mesh_count);
   for (size_t i = 0; i < scene->mesh_count; i++) {

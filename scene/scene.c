@@ -110,6 +110,8 @@ iris_material iris_material_default(iris_material_type type) {
   m.emission_texture = -1;
   m.emission_two_sided = true;
   m.double_sided = false;
+  m.normal_texture = -1;
+  m.normal_scale = 1.0f;
   return m;
 }
 
@@ -146,6 +148,7 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     m->color_texture = shift_ref(m->color_texture, tex0);
     m->metallic_roughness_texture = shift_ref(m->metallic_roughness_texture, tex0);
     m->emission_texture = shift_ref(m->emission_texture, tex0);
+    m->normal_texture = shift_ref(m->normal_texture, tex0);
   }
   for (size_t i = 0; i < src->mesh_count; i++)
     src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
@@ -256,6 +259,9 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
     return st;
   if ((st = check_texture_ref(m->metallic_roughness_texture, s->texture_count,
                               "metallic_roughness_texture", file, element, err)))
+    return st;
+  if (!isfinite(m->normal_scale)) FAIL("normal_scale %g is not finite", (double)m->normal_scale);
+  if ((st = check_texture_ref(m->normal_texture, s->texture_count, "normal_texture", file, element, err)))
     return st;
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,
                            element, err);

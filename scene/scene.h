@@ -69,6 +69,9 @@ typedef struct iris_material {
   int32_t emission_texture;/* multiplies emission (sRGB-decoded); -1 none */
   bool emission_two_sided; /* true: emits from both faces (Cycles' behaviour) */
   bool double_sided;       /* glTF doubleSided (informational for back-face shading) */
+  int32_t normal_texture;  /* tangent-space normal map (linear, glTF convention), -1 none;
+                              used on meshes with tangents */
+  float normal_scale;      /* glTF normalTexture.scale: scales the map's x and y (1 default) */
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */

@@ -193,6 +193,8 @@ static cJSON *write_material(const iris_material *m) {
   if (m->emission_two_sided != d.emission_two_sided)
     cJSON_AddBoolToObject(o, "emission_two_sided", m->emission_two_sided);
   if (m->double_sided != d.double_sided) cJSON_AddBoolToObject(o, "double_sided", m->double_sided);
+  if (m->normal_texture >= 0) cJSON_AddNumberToObject(o, "normal_texture", m->normal_texture);
+  if (m->normal_scale != d.normal_scale) add_float(o, "normal_scale", m->normal_scale);
   return o;
 }
 
@@ -585,7 +587,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   static const char *const keys[] = {"name", "type", "color", "color_texture", "roughness", "ior",
                                      "metallic", "metallic_roughness_texture", "specular",
                                      "specular_color", "transmission", "emission", "emission_texture",
-                                     "emission_two_sided", "double_sided"};
+                                     "emission_two_sided", "double_sided", "normal_texture",
+                                     "normal_scale"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -617,6 +620,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   TRY(get_i32(c, o, "emission_texture", -1, INT32_MAX, &full.emission_texture));
   TRY(get_bool(c, o, "emission_two_sided", &full.emission_two_sided));
   TRY(get_bool(c, o, "double_sided", &full.double_sided));
+  TRY(get_i32(c, o, "normal_texture", -1, INT32_MAX, &m->normal_texture));
+  TRY(get_float(c, o, "normal_scale", &m->normal_scale));
   memcpy(m->color, full.color, sizeof m->color);
   m->color_texture = full.color_texture;
   if (type != IRIS_MATERIAL_DIFFUSE) m->roughness = full.roughness;

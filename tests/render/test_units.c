@@ -8,6 +8,7 @@
 #include "chi2.h"
 #include "renderer/accel.h"
 #include "renderer/camera.h"
+#include "renderer/normal_map.h"
 #include "renderer/texture.h"
 #include "scenes/builtin.h"
 
@@ -112,6 +113,38 @@ static void test_texture_transform(void) {
       if (!CHECK(dist < cases[i].tol)) printf("  case %zu: tip at (%g, %g), distance %g\n", i, tu, tv, dist);
     } else {
       CHECK(dist > cases[i].tol);
+    }
+  }
+}
+
+/* Normal maps: the flat texel (0.5, 0.5, 1) gives N back; x along T, y along B;
+ * a normal bent so far that wo's mirror image would go below the surface is
+ * pulled back just enough (reflection height = min(0.9 cos, 0.01)), and valid
+ * ones are kept. */
+static void test_normal_map(void) {
+  iris_vec3 t = iris_v3(1, 0, 0), b = iris_v3(0, 1, 0), n = iris_v3(0, 0, 1);
+  const float flat[3] = {0.5f, 0.5f, 1.0f}, tilt[3] = {1.0f, 0.5f, 0.5f + 0.5f * 1.0f};
+  iris_vec3 r = iris_normal_map_apply(t, b, n, flat, 1.0f);
+  CHECK(fabsf(r.z - 1.0f) < 1e-6f);
+  r = iris_normal_map_apply(t, b, n, tilt, 1.0f); /* (1, 0, 1) normalised */
+  CHECK(fabsf(r.x - 0.70710678f) < 1e-5f && fabsf(r.z - 0.70710678f) < 1e-5f);
+  r = iris_normal_map_apply(t, b, n, tilt, 0.0f); /* scale 0: flat */
+  CHECK(fabsf(r.z - 1.0f) < 1e-6f);
+  iris_vec3 ng = iris_v3(0, 0, 1);
+  for (int i = 0; i < 200; i++) {
+    float th = 0.05f + 1.4f * (float)i / 200.0f, ph = 0.7f * (float)i;
+    iris_vec3 wo = iris_v3(sinf(th) * cosf(ph), sinf(th) * sinf(ph), cosf(th));
+    float bend = 1.5f * (float)((i * 37) % 200) / 200.0f;
+    iris_vec3 sn = iris_normalize(iris_v3(sinf(bend) * cosf(ph + 2.0f), sinf(bend) * sinf(ph + 2.0f), cosf(bend)));
+    iris_vec3 v = iris_normal_make_valid(ng, wo, sn);
+    iris_vec3 refl = iris_sub(iris_scale(sn, 2.0f * iris_dot(sn, wo)), wo);
+    float thr = fminf(0.9f * wo.z, 0.01f);
+    if (refl.z >= thr) {
+      CHECK(v.x == sn.x && v.y == sn.y && v.z == sn.z);
+    } else {
+      iris_vec3 rv = iris_sub(iris_scale(v, 2.0f * iris_dot(v, wo)), wo);
+      if (!CHECK(fabsf(iris_length(v) - 1.0f) < 1e-4f && rv.z >= thr - 2e-4f && v.z > 0.0f))
+        printf("  case %d: reflection height %g (threshold %g)\n", i, rv.z, thr);
     }
   }
 }
@@ -251,6 +284,7 @@ int main(void) {
   test_wrap();
   test_lookup();
   test_texture_transform();
+  test_normal_map();
   test_instances();
   test_offsets();
   test_camera();

@@ -125,6 +125,8 @@ iris_scene *fixture_rich_scene(const char *dir) {
   m.emission[2] = 1e-3f;
   m.emission_texture = 0;
   m.ior = 1.33f;
+  m.normal_texture = 1;
+  m.normal_scale = 0.75f;
   iris_scene_add_material(s, &m);
 
   iris_mesh cube = fixture_cube("cube", true, true, true);

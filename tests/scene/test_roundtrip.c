@@ -58,6 +58,8 @@ static void compare_scenes(const iris_scene *a, const iris_scene *b) {
     CHECK(same_floats(x->emission, y->emission, 3));
     CHECK_EQ_INT(x->emission_texture, y->emission_texture);
     CHECK_EQ_INT(x->emission_two_sided, y->emission_two_sided);
+    CHECK_EQ_INT(x->normal_texture, y->normal_texture);
+    CHECK(same_floats(&x->normal_scale, &y->normal_scale, 1));
     CHECK_EQ_INT(x->double_sided, y->double_sided);
     if (x->type != IRIS_MATERIAL_DIFFUSE) CHECK(same_floats(&x->roughness, &y->roughness, 1));
     if (x->type == IRIS_MATERIAL_GLASS || x->type == IRIS_MATERIAL_GLTF) CHECK(same_floats(&x->ior, &y->ior, 1));
