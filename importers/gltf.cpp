@@ -201,6 +201,7 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   o->emissive_texture = texture_ref(m.emissiveTexture, 1.0);
   o->double_sided = m.doubleSided;
   o->alpha_mode = m.alphaMode.c_str();
+  o->alpha_cutoff = m.alphaCutoff;
   o->normal_texture = texture_ref(m.normalTexture, m.normalTexture.scale);
   o->has_occlusion_texture = m.occlusionTexture.index >= 0;
   o->emissive_strength = 1.0;

@@ -418,6 +418,7 @@ static void free_mesh_arrays(iris_mesh *m) {
   free(m->colors);
   free(m->uvs1);
   free(m->tangents);
+  free(m->alphas);
   free(m->indices);
   memset(m, 0, sizeof *m);
 }
@@ -532,7 +533,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
    * primitives or are zero-filled; both could otherwise demand unbounded memory. */
   size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
   /* (tangents: 16 bytes, and generation may double the vertices at mirror seams) */
-  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0) + (uv1 ? 8 : 0) +
+  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 32 : 0) + (uv1 ? 8 : 0) +
                               (normal_set >= 0 ? 16.0 + 12 + 12 + (uv ? 8 : 0) + (col ? 12 : 0) + (uv1 ? 8 : 0) : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
   if (need > (double)c->budget_left)
@@ -612,8 +613,27 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
       return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     }
     read_floats(d, col, nc, tmp);
-    for (size_t i = 0; i < nv; i++) /* alpha dropped: iris is opaque */
+    if ((st = check_finite_array(c, tmp, nv * (size_t)nc, el, "COLOR_0"))) {
+      free(tmp);
+      return st;
+    }
+    for (size_t i = 0; i < nv; i++)
       for (int k = 0; k < 3; k++) m->colors[3 * i + (size_t)k] = tmp[(size_t)nc * i + (size_t)k];
+    /* COLOR_0's alpha is kept only where it matters: a MASK/BLEND material and some alpha < 1 */
+    bool alpha = false;
+    if (nc == 4 && gltf_material_alpha_mode(c, p->material) != IRIS_ALPHA_OPAQUE)
+      for (size_t i = 0; i < nv && !alpha; i++) alpha = tmp[4 * i + 3] != 1.0f;
+    if (alpha) {
+      m->alphas = malloc(nv * sizeof(float));
+      if (!m->alphas) {
+        free(tmp);
+        return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      }
+      for (size_t i = 0; i < nv; i++) {
+        float a = tmp[4 * i + 3];
+        m->alphas[i] = a < 0.0f ? 0.0f : a > 1.0f ? 1.0f : a; /* (normalised integers are in range) */
+      }
+    }
     free(tmp);
     if ((st = check_finite_array(c, m->colors, nv * 3, el, "COLOR_0"))) return st;
   }
@@ -1104,7 +1124,9 @@ static void report_ignored(gltf_ctx *c) {
   if (c->zero_normals)
     iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
   if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_2 or higher are ignored", f);
-  if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
+  if (c->warned_alpha_emission)
+    iris_warnf("%s: emissive MASK/BLEND materials: light sampling does not see their alpha (emission "
+               "from cut-out parts is still sampled)", f);
   if (c->warned_occlusion) iris_warnf("%s: occlusion textures are ignored (a path tracer has its own)", f);
   if (c->normal_map_no_normal)
     iris_warnf("%s: %zu primitive(s) without NORMAL are shaded flat, without their normal map", f,

@@ -93,6 +93,7 @@ typedef struct iris_gltf_material {
   iris_gltf_texture_ref emissive_texture;
   bool double_sided;
   const char *alpha_mode;
+  double alpha_cutoff;
   iris_gltf_texture_ref normal_texture;
   bool has_occlusion_texture;
   /* Extensions; `bad_extension` names one whose values have the wrong JSON type. */

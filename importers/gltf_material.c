@@ -232,6 +232,10 @@ int gltf_material_normal_uv_set(const gltf_ctx *c, int gi) {
   return c->slots[gi][GLTF_SLOT_NORMAL].uv_set;
 }
 
+iris_alpha_mode gltf_material_alpha_mode(const gltf_ctx *c, int gi) {
+  return gi < 0 ? IRIS_ALPHA_OPAQUE : c->materials[gi].alpha_mode;
+}
+
 bool gltf_material_uses_uv1(const gltf_ctx *c, int gi) {
   if (gi < 0) return false;
   for (int k = 0; k < GLTF_SLOT_COUNT; k++)
@@ -308,7 +312,14 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
     if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
       if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
         return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
-      c->warned_alpha = true;
+      /* alpha = baseColorFactor.a x texture alpha x COLOR_0 alpha (glTF 2.0 section 3.9.4) */
+      m->alpha_mode = strcmp(g->alpha_mode, "MASK") == 0 ? IRIS_ALPHA_MASK : IRIS_ALPHA_BLEND;
+      m->alpha = (float)g->base_color[3];
+      if (m->alpha_mode == IRIS_ALPHA_MASK) {
+        if ((st = gltf_check_range(c, el, "alphaCutoff", g->alpha_cutoff, 0, HUGE_VAL))) return st;
+        m->alpha_cutoff = (float)g->alpha_cutoff;
+      }
+      if (g->emissive[0] > 0 || g->emissive[1] > 0 || g->emissive[2] > 0) c->warned_alpha_emission = true;
     }
     if (g->has_occlusion_texture) c->warned_occlusion = true;
     if (g->has_specular_textures) c->warned_spec_tex = true;

@@ -75,7 +75,7 @@ typedef struct gltf_ctx {
   /* Present-but-ignored features, reported once each at the end. */
   char ignored_attributes[256];
   size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
-  bool warned_texcoord, warned_alpha, warned_occlusion, warned_spec_tex, warned_trans_tex;
+  bool warned_texcoord, warned_alpha_emission, warned_occlusion, warned_spec_tex, warned_trans_tex;
   size_t normal_map_no_normal, normal_map_no_uv; /* primitives whose normal map is not applied */
   size_t tangents_generated, tangents_split;
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
@@ -107,6 +107,8 @@ iris_status gltf_validate_materials(gltf_ctx *c);
 iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out);
 /* The uv set (validated) glTF material `gi`'s normal map reads, -1 without one. */
 int gltf_material_normal_uv_set(const gltf_ctx *c, int gi);
+/* The alpha mode of (validated) glTF material `gi` (-1: the default material, opaque). */
+iris_alpha_mode gltf_material_alpha_mode(const gltf_ctx *c, int gi);
 /* Whether (validated) glTF material `gi` reads textures through TEXCOORD_1. */
 bool gltf_material_uses_uv1(const gltf_ctx *c, int gi);
 

@@ -158,7 +158,7 @@ bool iris_mesh_generate_tangents(iris_mesh *m, int uv_set, uint32_t *split) {
   if (extra) {
     if (!grow_floats(&m->positions, nv, total, 3) || !grow_floats(&m->normals, nv, total, 3) ||
         !grow_floats(&m->uvs, nv, total, 2) || !grow_floats(&m->colors, nv, total, 3) ||
-        !grow_floats(&m->uvs1, nv, total, 2))
+        !grow_floats(&m->uvs1, nv, total, 2) || !grow_floats(&m->alphas, nv, total, 1))
       goto done; /* arrays grown so far keep their old contents: the mesh is unchanged */
     size_t next = nv;
     for (size_t v = 0; v < nv; v++) {
@@ -171,6 +171,7 @@ bool iris_mesh_generate_tangents(iris_mesh *m, int uv_set, uint32_t *split) {
       if (m->uvs) memcpy(m->uvs + 2 * w, m->uvs + 2 * v, 2 * sizeof(float));
       if (m->colors) memcpy(m->colors + 3 * w, m->colors + 3 * v, 3 * sizeof(float));
       if (m->uvs1) memcpy(m->uvs1 + 2 * w, m->uvs1 + 2 * v, 2 * sizeof(float));
+      if (m->alphas) m->alphas[w] = m->alphas[v];
     }
     for (size_t f = 0; f < nt; f++)
       if (orient[f] == 0)

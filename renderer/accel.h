@@ -57,7 +57,20 @@ typedef struct iris_accel iris_accel;
 iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err);
 void iris_accel_destroy(iris_accel *accel);
 
-/* Closest hit in (tmin, tmax); false on a miss. */
+/* Textures for the coverage (alpha) of MASK/BLEND materials' colour textures;
+ * until set (or with NULL) only their alpha factor and vertex alpha count.
+ * `tex` must outlive the accel's use. */
+struct iris_textures;
+void iris_accel_set_textures(iris_accel *accel, const struct iris_textures *tex);
+/* The coverage alpha of a hit on triangle `prim` at barycentrics (b1, b2):
+ * material alpha x vertex alpha x colour texture alpha (1 for opaque materials). */
+float iris_accel_alpha(const iris_accel *accel, uint32_t prim, float b1, float b2);
+
+/* Closest hit in (tmin, tmax); false on a miss. Surfaces of MASK materials
+ * are skipped where alpha < cutoff, surfaces of BLEND materials with
+ * probability 1 - alpha, decided by a hash of the ray and the triangle (so the
+ * same ray always gets the same answer, whatever thread casts it);
+ * docs/rendering.md, "Alpha". Opaque geometry has no filter and pays nothing. */
 bool iris_accel_intersect(const iris_accel *accel, const iris_ray *ray, iris_hit *hit);
 /* Any hit in (tmin, tmax). */
 bool iris_accel_occluded(const iris_accel *accel, const iris_ray *ray);

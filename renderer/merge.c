@@ -72,6 +72,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_u64(&s, (uint64_t)(int64_t)m->metallic_roughness_texture);
     hash_u64(&s, (uint64_t)(int64_t)m->emission_texture);
     hash_u64(&s, (m->emission_two_sided ? 2u : 0u) | (m->double_sided ? 1u : 0u));
+    if (m->alpha_mode != IRIS_ALPHA_OPAQUE || m->alpha != 1.0f) { /* (opaque scenes hash as before) */
+      float a[2] = {m->alpha, m->alpha_cutoff};
+      hash_u64(&s, (uint64_t)m->alpha_mode);
+      hash_floats(&s, a, 2);
+    }
     if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
       hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
       hash_floats(&s, &m->normal_scale, 1);
@@ -87,6 +92,7 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_floats(&s, m->colors, 3 * (size_t)m->vertex_count);
     if (m->uvs1) hash_floats(&s, m->uvs1, 2 * (size_t)m->vertex_count);
     if (m->tangents) hash_floats(&s, m->tangents, 4 * (size_t)m->vertex_count);
+    if (m->alphas) hash_floats(&s, m->alphas, (size_t)m->vertex_count);
     if (m->indices) hash_bytes(&s, m->indices, 3 * (size_t)m->triangle_count * sizeof(uint32_t));
     hash_u64(&s, (uint64_t)(int64_t)m->material);
   }

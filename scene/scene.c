@@ -27,6 +27,7 @@ static void free_mesh(iris_mesh *m) {
     free(m->colors);
     free(m->uvs1);
     free(m->tangents);
+    free(m->alphas);
     free(m->indices);
   }
 }
@@ -112,6 +113,9 @@ iris_material iris_material_default(iris_material_type type) {
   m.double_sided = false;
   m.normal_texture = -1;
   m.normal_scale = 1.0f;
+  m.alpha_mode = IRIS_ALPHA_OPAQUE;
+  m.alpha = 1.0f;
+  m.alpha_cutoff = 0.5f;
   return m;
 }
 
@@ -261,6 +265,10 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
                               "metallic_roughness_texture", file, element, err)))
     return st;
   if (!isfinite(m->normal_scale)) FAIL("normal_scale %g is not finite", (double)m->normal_scale);
+  if ((unsigned)m->alpha_mode > IRIS_ALPHA_BLEND) FAIL("unknown alpha mode %d", (int)m->alpha_mode);
+  if (!isfinite(m->alpha) || m->alpha < 0.0f || m->alpha > 1.0f) FAIL("alpha %g outside [0, 1]", (double)m->alpha);
+  if (!isfinite(m->alpha_cutoff) || m->alpha_cutoff < 0.0f)
+    FAIL("alpha_cutoff %g must be finite and non-negative", (double)m->alpha_cutoff);
   if ((st = check_texture_ref(m->normal_texture, s->texture_count, "normal_texture", file, element, err)))
     return st;
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,
@@ -286,6 +294,9 @@ static iris_status validate_mesh(const iris_scene *s, const iris_mesh *m, const 
     FAIL("color of vertex %zu is not finite", bad / 3);
   if (m->uvs1 && (bad = first_nonfinite(m->uvs1, 2 * nv)) < 2 * nv)
     FAIL("uv1 of vertex %zu is not finite", bad / 2);
+  if (m->alphas)
+    for (size_t v = 0; v < nv; v++)
+      if (!(m->alphas[v] >= 0.0f && m->alphas[v] <= 1.0f)) FAIL("alpha of vertex %zu is not in [0, 1]", v);
   if (m->tangents) {
     if (!m->normals) FAIL("mesh has tangents but no normals");
     if ((bad = first_nonfinite(m->tangents, 4 * nv)) < 4 * nv)

@@ -53,6 +53,14 @@ typedef enum iris_material_type {
   IRIS_MATERIAL_GLTF         /* glTF 2.0 metallic-roughness (Appendix B)   <-> Principled BSDF */
 } iris_material_type;
 
+/* glTF alphaMode: how the coverage alpha = `alpha` x colour texture alpha x
+ * vertex alpha is used (docs/materials.md, "Alpha"). */
+typedef enum iris_alpha_mode {
+  IRIS_ALPHA_OPAQUE = 0, /* alpha ignored */
+  IRIS_ALPHA_MASK,       /* the surface exists where alpha >= alpha_cutoff */
+  IRIS_ALPHA_BLEND       /* rays pass through with probability 1 - alpha */
+} iris_alpha_mode;
+
 typedef struct iris_material {
   char *name;
   iris_material_type type;
@@ -72,6 +80,9 @@ typedef struct iris_material {
   int32_t normal_texture;  /* tangent-space normal map (linear, glTF convention), -1 none;
                               used on meshes with tangents */
   float normal_scale;      /* glTF normalTexture.scale: scales the map's x and y (1 default) */
+  iris_alpha_mode alpha_mode;
+  float alpha;             /* glTF baseColorFactor.a, [0, 1] (1 default) */
+  float alpha_cutoff;      /* MASK threshold, >= 0 (0.5 default) */
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */
@@ -91,6 +102,8 @@ typedef struct iris_mesh {
   float *tangents;    /* 4 * vertex_count or NULL: xyz unit tangent along +u, w = +-1 the
                          bitangent sign, B = w (N x T) (glTF TANGENT or generated; only
                          with normals, for normal maps) */
+  float *alphas;      /* vertex_count or NULL: vertex alpha in [0, 1] (glTF COLOR_0.a; only for
+                         MASK/BLEND materials) */
   uint32_t *indices;  /* 3 * triangle_count, counter-clockwise = front */
   int32_t material;   /* index or -1 for the default material (diffuse 0.8) */
   bool owned;

@@ -28,8 +28,9 @@ static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf
 static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
 static const char *const WRAP_MODES[] = {"repeat", "clamp", "mirror"};
 /* In IRIS_MESH_HAS_* bit order. */
-static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors", "uvs1", "tangents"};
-#define ATTRIBUTE_COUNT 5
+static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors", "uvs1", "tangents", "alphas"};
+#define ATTRIBUTE_COUNT 6
+static const char *const ALPHA_MODES[] = {"opaque", "mask", "blend"};
 
 /* ====================================================================== */
 /* Numbers                                                                 */
@@ -195,6 +196,9 @@ static cJSON *write_material(const iris_material *m) {
   if (m->double_sided != d.double_sided) cJSON_AddBoolToObject(o, "double_sided", m->double_sided);
   if (m->normal_texture >= 0) cJSON_AddNumberToObject(o, "normal_texture", m->normal_texture);
   if (m->normal_scale != d.normal_scale) add_float(o, "normal_scale", m->normal_scale);
+  if (m->alpha_mode != IRIS_ALPHA_OPAQUE) cJSON_AddStringToObject(o, "alpha_mode", ALPHA_MODES[m->alpha_mode]);
+  if (m->alpha != d.alpha) add_float(o, "alpha", m->alpha);
+  if (m->alpha_cutoff != d.alpha_cutoff) add_float(o, "alpha_cutoff", m->alpha_cutoff);
   return o;
 }
 
@@ -346,7 +350,7 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
     cJSON_AddNumberToObject(o, "vertices", m->vertex_count);
     cJSON_AddNumberToObject(o, "triangles", m->triangle_count);
     cJSON *attrs = cJSON_AddArrayToObject(o, "attributes");
-    const void *present[ATTRIBUTE_COUNT] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents};
+    const void *present[ATTRIBUTE_COUNT] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents, m->alphas};
     for (int k = 0; k < ATTRIBUTE_COUNT; k++)
       if (present[k]) cJSON_AddItemToArray(attrs, cJSON_CreateString(ATTRIBUTE_NAMES[k]));
     cJSON_AddItemToArray(meshes, o);
@@ -588,7 +592,7 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                                      "metallic", "metallic_roughness_texture", "specular",
                                      "specular_color", "transmission", "emission", "emission_texture",
                                      "emission_two_sided", "double_sided", "normal_texture",
-                                     "normal_scale"};
+                                     "normal_scale", "alpha_mode", "alpha", "alpha_cutoff"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -622,6 +626,11 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   TRY(get_bool(c, o, "double_sided", &full.double_sided));
   TRY(get_i32(c, o, "normal_texture", -1, INT32_MAX, &m->normal_texture));
   TRY(get_float(c, o, "normal_scale", &m->normal_scale));
+  int alpha_mode = IRIS_ALPHA_OPAQUE;
+  TRY(get_enum(c, o, "alpha_mode", ALPHA_MODES, 3, &alpha_mode));
+  m->alpha_mode = (iris_alpha_mode)alpha_mode;
+  TRY(get_float(c, o, "alpha", &m->alpha));
+  TRY(get_float(c, o, "alpha_cutoff", &m->alpha_cutoff));
   memcpy(m->color, full.color, sizeof m->color);
   m->color_texture = full.color_texture;
   if (type != IRIS_MATERIAL_DIFFUSE) m->roughness = full.roughness;
@@ -722,8 +731,8 @@ static iris_status load_mesh_desc(jctx *c, const cJSON *o, iris_mesh *m, mesh_de
       while (k < ATTRIBUTE_COUNT && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
       if (k == ATTRIBUTE_COUNT)
         return jfail(c, IRIS_ERR_INVALID,
-                     "'attributes' entries must be \"normals\", \"uvs\", \"colors\", \"uvs1\" or "
-                     "\"tangents\"");
+                     "'attributes' entries must be \"normals\", \"uvs\", \"colors\", \"uvs1\", "
+                     "\"tangents\" or \"alphas\"");
       if (d->attributes & (1 << k)) return jfail(c, IRIS_ERR_INVALID, "'%s' listed twice in 'attributes'", ATTRIBUTE_NAMES[k]);
       d->attributes |= 1 << k;
     }

@@ -14,8 +14,8 @@
 static const char *const CMD = "info";
 static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
 static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
-static const char *const ATTRIBUTES[] = {"normals", "uvs", "colors", "uvs1", "tangents"};
-static const int ATTRIBUTE_BYTES[] = {12, 8, 12, 8, 16};
+static const char *const ATTRIBUTES[] = {"normals", "uvs", "colors", "uvs1", "tangents", "alphas"};
+static const int ATTRIBUTE_BYTES[] = {12, 8, 12, 8, 16, 4};
 
 static void print_help(void) {
   printf("Usage: iris info FILE [--json]\n"
@@ -36,7 +36,7 @@ static void print_help(void) {
 typedef struct scene_stats {
   uint64_t vertices, triangles, world_triangles, emissive_world_triangles;
   uint64_t mesh_bytes, texture_bytes;
-  size_t materials_by_type[4], lights_by_type[3], meshes_with[5];
+  size_t materials_by_type[4], lights_by_type[3], meshes_with[6];
   size_t embedded_textures;
   bool has_bounds;
   iris_vec3 lo, hi;
@@ -53,9 +53,9 @@ static scene_stats compute_stats(const iris_scene *s) {
     const iris_mesh *m = &s->meshes[i];
     st.vertices += m->vertex_count;
     st.triangles += m->triangle_count;
-    const void *attrs[5] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents};
+    const void *attrs[6] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents, m->alphas};
     uint64_t per_vertex = 12;
-    for (int k = 0; k < 5; k++)
+    for (int k = 0; k < 6; k++)
       if (attrs[k]) {
         st.meshes_with[k]++;
         per_vertex += (uint64_t)ATTRIBUTE_BYTES[k];
@@ -97,7 +97,7 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
   cJSON_AddNumberToObject(meshes, "triangles", (double)st->triangles);
   cJSON_AddNumberToObject(meshes, "bytes", (double)st->mesh_bytes);
   cJSON *with = cJSON_AddObjectToObject(meshes, "with_attribute");
-  for (int k = 0; k < 5; k++) cJSON_AddNumberToObject(with, ATTRIBUTES[k], (double)st->meshes_with[k]);
+  for (int k = 0; k < 6; k++) cJSON_AddNumberToObject(with, ATTRIBUTES[k], (double)st->meshes_with[k]);
   cJSON *inst = cJSON_AddObjectToObject(o, "instances");
   cJSON_AddNumberToObject(inst, "count", (double)s->instance_count);
   cJSON_AddNumberToObject(inst, "world_triangles", (double)st->world_triangles);
@@ -161,8 +161,8 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
          (unsigned long long)st->vertices, (unsigned long long)st->triangles);
   printf("attributes   normals %zu, uvs %zu, colors %zu", st->meshes_with[0], st->meshes_with[1],
          st->meshes_with[2]);
-  if (st->meshes_with[3] || st->meshes_with[4]) /* only scenes that have them */
-    printf(", uvs1 %zu, tangents %zu", st->meshes_with[3], st->meshes_with[4]);
+  if (st->meshes_with[3] || st->meshes_with[4] || st->meshes_with[5]) /* only scenes that have them */
+    printf(", uvs1 %zu, tangents %zu, alphas %zu", st->meshes_with[3], st->meshes_with[4], st->meshes_with[5]);
   printf(" of %zu meshes\n", s->mesh_count);
   printf("instances    %zu (%llu triangles in the world, %llu emissive)\n", s->instance_count,
          (unsigned long long)st->world_triangles, (unsigned long long)st->emissive_world_triangles);
