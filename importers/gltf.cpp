@@ -187,6 +187,31 @@ iris_gltf_texture_ref texture_ref(const Info &t, double scale) {
   return r;
 }
 
+// A textureInfo given as a JSON value inside an extension (index, texCoord,
+// scale, KHR_texture_transform); false when present with wrong types.
+bool texture_ref_value(const tinygltf::Value &ext, const char *key, iris_gltf_texture_ref *r) {
+  tinygltf::TextureInfo none;
+  *r = texture_ref(none, 1.0);
+  if (!ext.IsObject() || !ext.Has(key)) return true;
+  const tinygltf::Value &t = ext.Get(key);
+  if (!t.IsObject() || !t.Has("index") || !t.Get("index").IsInt()) return false;
+  r->texture = t.Get("index").GetNumberAsInt();
+  if (t.Has("texCoord")) {
+    if (!t.Get("texCoord").IsInt()) return false;
+    r->texcoord = t.Get("texCoord").GetNumberAsInt();
+  }
+  if (!get_number(t, "scale", &r->scale, nullptr)) return false;
+  if (t.Has("extensions") && t.Get("extensions").IsObject() && t.Get("extensions").Has("KHR_texture_transform")) {
+    tinygltf::TextureInfo info;
+    info.index = r->texture;
+    info.texCoord = r->texcoord;
+    info.extensions["KHR_texture_transform"] = t.Get("extensions").Get("KHR_texture_transform");
+    double scale = r->scale;
+    *r = texture_ref(info, scale);
+  }
+  return true;
+}
+
 void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   std::memset(o, 0, sizeof *o);
   o->name = m.name.c_str();
@@ -245,6 +270,38 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   if (const tinygltf::Value *v = ext("KHR_materials_ior")) {
     o->has_ior = true;
     if (!get_number(*v, "ior", &o->ior, nullptr)) o->bad_extension = "KHR_materials_ior";
+  }
+  {
+    tinygltf::TextureInfo none;
+    o->clearcoat_texture = o->clearcoat_roughness_texture = o->clearcoat_normal_texture =
+        o->sheen_color_texture = o->sheen_roughness_texture = texture_ref(none, 1.0);
+  }
+  if (const tinygltf::Value *v = ext("KHR_materials_clearcoat")) {
+    o->has_clearcoat = true;
+    if (!get_number(*v, "clearcoatFactor", &o->clearcoat, nullptr) ||
+        !get_number(*v, "clearcoatRoughnessFactor", &o->clearcoat_roughness, nullptr) ||
+        !texture_ref_value(*v, "clearcoatTexture", &o->clearcoat_texture) ||
+        !texture_ref_value(*v, "clearcoatRoughnessTexture", &o->clearcoat_roughness_texture) ||
+        !texture_ref_value(*v, "clearcoatNormalTexture", &o->clearcoat_normal_texture))
+      o->bad_extension = "KHR_materials_clearcoat";
+  }
+  if (const tinygltf::Value *v = ext("KHR_materials_sheen")) {
+    o->has_sheen = true;
+    if (v->IsObject() && v->Has("sheenColorFactor")) {
+      const tinygltf::Value &c = v->Get("sheenColorFactor");
+      if (!c.IsArray() || c.ArrayLen() != 3) {
+        o->bad_extension = "KHR_materials_sheen";
+      } else {
+        for (int i = 0; i < 3; i++) {
+          if (!c.Get(i).IsNumber()) o->bad_extension = "KHR_materials_sheen";
+          else o->sheen_color[i] = c.Get(i).GetNumberAsDouble();
+        }
+      }
+    }
+    if (!get_number(*v, "sheenRoughnessFactor", &o->sheen_roughness, nullptr) ||
+        !texture_ref_value(*v, "sheenColorTexture", &o->sheen_color_texture) ||
+        !texture_ref_value(*v, "sheenRoughnessTexture", &o->sheen_roughness_texture))
+      o->bad_extension = "KHR_materials_sheen";
   }
 }
 

@@ -108,6 +108,12 @@ typedef struct iris_gltf_material {
   bool has_transmission_texture;
   bool has_ior;
   double ior;
+  bool has_clearcoat;
+  double clearcoat, clearcoat_roughness;
+  iris_gltf_texture_ref clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+  bool has_sheen;
+  double sheen_color[3], sheen_roughness;
+  iris_gltf_texture_ref sheen_color_texture, sheen_roughness_texture;
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {

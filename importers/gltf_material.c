@@ -228,8 +228,10 @@ static iris_status texture_ref(gltf_ctx *c, const char *el, const char *what, ir
 }
 
 int gltf_material_normal_uv_set(const gltf_ctx *c, int gi) {
-  if (gi < 0 || c->slots[gi][GLTF_SLOT_NORMAL].texture < 0) return -1;
-  return c->slots[gi][GLTF_SLOT_NORMAL].uv_set;
+  if (gi < 0) return -1;
+  if (c->slots[gi][GLTF_SLOT_NORMAL].texture >= 0) return c->slots[gi][GLTF_SLOT_NORMAL].uv_set;
+  if (c->slots[gi][GLTF_SLOT_CLEARCOAT_NORMAL].texture >= 0) return c->slots[gi][GLTF_SLOT_CLEARCOAT_NORMAL].uv_set;
+  return -1;
 }
 
 iris_alpha_mode gltf_material_alpha_mode(const gltf_ctx *c, int gi) {
@@ -306,6 +308,36 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
     if ((st = texture_ref(c, el, "normalTexture", g->normal_texture, &slots[GLTF_SLOT_NORMAL],
                           &m->normal_texture)))
       return st;
+    if (g->has_clearcoat) { /* KHR_materials_clearcoat */
+      if ((st = gltf_check_range(c, el, "KHR_materials_clearcoat clearcoatFactor", g->clearcoat, 0, 1)) ||
+          (st = gltf_check_range(c, el, "KHR_materials_clearcoat clearcoatRoughnessFactor",
+                                 g->clearcoat_roughness, 0, 1)) ||
+          (st = texture_ref(c, el, "clearcoatTexture", g->clearcoat_texture, &slots[GLTF_SLOT_CLEARCOAT],
+                            &m->clearcoat_texture)) ||
+          (st = texture_ref(c, el, "clearcoatRoughnessTexture", g->clearcoat_roughness_texture,
+                            &slots[GLTF_SLOT_CLEARCOAT_ROUGHNESS], &m->clearcoat_roughness_texture)) ||
+          (st = texture_ref(c, el, "clearcoatNormalTexture", g->clearcoat_normal_texture,
+                            &slots[GLTF_SLOT_CLEARCOAT_NORMAL], &m->clearcoat_normal_texture)))
+        return st;
+      if (!isfinite(g->clearcoat_normal_texture.scale))
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "clearcoatNormalTexture scale is not finite");
+      m->clearcoat = (float)g->clearcoat;
+      m->clearcoat_roughness = (float)g->clearcoat_roughness;
+      m->clearcoat_normal_scale = (float)g->clearcoat_normal_texture.scale;
+    }
+    if (g->has_sheen) { /* KHR_materials_sheen */
+      for (int k = 0; k < 3; k++)
+        if ((st = gltf_check_range(c, el, "KHR_materials_sheen sheenColorFactor component", g->sheen_color[k], 0, 1)))
+          return st;
+      if ((st = gltf_check_range(c, el, "KHR_materials_sheen sheenRoughnessFactor", g->sheen_roughness, 0, 1)) ||
+          (st = texture_ref(c, el, "sheenColorTexture", g->sheen_color_texture, &slots[GLTF_SLOT_SHEEN_COLOR],
+                            &m->sheen_color_texture)) ||
+          (st = texture_ref(c, el, "sheenRoughnessTexture", g->sheen_roughness_texture,
+                            &slots[GLTF_SLOT_SHEEN_ROUGHNESS], &m->sheen_roughness_texture)))
+        return st;
+      for (int k = 0; k < 3; k++) m->sheen_color[k] = (float)g->sheen_color[k];
+      m->sheen_roughness = (float)g->sheen_roughness;
+    }
     if (!isfinite(g->normal_texture.scale) || fabs(g->normal_texture.scale) > 3.4e38)
       return gltf_fail(c, IRIS_ERR_INVALID, el, "normalTexture scale %g is not finite", g->normal_texture.scale);
     m->normal_scale = (float)g->normal_texture.scale;
@@ -355,7 +387,10 @@ iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out) {
   iris_material m = c->materials[gi];
   iris_status st;
   int32_t *fields[GLTF_SLOT_COUNT] = {&m.color_texture, &m.metallic_roughness_texture,
-                                      &m.emission_texture, &m.normal_texture};
+                                      &m.emission_texture, &m.normal_texture,
+                                      &m.clearcoat_texture, &m.clearcoat_roughness_texture,
+                                      &m.clearcoat_normal_texture, &m.sheen_color_texture,
+                                      &m.sheen_roughness_texture};
   for (int k = 0; k < GLTF_SLOT_COUNT; k++) {
     if (!fields[k] || c->slots[gi][k].texture < 0) continue;
     int32_t id;

@@ -28,7 +28,8 @@ typedef struct dmat4 {
 /* The texture references of a material, in this order. */
 enum {
   GLTF_SLOT_COLOR, GLTF_SLOT_METALLIC_ROUGHNESS, GLTF_SLOT_EMISSION, GLTF_SLOT_NORMAL,
-  GLTF_SLOT_COUNT
+  GLTF_SLOT_CLEARCOAT, GLTF_SLOT_CLEARCOAT_ROUGHNESS, GLTF_SLOT_CLEARCOAT_NORMAL, GLTF_SLOT_SHEEN_COLOR,
+  GLTF_SLOT_SHEEN_ROUGHNESS, GLTF_SLOT_COUNT
 };
 
 /* How a material slot places a texture: the glTF texture, the uv set and

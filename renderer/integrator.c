@@ -47,6 +47,50 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
   return it;
 }
 
+/* KHR_materials_clearcoat / _sheen values at the point (textures applied) into
+ * the BSDF; the coat normal is the unmapped shading normal or the coat's own
+ * normal map, expressed in the shading frame. Only for materials that have them. */
+static void shade_layers(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
+                         iris_shading_point *sp) {
+  float t[4];
+  if (m->clearcoat > 0.0f) {
+    float cc = m->clearcoat, ccr = m->clearcoat_roughness;
+    if (m->clearcoat_texture >= 0) {
+      iris_texture_sample(it->textures, m->clearcoat_texture, si->uv, si->uv1, false, t);
+      cc *= t[0];
+    }
+    if (m->clearcoat_roughness_texture >= 0) {
+      iris_texture_sample(it->textures, m->clearcoat_roughness_texture, si->uv, si->uv1, false, t);
+      ccr *= t[1];
+    }
+    iris_vec3 cn = si->ns;
+    if (m->clearcoat_normal_texture >= 0 && si->has_tangent) {
+      iris_texture_sample(it->textures, m->clearcoat_normal_texture, si->uv, si->uv1, false, t);
+      cn = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->clearcoat_normal_scale);
+    }
+    if (iris_dot(sp->si.ns, si->ns) < 0.0f) cn = iris_neg(cn); /* flipped with the shading normal */
+    sp->bsdf.clearcoat = cc;
+    sp->bsdf.clearcoat_roughness = ccr;
+    sp->bsdf.coat_n = iris_frame_to_local(&sp->frame, cn);
+  }
+  iris_vec3 sheen = iris_v3_load(m->sheen_color);
+  if (iris_max3(sheen) > 0.0f) {
+    float sr = m->sheen_roughness;
+    if (m->sheen_color_texture >= 0) {
+      iris_texture_sample(it->textures, m->sheen_color_texture, si->uv, si->uv1, true, t);
+      sheen = iris_mul(sheen, iris_v3(t[0], t[1], t[2]));
+    }
+    if (m->sheen_roughness_texture >= 0) {
+      iris_texture_sample(it->textures, m->sheen_roughness_texture, si->uv, si->uv1, false, t);
+      sr *= t[3];
+    }
+    sp->bsdf.sheen_color = sheen;
+    sp->bsdf.sheen_roughness = sr;
+  }
+  sp->lobes = iris_bsdf_lobes(&sp->bsdf);
+  sp->delta = iris_bsdf_is_delta(&sp->bsdf);
+}
+
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp) {
   const iris_material *m = si->material >= 0 && (size_t)si->material < it->scene->material_count
@@ -90,6 +134,8 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   }
   sp->frame = iris_frame_from_normal(sp->si.ns);
   sp->wo_local = iris_frame_to_local(&sp->frame, wo);
+  if (m->type == IRIS_MATERIAL_GLTF && (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f))
+    shade_layers(it, m, si, sp);
 }
 
 /* A direction that leaves a non-transmissive surface below its geometric

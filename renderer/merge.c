@@ -77,6 +77,14 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
       hash_u64(&s, (uint64_t)m->alpha_mode);
       hash_floats(&s, a, 2);
     }
+    if (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f) { /* (others hash as before) */
+      float l[8] = {m->clearcoat, m->clearcoat_roughness, m->clearcoat_normal_scale, m->sheen_color[0],
+                    m->sheen_color[1], m->sheen_color[2], m->sheen_roughness, 0};
+      hash_floats(&s, l, 8);
+      int32_t t[5] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+                      m->sheen_color_texture, m->sheen_roughness_texture};
+      for (int k = 0; k < 5; k++) hash_u64(&s, (uint64_t)(int64_t)t[k]);
+    }
     if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
       hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
       hash_floats(&s, &m->normal_scale, 1);

@@ -116,6 +116,9 @@ iris_material iris_material_default(iris_material_type type) {
   m.alpha_mode = IRIS_ALPHA_OPAQUE;
   m.alpha = 1.0f;
   m.alpha_cutoff = 0.5f;
+  m.clearcoat_texture = m.clearcoat_roughness_texture = m.clearcoat_normal_texture = -1;
+  m.clearcoat_normal_scale = 1.0f;
+  m.sheen_color_texture = m.sheen_roughness_texture = -1;
   return m;
 }
 
@@ -153,6 +156,11 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     m->metallic_roughness_texture = shift_ref(m->metallic_roughness_texture, tex0);
     m->emission_texture = shift_ref(m->emission_texture, tex0);
     m->normal_texture = shift_ref(m->normal_texture, tex0);
+    m->clearcoat_texture = shift_ref(m->clearcoat_texture, tex0);
+    m->clearcoat_roughness_texture = shift_ref(m->clearcoat_roughness_texture, tex0);
+    m->clearcoat_normal_texture = shift_ref(m->clearcoat_normal_texture, tex0);
+    m->sheen_color_texture = shift_ref(m->sheen_color_texture, tex0);
+    m->sheen_roughness_texture = shift_ref(m->sheen_roughness_texture, tex0);
   }
   for (size_t i = 0; i < src->mesh_count; i++)
     src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
@@ -271,6 +279,24 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
     FAIL("alpha_cutoff %g must be finite and non-negative", (double)m->alpha_cutoff);
   if ((st = check_texture_ref(m->normal_texture, s->texture_count, "normal_texture", file, element, err)))
     return st;
+  if (!isfinite(m->clearcoat) || m->clearcoat < 0.0f || m->clearcoat > 1.0f)
+    FAIL("clearcoat %g outside [0, 1]", (double)m->clearcoat);
+  if (!isfinite(m->clearcoat_roughness) || m->clearcoat_roughness < 0.0f || m->clearcoat_roughness > 1.0f)
+    FAIL("clearcoat_roughness %g outside [0, 1]", (double)m->clearcoat_roughness);
+  if (!isfinite(m->clearcoat_normal_scale)) FAIL("clearcoat_normal_scale is not finite");
+  if (!nonneg_finite_n(m->sheen_color, 3) || m->sheen_color[0] > 1.0f || m->sheen_color[1] > 1.0f ||
+      m->sheen_color[2] > 1.0f)
+    FAIL("sheen_color must be in [0, 1]");
+  if (!isfinite(m->sheen_roughness) || m->sheen_roughness < 0.0f || m->sheen_roughness > 1.0f)
+    FAIL("sheen_roughness %g outside [0, 1]", (double)m->sheen_roughness);
+  {
+    const int32_t refs[5] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+                             m->sheen_color_texture, m->sheen_roughness_texture};
+    const char *names[5] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                            "sheen_color_texture", "sheen_roughness_texture"};
+    for (int k = 0; k < 5; k++)
+      if ((st = check_texture_ref(refs[k], s->texture_count, names[k], file, element, err))) return st;
+  }
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,
                            element, err);
 }

@@ -83,6 +83,15 @@ typedef struct iris_material {
   iris_alpha_mode alpha_mode;
   float alpha;             /* glTF baseColorFactor.a, [0, 1] (1 default) */
   float alpha_cutoff;      /* MASK threshold, >= 0 (0.5 default) */
+  /* gltf KHR_materials_clearcoat: factor x texture R, roughness x texture G,
+   * the coat's own normal map (else the coat follows the unmapped normal) */
+  float clearcoat, clearcoat_roughness;
+  int32_t clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+  float clearcoat_normal_scale;
+  /* gltf KHR_materials_sheen: colour x texture RGB (sRGB), roughness x texture A */
+  float sheen_color[3];
+  float sheen_roughness;
+  int32_t sheen_color_texture, sheen_roughness_texture;
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */

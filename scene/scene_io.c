@@ -188,6 +188,20 @@ static cJSON *write_material(const iris_material *m) {
     if (!floats_equal(m->specular_color, d.specular_color, 3))
       add_floats(o, "specular_color", m->specular_color, 3);
     if (m->transmission != d.transmission) add_float(o, "transmission", m->transmission);
+    if (m->clearcoat != d.clearcoat) add_float(o, "clearcoat", m->clearcoat);
+    if (m->clearcoat_roughness != d.clearcoat_roughness) add_float(o, "clearcoat_roughness", m->clearcoat_roughness);
+    if (m->clearcoat_texture >= 0) cJSON_AddNumberToObject(o, "clearcoat_texture", m->clearcoat_texture);
+    if (m->clearcoat_roughness_texture >= 0)
+      cJSON_AddNumberToObject(o, "clearcoat_roughness_texture", m->clearcoat_roughness_texture);
+    if (m->clearcoat_normal_texture >= 0)
+      cJSON_AddNumberToObject(o, "clearcoat_normal_texture", m->clearcoat_normal_texture);
+    if (m->clearcoat_normal_scale != d.clearcoat_normal_scale)
+      add_float(o, "clearcoat_normal_scale", m->clearcoat_normal_scale);
+    if (!floats_equal(m->sheen_color, d.sheen_color, 3)) add_floats(o, "sheen_color", m->sheen_color, 3);
+    if (m->sheen_roughness != d.sheen_roughness) add_float(o, "sheen_roughness", m->sheen_roughness);
+    if (m->sheen_color_texture >= 0) cJSON_AddNumberToObject(o, "sheen_color_texture", m->sheen_color_texture);
+    if (m->sheen_roughness_texture >= 0)
+      cJSON_AddNumberToObject(o, "sheen_roughness_texture", m->sheen_roughness_texture);
   }
   if (!floats_equal(m->emission, d.emission, 3)) add_floats(o, "emission", m->emission, 3);
   if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
@@ -592,7 +606,11 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                                      "metallic", "metallic_roughness_texture", "specular",
                                      "specular_color", "transmission", "emission", "emission_texture",
                                      "emission_two_sided", "double_sided", "normal_texture",
-                                     "normal_scale", "alpha_mode", "alpha", "alpha_cutoff"};
+                                     "normal_scale", "alpha_mode", "alpha", "alpha_cutoff", "clearcoat",
+                                     "clearcoat_roughness", "clearcoat_texture",
+                                     "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                                     "clearcoat_normal_scale", "sheen_color", "sheen_roughness",
+                                     "sheen_color_texture", "sheen_roughness_texture"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -605,7 +623,11 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     const char *key;
     unsigned types; /* bit per iris_material_type */
   } applies[] = {{"roughness", 0xE}, {"ior", 0xC}, {"metallic", 0x8}, {"metallic_roughness_texture", 0x8},
-                 {"specular", 0x8}, {"specular_color", 0x8}, {"transmission", 0x8}};
+                 {"specular", 0x8}, {"specular_color", 0x8}, {"transmission", 0x8},
+                 {"clearcoat", 0x8}, {"clearcoat_roughness", 0x8}, {"clearcoat_texture", 0x8},
+                 {"clearcoat_roughness_texture", 0x8}, {"clearcoat_normal_texture", 0x8},
+                 {"clearcoat_normal_scale", 0x8}, {"sheen_color", 0x8}, {"sheen_roughness", 0x8},
+                 {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8}};
   for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
     if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
       iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
@@ -641,6 +663,18 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     m->specular = full.specular;
     memcpy(m->specular_color, full.specular_color, sizeof m->specular_color);
     m->transmission = full.transmission;
+  }
+  if (type == IRIS_MATERIAL_GLTF) {
+    TRY(get_float(c, o, "clearcoat", &m->clearcoat));
+    TRY(get_float(c, o, "clearcoat_roughness", &m->clearcoat_roughness));
+    TRY(get_i32(c, o, "clearcoat_texture", -1, INT32_MAX, &m->clearcoat_texture));
+    TRY(get_i32(c, o, "clearcoat_roughness_texture", -1, INT32_MAX, &m->clearcoat_roughness_texture));
+    TRY(get_i32(c, o, "clearcoat_normal_texture", -1, INT32_MAX, &m->clearcoat_normal_texture));
+    TRY(get_float(c, o, "clearcoat_normal_scale", &m->clearcoat_normal_scale));
+    TRY(get_floats(c, o, "sheen_color", m->sheen_color, 3));
+    TRY(get_float(c, o, "sheen_roughness", &m->sheen_roughness));
+    TRY(get_i32(c, o, "sheen_color_texture", -1, INT32_MAX, &m->sheen_color_texture));
+    TRY(get_i32(c, o, "sheen_roughness_texture", -1, INT32_MAX, &m->sheen_roughness_texture));
   }
   memcpy(m->emission, full.emission, sizeof m->emission);
   m->emission_texture = full.emission_texture;
