@@ -298,6 +298,7 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
     m->double_sided = g->double_sided;
     m->emission_two_sided = g->double_sided;
     gltf_slot *slots = c->slots[i];
+    for (int k = 0; k < GLTF_SLOT_COUNT; k++) slots[k].texture = -1;
     if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &slots[GLTF_SLOT_COLOR],
                           &m->color_texture)) ||
         (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
