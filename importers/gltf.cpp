@@ -285,6 +285,23 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
         !texture_ref_value(*v, "clearcoatNormalTexture", &o->clearcoat_normal_texture))
       o->bad_extension = "KHR_materials_clearcoat";
   }
+  o->attenuation_color[0] = o->attenuation_color[1] = o->attenuation_color[2] = 1.0;
+  if (const tinygltf::Value *v = ext("KHR_materials_volume")) {
+    o->has_volume = true;
+    if (!get_number(*v, "attenuationDistance", &o->attenuation_distance, &o->has_attenuation_distance))
+      o->bad_extension = "KHR_materials_volume";
+    if (v->IsObject() && v->Has("attenuationColor")) {
+      const tinygltf::Value &c = v->Get("attenuationColor");
+      if (!c.IsArray() || c.ArrayLen() != 3) {
+        o->bad_extension = "KHR_materials_volume";
+      } else {
+        for (int i = 0; i < 3; i++) {
+          if (!c.Get(i).IsNumber()) o->bad_extension = "KHR_materials_volume";
+          else o->attenuation_color[i] = c.Get(i).GetNumberAsDouble();
+        }
+      }
+    }
+  }
   if (const tinygltf::Value *v = ext("KHR_materials_sheen")) {
     o->has_sheen = true;
     if (v->IsObject() && v->Has("sheenColorFactor")) {

@@ -114,6 +114,8 @@ typedef struct iris_gltf_material {
   bool has_sheen;
   double sheen_color[3], sheen_roughness;
   iris_gltf_texture_ref sheen_color_texture, sheen_roughness_texture;
+  bool has_volume, has_attenuation_distance;
+  double attenuation_distance, attenuation_color[3];
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {

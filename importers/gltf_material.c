@@ -326,6 +326,19 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
       m->clearcoat_roughness = (float)g->clearcoat_roughness;
       m->clearcoat_normal_scale = (float)g->clearcoat_normal_texture.scale;
     }
+    if (g->has_volume) { /* KHR_materials_volume: the attenuation (thickness is for rasterisers) */
+      for (int k = 0; k < 3; k++)
+        if ((st = gltf_check_range(c, el, "KHR_materials_volume attenuationColor component",
+                                   g->attenuation_color[k], 0, 1)))
+          return st;
+      if (g->has_attenuation_distance && (!isfinite(g->attenuation_distance) || !(g->attenuation_distance > 0)))
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "KHR_materials_volume attenuationDistance %g is not > 0",
+                         g->attenuation_distance);
+      if (g->has_attenuation_distance && g->attenuation_distance < 3.4e38) {
+        m->attenuation_distance = (float)g->attenuation_distance;
+        for (int k = 0; k < 3; k++) m->attenuation_color[k] = (float)g->attenuation_color[k];
+      }
+    }
     if (g->has_sheen) { /* KHR_materials_sheen */
       for (int k = 0; k < 3; k++)
         if ((st = gltf_check_range(c, el, "KHR_materials_sheen sheenColorFactor component", g->sheen_color[k], 0, 1)))

@@ -85,6 +85,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
                       m->sheen_color_texture, m->sheen_roughness_texture};
       for (int k = 0; k < 5; k++) hash_u64(&s, (uint64_t)(int64_t)t[k]);
     }
+    if (m->attenuation_distance > 0.0f) { /* (others hash as before) */
+      float v[4] = {m->attenuation_color[0], m->attenuation_color[1], m->attenuation_color[2],
+                    m->attenuation_distance};
+      hash_floats(&s, v, 4);
+    }
     if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
       hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
       hash_floats(&s, &m->normal_scale, 1);

@@ -119,6 +119,8 @@ iris_material iris_material_default(iris_material_type type) {
   m.clearcoat_texture = m.clearcoat_roughness_texture = m.clearcoat_normal_texture = -1;
   m.clearcoat_normal_scale = 1.0f;
   m.sheen_color_texture = m.sheen_roughness_texture = -1;
+  m.attenuation_color[0] = m.attenuation_color[1] = m.attenuation_color[2] = 1.0f;
+  m.attenuation_distance = 0.0f;
   return m;
 }
 
@@ -287,6 +289,11 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
   if (!nonneg_finite_n(m->sheen_color, 3) || m->sheen_color[0] > 1.0f || m->sheen_color[1] > 1.0f ||
       m->sheen_color[2] > 1.0f)
     FAIL("sheen_color must be in [0, 1]");
+  if (!nonneg_finite_n(m->attenuation_color, 3) || m->attenuation_color[0] > 1.0f ||
+      m->attenuation_color[1] > 1.0f || m->attenuation_color[2] > 1.0f)
+    FAIL("attenuation_color must be in [0, 1]");
+  if (!isfinite(m->attenuation_distance) || m->attenuation_distance < 0.0f)
+    FAIL("attenuation_distance %g must be finite and >= 0 (0: none)", (double)m->attenuation_distance);
   if (!isfinite(m->sheen_roughness) || m->sheen_roughness < 0.0f || m->sheen_roughness > 1.0f)
     FAIL("sheen_roughness %g outside [0, 1]", (double)m->sheen_roughness);
   {

@@ -92,6 +92,11 @@ typedef struct iris_material {
   float sheen_color[3];
   float sheen_roughness;
   int32_t sheen_color_texture, sheen_roughness_texture;
+  /* gltf KHR_materials_volume: Beer-Lambert absorption inside the (closed,
+   * transmissive) mesh, sigma = -ln(attenuation_color) / attenuation_distance;
+   * distance 0 = no attenuation (the extension's infinity) */
+  float attenuation_color[3];
+  float attenuation_distance;
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */

@@ -202,6 +202,10 @@ static cJSON *write_material(const iris_material *m) {
     if (m->sheen_color_texture >= 0) cJSON_AddNumberToObject(o, "sheen_color_texture", m->sheen_color_texture);
     if (m->sheen_roughness_texture >= 0)
       cJSON_AddNumberToObject(o, "sheen_roughness_texture", m->sheen_roughness_texture);
+    if (!floats_equal(m->attenuation_color, d.attenuation_color, 3))
+      add_floats(o, "attenuation_color", m->attenuation_color, 3);
+    if (m->attenuation_distance != d.attenuation_distance)
+      add_float(o, "attenuation_distance", m->attenuation_distance);
   }
   if (!floats_equal(m->emission, d.emission, 3)) add_floats(o, "emission", m->emission, 3);
   if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
@@ -610,7 +614,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                                      "clearcoat_roughness", "clearcoat_texture",
                                      "clearcoat_roughness_texture", "clearcoat_normal_texture",
                                      "clearcoat_normal_scale", "sheen_color", "sheen_roughness",
-                                     "sheen_color_texture", "sheen_roughness_texture"};
+                                     "sheen_color_texture", "sheen_roughness_texture",
+                                     "attenuation_color", "attenuation_distance"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -627,7 +632,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                  {"clearcoat", 0x8}, {"clearcoat_roughness", 0x8}, {"clearcoat_texture", 0x8},
                  {"clearcoat_roughness_texture", 0x8}, {"clearcoat_normal_texture", 0x8},
                  {"clearcoat_normal_scale", 0x8}, {"sheen_color", 0x8}, {"sheen_roughness", 0x8},
-                 {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8}};
+                 {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8},
+                 {"attenuation_color", 0x8}, {"attenuation_distance", 0x8}};
   for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
     if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
       iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
@@ -675,6 +681,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     TRY(get_float(c, o, "sheen_roughness", &m->sheen_roughness));
     TRY(get_i32(c, o, "sheen_color_texture", -1, INT32_MAX, &m->sheen_color_texture));
     TRY(get_i32(c, o, "sheen_roughness_texture", -1, INT32_MAX, &m->sheen_roughness_texture));
+    TRY(get_floats(c, o, "attenuation_color", m->attenuation_color, 3));
+    TRY(get_float(c, o, "attenuation_distance", &m->attenuation_distance));
   }
   memcpy(m->emission, full.emission, sizeof m->emission);
   m->emission_texture = full.emission_texture;
