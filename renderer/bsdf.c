@@ -503,23 +503,28 @@ static float layered_pdf(const iris_bsdf *b, const layers *l, iris_vec3 wo, iris
   return l->p_coat * coat_pdf(l, wo, wi) + l->p_sheen * sheen_pdf(wi) + p_base * gltf_base_pdf(b, wo, wi);
 }
 
-static iris_vec3 gltf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
-  if (!has_layers(b) || wo.z <= 0.0f) return gltf_base_eval(b, wo, wi); /* layers are outside only */
+/* The layered paths are kept out of line so that the plain glTF BSDF inlines
+ * into the dispatch as it did before the layers existed (measured: docs/performance.md). */
+#if defined(__GNUC__)
+#define IRIS_NOINLINE __attribute__((noinline))
+#else
+#define IRIS_NOINLINE
+#endif
+
+static IRIS_NOINLINE iris_vec3 gltf_layered_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   layers l;
   layers_begin(b, wo, &l);
   return layered_eval(b, &l, wo, wi);
 }
 
-static float gltf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
-  if (!has_layers(b) || wo.z <= 0.0f) return gltf_base_pdf(b, wo, wi);
+static IRIS_NOINLINE float gltf_layered_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   layers l;
   layers_begin(b, wo, &l);
   return layered_pdf(b, &l, wo, wi);
 }
 
-static bool gltf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
-                        struct iris_bsdf_sample *s) {
-  if (!has_layers(b) || wo.z <= 0.0f) return gltf_base_sample(b, wo, u_lobe, u0, u1, s);
+static IRIS_NOINLINE bool gltf_layered_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0,
+                                               float u1, struct iris_bsdf_sample *s) {
   layers l;
   layers_begin(b, wo, &l);
   if (u_lobe < l.p_coat) {
@@ -594,7 +599,9 @@ iris_vec3 iris_bsdf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
     case IRIS_BSDF_DIFFUSE: f = diffuse_eval(b, wo, wi); break;
     case IRIS_BSDF_GLOSSY: f = glossy_eval(b, wo, wi); break;
     case IRIS_BSDF_GLASS: f = glass_eval(b, wo, wi); break;
-    case IRIS_BSDF_GLTF: f = gltf_eval(b, wo, wi); break;
+    case IRIS_BSDF_GLTF: /* layers are outside only */
+      f = has_layers(b) && wo.z > 0.0f ? gltf_layered_eval(b, wo, wi) : gltf_base_eval(b, wo, wi);
+      break;
     default: f = zero3; break;
   }
   return sanitize3(f);
@@ -606,7 +613,9 @@ float iris_bsdf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
     case IRIS_BSDF_DIFFUSE: p = diffuse_pdf(wo, wi); break;
     case IRIS_BSDF_GLOSSY: p = glossy_pdf(b, wo, wi); break;
     case IRIS_BSDF_GLASS: p = glass_pdf(b, wo, wi); break;
-    case IRIS_BSDF_GLTF: p = gltf_pdf(b, wo, wi); break;
+    case IRIS_BSDF_GLTF:
+      p = has_layers(b) && wo.z > 0.0f ? gltf_layered_pdf(b, wo, wi) : gltf_base_pdf(b, wo, wi);
+      break;
     default: p = 0.0f; break;
   }
   return sanitize1(p);
@@ -623,7 +632,10 @@ bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, 
     case IRIS_BSDF_DIFFUSE: ok = diffuse_sample(b, wo, u0, u1, s); break;
     case IRIS_BSDF_GLOSSY: ok = glossy_sample(b, wo, u0, u1, s); break;
     case IRIS_BSDF_GLASS: ok = glass_sample(b, wo, u_lobe, u0, u1, s); break;
-    case IRIS_BSDF_GLTF: ok = gltf_sample(b, wo, u_lobe, u0, u1, s); break;
+    case IRIS_BSDF_GLTF:
+      ok = has_layers(b) && wo.z > 0.0f ? gltf_layered_sample(b, wo, u_lobe, u0, u1, s)
+                                        : gltf_base_sample(b, wo, u_lobe, u0, u1, s);
+      break;
     default: ok = false; break;
   }
   s->f = sanitize3(s->f);
