@@ -13,7 +13,7 @@ same file with bpy.ops.import_scene.gltf (numpy.bool restored first, as
 strength 1 and the fair-comparison settings of iris's Blender exporter (box filter, no
 denoising or clamping, 64 bounces, caustics on), render, and compare: mean per channel
 (relative difference) and the 8x8 block means (largest relative block difference among
-blocks brighter than 5% of the image mean). Writes OUT_DIR/<model>.json and prints a
+blocks brighter than 5% of the image mean). Writes OUT_DIR/<model>-compare.json (and the scene OUT_DIR/<model>.json) and prints a
 table row per model.
 """
 import json
@@ -171,7 +171,7 @@ def main():
         res = compare(load(ie, a.size), load(be, a.size))
         res.update({"model": model, "spp": a.spp, "size": a.size})
         name = os.path.splitext(os.path.basename(model))[0]
-        with open(os.path.join(a.out, name + ".json"), "w") as f:
+        with open(os.path.join(a.out, name + "-compare.json"), "w") as f:  # (name.json is the iris scene)
             json.dump(res, f, indent=1)
         f3 = lambda v: " ".join("%.4f" % x for x in v)
         pct = lambda v: " ".join("%+.1f%%" % (100 * x) for x in v)
