@@ -50,7 +50,7 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
 /* KHR_materials_volume: a segment that ends on the back of a surface whose
  * material attenuates ran inside it (closed meshes), and its throughput is
  * exp(-sigma d), sigma = -ln(attenuation_color) / attenuation_distance. */
-static iris_vec3 volume_transmittance(const iris_integrator *it, const iris_interaction *si, float d) {
+iris_vec3 iris_integrator_volume_transmittance(const iris_integrator *it, const iris_interaction *si, float d) {
   if (si->material < 0 || (size_t)si->material >= it->scene->material_count) return iris_v3(1, 1, 1);
   const iris_material *m = &it->scene->materials[si->material];
   if (!(m->attenuation_distance > 0.0f)) return iris_v3(1, 1, 1);
@@ -265,7 +265,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     }
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
-    if (!si.front) beta = iris_mul(beta, volume_transmittance(it, &si, hit.t * iris_length(ray.d)));
+    if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the point is shaded. */
     iris_light_choice choice = {0, 0.0f};
