@@ -14,7 +14,7 @@
 #include "renderer/accel.h"
 #include "renderer/render.h"
 
-static void add_quad(iris_scene *s, float z, int32_t material, bool with_alpha, float emit) {
+static void add_quad(iris_scene *s, float z, int32_t material, bool with_alpha) {
   iris_mesh m;
   memset(&m, 0, sizeof m);
   m.name = iris_strdup("quad");
@@ -37,7 +37,6 @@ static void add_quad(iris_scene *s, float z, int32_t material, bool with_alpha, 
   iris_scene_add_mesh(s, &m);
   iris_instance inst = {(uint32_t)(s->mesh_count - 1), iris_mat4_identity()};
   iris_scene_add_instance(s, &inst);
-  (void)emit;
 }
 
 /* mask quad at z = 0 (facing +z, black diffuse, the given alpha), emitter at z = -1 */
@@ -54,8 +53,8 @@ static iris_scene *alpha_scene(iris_alpha_mode mode, float alpha, bool gradient)
   light.emission[0] = light.emission[1] = light.emission[2] = 1.0f;
   light.emission_two_sided = false;
   iris_scene_add_material(s, &light);
-  add_quad(s, 0.0f, 0, gradient, 0);
-  add_quad(s, -1.0f, 1, false, 1);
+  add_quad(s, 0.0f, 0, gradient);
+  add_quad(s, -1.0f, 1, false);
   /* camera at z = 4 seeing exactly x, y in [-1, 1] of the mask plane */
   iris_camera cam;
   memset(&cam, 0, sizeof cam);
