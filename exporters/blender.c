@@ -90,6 +90,16 @@ static const char *const PRELUDE[] = {
     "        corner = uv.reshape(-1, 2)[idx].copy()",
     "        corner[:, 1] = 1.0 - corner[:, 1]",
     "        me.uv_layers.new(name=\"UVMap\").data.foreach_set(\"uv\", corner.ravel())",
+    "    uv1 = data.array(m[\"uv1\"], \"<f4\", 2 * nv)",
+    "    if uv1 is not None:  # glTF TEXCOORD_1",
+    "        corner = uv1.reshape(-1, 2)[idx].copy()",
+    "        corner[:, 1] = 1.0 - corner[:, 1]",
+    "        if uv is None:",
+    "            me.uv_layers.new(name=\"UVMap\").data.foreach_set(\"uv\", corner.ravel())",
+    "        me.uv_layers.new(name=\"UV1\").data.foreach_set(\"uv\", corner.ravel())",
+    "    alpha = data.array(m[\"alpha\"], \"<f4\", nv)",
+    "    if alpha is not None:  # glTF COLOR_0 alpha, read by the Attribute node \"Alpha\"",
+    "        me.attributes.new(\"Alpha\", \"FLOAT\", \"POINT\").data.foreach_set(\"value\", alpha)",
     "    col = data.array(m[\"col\"], \"<f4\", 3 * nv)",
     "    if col is not None:",
     "        rgba = np.ones((nv, 4), dtype=np.float32)",
@@ -128,8 +138,28 @@ static const char *const PRELUDE[] = {
     "            path = os.path.join(HERE, path)",
     "        img = bpy.data.images.load(path, check_existing=False)",
     "        img.colorspace_settings.name = colorspace",
+    "        # iris reads colour and alpha independently (glTF: straight alpha); Cycles",
+    "        # would associate the colour with the alpha when the Alpha output is unused",
+    "        img.alpha_mode = \"CHANNEL_PACKED\"",
     "        IMAGES[key] = img",
     "    return IMAGES[key]",
+    "",
+    "",
+    "def uv_source(nt, t):",
+    "    \"\"\"The texture's placement: its UV map, then its KHR_texture_transform as a",
+    "    Mapping node (scale, rotate about Z, translate, in Blender's v-up UVs).\"\"\"",
+    "    uvmap = nt.nodes.new(\"ShaderNodeUVMap\")",
+    "    uvmap.uv_map = t[\"uv_map\"]",
+    "    if t[\"xf\"] is None:",
+    "        return uvmap.outputs[\"UV\"]",
+    "    ox, oy, rot, sx, sy = t[\"xf\"]",
+    "    mp = nt.nodes.new(\"ShaderNodeMapping\")",
+    "    mp.vector_type = \"POINT\"",
+    "    mp.inputs[\"Scale\"].default_value = (sx, sy, 1.0)",
+    "    mp.inputs[\"Rotation\"].default_value = (0.0, 0.0, rot)",
+    "    mp.inputs[\"Location\"].default_value = (ox + math.sin(rot) * sy, 1.0 - math.cos(rot) * sy - oy, 0.0)",
+    "    nt.links.new(uvmap.outputs[\"UV\"], mp.inputs[\"Vector\"])",
+    "    return mp.outputs[\"Vector\"]",
     "",
     "",
     "def texture_node(nt, tex_index, colorspace):",
@@ -138,16 +168,18 @@ static const char *const PRELUDE[] = {
     "    node.image = image(tex_index, colorspace)",
     "    node.interpolation = \"Closest\" if t[\"nearest\"] else \"Linear\"",
     "    ws, wt = t[\"wrap_s\"], t[\"wrap_t\"]",
+    "    placed = t[\"uv_map\"] != \"UVMap\" or t[\"xf\"] is not None",
     "    if ws == wt and ws in (\"REPEAT\", \"CLAMP\"):",
     "        node.extension = \"REPEAT\" if ws == \"REPEAT\" else \"EXTEND\"",
+    "        if placed:",
+    "            nt.links.new(uv_source(nt, t), node.inputs[\"Vector\"])",
     "        return node",
     "    # Per-axis wrap modes (and mirror, which Blender 3.4's Image Texture lacks)",
     "    # are applied to the UVs, then the image is sampled with EXTEND.",
     "    node.extension = \"EXTEND\"",
-    "    uvmap = nt.nodes.new(\"ShaderNodeUVMap\")",
     "    sep = nt.nodes.new(\"ShaderNodeSeparateXYZ\")",
     "    comb = nt.nodes.new(\"ShaderNodeCombineXYZ\")",
-    "    nt.links.new(uvmap.outputs[\"UV\"], sep.inputs[0])",
+    "    nt.links.new(uv_source(nt, t), sep.inputs[0])",
     "    for axis, mode in ((\"X\", ws), (\"Y\", wt)):",
     "        if mode == \"CLAMP\":",
     "            nt.links.new(sep.outputs[axis], comb.inputs[axis])",
@@ -270,7 +302,7 @@ static const char *const PRELUDE[] = {
     "    return shader",
     "",
     "",
-    "def gltf_nodes(nt, m, vc):",
+    "def gltf_nodes(nt, m, vc, normal=None):",
     "    \"\"\"glTF metallic-roughness as iris renders it (docs/materials.md), from",
     "    Cycles closures: Diffuse (roughness 0) x (1-m)(1-T)(1 - w max Fr) + Glossy",
     "    GGX x [w (1-m) Fr + m F_m] + Refraction GGX x (1-m) T (1 - w max Fr) base.",
@@ -305,6 +337,8 @@ static const char *const PRELUDE[] = {
     "        d.inputs[\"Roughness\"].default_value = 0.0",
     "        link_or_set(nt, d.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kd))",
     "        shaders.append(d.outputs[0])",
+    "        if normal is not None:",
+    "            nt.links.new(normal, d.inputs[\"Normal\"])",
     "    if T > 0.0 and one_minus_m != 0.0:",
     "        kt = math_node(nt, \"MULTIPLY\", math_node(nt, \"MULTIPLY\", base_w, one_minus_m), T)",
     "        r = nt.nodes.new(\"ShaderNodeBsdfRefraction\")",
@@ -313,6 +347,8 @@ static const char *const PRELUDE[] = {
     "        r.inputs[\"IOR\"].default_value = ior",
     "        link_or_set(nt, r.inputs[\"Color\"], mix_rgb(nt, \"MULTIPLY\", 1.0, base, kt))",
     "        shaders.append(r.outputs[0])",
+    "        if normal is not None:",
+    "            nt.links.new(normal, r.inputs[\"Normal\"])",
     "    if w > 0.0 or metal != 0.0:",
     "        fr = mix_rgb(nt, \"MIX\", s, tuple(f0), (1.0, 1.0, 1.0))",
     "        fm = mix_rgb(nt, \"MIX\", s, base, (1.0, 1.0, 1.0))",
@@ -322,7 +358,58 @@ static const char *const PRELUDE[] = {
     "        link_or_set(nt, g.inputs[\"Roughness\"], rough)",
     "        link_or_set(nt, g.inputs[\"Color\"], mix_rgb(nt, \"MIX\", metal, diel, fm))",
     "        shaders.append(g.outputs[0])",
+    "        if normal is not None:",
+    "            nt.links.new(normal, g.inputs[\"Normal\"])",
     "    return add_shaders(nt, shaders)",
+    "",
+    "",
+    "def normal_map(nt, tex_index, strength):",
+    "    \"\"\"Tangent-space Normal Map node on the texture's UV map (Blender computes",
+    "    MikkTSpace tangents, as iris does when the file has none).\"\"\"",
+    "    nm = nt.nodes.new(\"ShaderNodeNormalMap\")",
+    "    nm.space = \"TANGENT\"",
+    "    nm.uv_map = TEXTURES[tex_index][\"uv_map\"]",
+    "    nm.inputs[\"Strength\"].default_value = strength",
+    "    nt.links.new(texture_node(nt, tex_index, \"Non-Color\").outputs[\"Color\"], nm.inputs[\"Color\"])",
+    "    return nm.outputs[\"Normal\"]",
+    "",
+    "",
+    "def alpha_socket(nt, m, vertex_alpha):",
+    "    \"\"\"alpha x colour-texture alpha x vertex alpha, thresholded for MASK.\"\"\"",
+    "    sock = None",
+    "    if m[\"color_tex\"] >= 0:",
+    "        sock = texture_node(nt, m[\"color_tex\"], \"sRGB\").outputs[\"Alpha\"]",
+    "    if m[\"vertex_alpha\"]:",
+    "        at = nt.nodes.new(\"ShaderNodeAttribute\")",
+    "        at.attribute_name = \"Alpha\"",
+    "        if sock is None:",
+    "            sock = at.outputs[\"Fac\"]",
+    "        else:",
+    "            mul = nt.nodes.new(\"ShaderNodeMath\")",
+    "            mul.operation = \"MULTIPLY\"",
+    "            nt.links.new(sock, mul.inputs[0])",
+    "            nt.links.new(at.outputs[\"Fac\"], mul.inputs[1])",
+    "            sock = mul.outputs[0]",
+    "    if sock is not None and m[\"alpha\"] != 1.0:",
+    "        mul = nt.nodes.new(\"ShaderNodeMath\")",
+    "        mul.operation = \"MULTIPLY\"",
+    "        mul.inputs[1].default_value = m[\"alpha\"]",
+    "        nt.links.new(sock, mul.inputs[0])",
+    "        sock = mul.outputs[0]",
+    "    if m[\"alpha_mode\"] == \"mask\":",
+    "        ge = nt.nodes.new(\"ShaderNodeMath\")  # alpha >= cutoff: 1 - (alpha < cutoff)",
+    "        ge.operation = \"LESS_THAN\"",
+    "        ge.inputs[1].default_value = m[\"alpha_cutoff\"]",
+    "        if sock is None:",
+    "            ge.inputs[0].default_value = m[\"alpha\"]",
+    "        else:",
+    "            nt.links.new(sock, ge.inputs[0])",
+    "        inv = nt.nodes.new(\"ShaderNodeMath\")",
+    "        inv.operation = \"SUBTRACT\"",
+    "        inv.inputs[0].default_value = 1.0",
+    "        nt.links.new(ge.outputs[0], inv.inputs[1])",
+    "        sock = inv.outputs[0]",
+    "    return sock",
     "",
     "",
     "def build_material(m):",
@@ -332,6 +419,7 @@ static const char *const PRELUDE[] = {
     "    nt.nodes.clear()",
     "    out = nt.nodes.new(\"ShaderNodeOutputMaterial\")",
     "    kind, vc = m[\"type\"], m[\"vertex_colors\"]",
+    "    normal = normal_map(nt, m[\"normal_tex\"], m[\"normal_scale\"]) if m[\"normal_tex\"] >= 0 else None",
     "    if kind == \"diffuse\":",
     "        bsdf = nt.nodes.new(\"ShaderNodeBsdfDiffuse\")",
     "        bsdf.inputs[\"Roughness\"].default_value = 0.0",
@@ -347,7 +435,9 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"Roughness\"].default_value = m[\"roughness\"]",
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        set_color(nt, bsdf.inputs[\"Color\"], m[\"color\"], m[\"color_tex\"], vc)",
-    "    elif m[\"principled\"]:",
+    "    elif m[\"principled\"] or m[\"clearcoat\"] > 0.0 or max(m[\"sheen\"]) > 0.0:",
+    "        # clearcoat and sheen exist only as Principled v1 inputs (approximate,",
+    "        # docs/export.md); every other glTF material is the exact node tree",
     "        bsdf = nt.nodes.new(\"ShaderNodeBsdfPrincipled\")",
     "        bsdf.distribution = \"GGX\"",
     "        set_color(nt, bsdf.inputs[\"Base Color\"], m[\"color\"], m[\"color_tex\"], vc)",
@@ -363,11 +453,53 @@ static const char *const PRELUDE[] = {
     "        bsdf.inputs[\"IOR\"].default_value = m[\"ior\"]",
     "        bsdf.inputs[\"Transmission\"].default_value = m[\"transmission\"]",
     "        bsdf.inputs[\"Transmission Roughness\"].default_value = 0.0",
+    "        if m[\"clearcoat\"] > 0.0:",
+    "            cc = cr = None",
+    "            if m[\"cc_tex\"] >= 0:",
+    "                sep = nt.nodes.new(\"ShaderNodeSeparateColor\")",
+    "                nt.links.new(texture_node(nt, m[\"cc_tex\"], \"Non-Color\").outputs[\"Color\"], sep.inputs[0])",
+    "                cc = sep.outputs[\"Red\"]",
+    "            if m[\"ccr_tex\"] >= 0:",
+    "                sep = nt.nodes.new(\"ShaderNodeSeparateColor\")",
+    "                nt.links.new(texture_node(nt, m[\"ccr_tex\"], \"Non-Color\").outputs[\"Color\"], sep.inputs[0])",
+    "                cr = sep.outputs[\"Green\"]",
+    "            scalar(nt, bsdf.inputs[\"Clearcoat\"], m[\"clearcoat\"], cc)",
+    "            scalar(nt, bsdf.inputs[\"Clearcoat Roughness\"], m[\"clearcoat_roughness\"], cr)",
+    "            if m[\"ccn_tex\"] >= 0:",
+    "                nt.links.new(normal_map(nt, m[\"ccn_tex\"], m[\"ccn_scale\"]), bsdf.inputs[\"Clearcoat Normal\"])",
+    "        if max(m[\"sheen\"]) > 0.0:",
+    "            # Principled v1's sheen is not the Charlie lobe: amount = max(colour),",
+    "            # white (Sheen Tint 0); docs/export.md gives the measured difference.",
+    "            bsdf.inputs[\"Sheen\"].default_value = max(m[\"sheen\"])",
+    "            bsdf.inputs[\"Sheen Tint\"].default_value = 0.0",
     "    else:",
     "        bsdf = None",
-    "        shader = gltf_nodes(nt, m, vc)",
+    "        shader = gltf_nodes(nt, m, vc, normal)",
     "    if bsdf is not None:",
+    "        if normal is not None and \"Normal\" in bsdf.inputs:",
+    "            nt.links.new(normal, bsdf.inputs[\"Normal\"])",
     "        shader = bsdf.outputs[0]",
+    "    if m[\"alpha_mode\"] != \"opaque\":",
+    "        # Coverage as a Transparent BSDF mix (Cycles' stochastic alpha, as iris's)",
+    "        a = alpha_socket(nt, m, vc)",
+    "        mix = nt.nodes.new(\"ShaderNodeMixShader\")",
+    "        tr = nt.nodes.new(\"ShaderNodeBsdfTransparent\")",
+    "        if a is None:",
+    "            mix.inputs[\"Fac\"].default_value = m[\"alpha\"]",
+    "        else:",
+    "            nt.links.new(a, mix.inputs[\"Fac\"])",
+    "        nt.links.new(tr.outputs[0], mix.inputs[1])",
+    "        nt.links.new(shader, mix.inputs[2])",
+    "        shader = mix.outputs[0]",
+    "        mat.blend_method = \"CLIP\" if m[\"alpha_mode\"] == \"mask\" else \"BLEND\"",
+    "    if m[\"attenuation\"] is not None:",
+    "        # KHR_materials_volume: Cycles absorbs density (1 - colour) per unit length",
+    "        sigma = [-math.log(max(c, 1e-30)) / m[\"attenuation\"][3] for c in m[\"attenuation\"][:3]]",
+    "        rho = max(max(sigma), 1e-12)",
+    "        vol = nt.nodes.new(\"ShaderNodeVolumeAbsorption\")",
+    "        vol.inputs[\"Density\"].default_value = rho",
+    "        vol.inputs[\"Color\"].default_value = (*[1.0 - s / rho for s in sigma], 1.0)",
+    "        nt.links.new(vol.outputs[0], out.inputs[\"Volume\"])",
     "    if max(m[\"emission\"]) > 0.0:",
     "        em = nt.nodes.new(\"ShaderNodeEmission\")",
     "        em.inputs[\"Strength\"].default_value = 1.0",
@@ -670,6 +802,7 @@ static void put_matrix(FILE *fp, const iris_mat4 *m) {
 
 typedef struct mesh_layout {
   int64_t pos, nrm, uv, col, idx; /* byte offsets, -1 when absent */
+  int64_t uv1, alpha;
 } mesh_layout;
 
 static uint64_t align16(uint64_t v) { return (v + 15u) & ~(uint64_t)15u; }
@@ -687,6 +820,10 @@ static uint64_t layout_meshes(const iris_scene *scene, mesh_layout *lay) {
     if (m->uvs) off = align16(off + 8u * nv);
     lay[i].col = m->colors ? (int64_t)off : -1;
     if (m->colors) off = align16(off + 12u * nv);
+    lay[i].uv1 = m->uvs1 ? (int64_t)off : -1;
+    if (m->uvs1) off = align16(off + 8u * nv);
+    lay[i].alpha = m->alphas ? (int64_t)off : -1;
+    if (m->alphas) off = align16(off + 4u * nv);
     lay[i].idx = (int64_t)off;
     off = align16(off + 12u * nt);
   }
@@ -784,6 +921,14 @@ static void write_blob(blob_sink *s, const iris_scene *scene, const mesh_layout 
       sink_pad(s, (uint64_t)lay[i].col);
       sink_words(s, m->colors, 3 * nv);
     }
+    if (m->uvs1) {
+      sink_pad(s, (uint64_t)lay[i].uv1);
+      sink_words(s, m->uvs1, 2 * nv);
+    }
+    if (m->alphas) {
+      sink_pad(s, (uint64_t)lay[i].alpha);
+      sink_words(s, m->alphas, nv);
+    }
     sink_pad(s, (uint64_t)lay[i].idx);
     sink_words(s, m->indices, 3 * nt);
   }
@@ -798,6 +943,7 @@ static void write_blob(blob_sink *s, const iris_scene *scene, const mesh_layout 
 typedef struct material_variant {
   int32_t material; /* -1 = iris's default material */
   bool vertex_colors;
+  bool vertex_alpha; /* the mesh has alphas (read by MASK/BLEND materials) */
 } material_variant;
 
 static const char *wrap_name(iris_wrap w) {
@@ -853,9 +999,36 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v, 
   fprintf(fp, ", principled=%s", principled ? "True" : "False");
   fputs(", emission=", fp);
   iris_blender_put_vec3(fp, m->emission);
-  fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s),\n",
+  fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s",
           (int)m->emission_texture, m->emission_two_sided ? "True" : "False",
           v.vertex_colors ? "True" : "False");
+  static const char *const ALPHA[] = {"opaque", "mask", "blend"};
+  fprintf(fp, ", normal_tex=%d, normal_scale=", (int)m->normal_texture);
+  put_float(fp, m->normal_scale);
+  fprintf(fp, ", alpha_mode=\"%s\", vertex_alpha=%s, alpha=", ALPHA[m->alpha_mode <= IRIS_ALPHA_BLEND ? m->alpha_mode : 0],
+          v.vertex_alpha ? "True" : "False");
+  put_float(fp, m->alpha);
+  fputs(", alpha_cutoff=", fp);
+  put_float(fp, m->alpha_cutoff);
+  fputs(", clearcoat=", fp);
+  put_float(fp, m->clearcoat);
+  fputs(", clearcoat_roughness=", fp);
+  put_float(fp, m->clearcoat_roughness);
+  fprintf(fp, ", cc_tex=%d, ccr_tex=%d, ccn_tex=%d, ccn_scale=", (int)m->clearcoat_texture,
+          (int)m->clearcoat_roughness_texture, (int)m->clearcoat_normal_texture);
+  put_float(fp, m->clearcoat_normal_scale);
+  fputs(", sheen=", fp);
+  iris_blender_put_vec3(fp, m->sheen_color);
+  fputs(", attenuation=", fp);
+  if (m->attenuation_distance > 0.0f) {
+    fputs("(", fp);
+    for (int k = 0; k < 3; k++) put_float(fp, m->attenuation_color[k]), fputs(", ", fp);
+    put_float(fp, m->attenuation_distance);
+    fputs(")", fp);
+  } else {
+    fputs("None", fp);
+  }
+  fputs("),\n", fp);
 }
 
 /* ---- textures -------------------------------------------------------------- */
@@ -866,8 +1039,20 @@ static void put_texture(FILE *fp, const iris_scene *scene, size_t index, const c
   iris_export_texture_file(scene, index, script_path, false, path, sizeof path);
   fputs("    dict(path=", fp);
   iris_blender_put_bytes(fp, path);
-  fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s),\n", wrap_name(t->wrap_s),
-          wrap_name(t->wrap_t), t->nearest ? "True" : "False");
+  fprintf(fp, ", wrap_s=\"%s\", wrap_t=\"%s\", nearest=%s, uv_map=\"%s\", xf=", wrap_name(t->wrap_s),
+          wrap_name(t->wrap_t), t->nearest ? "True" : "False", t->uv_set ? "UV1" : "UVMap");
+  if (t->has_transform) {
+    const float v[5] = {t->offset[0], t->offset[1], t->rotation, t->scale[0], t->scale[1]};
+    fputc('(', fp);
+    for (int k = 0; k < 5; k++) {
+      if (k) fputs(", ", fp);
+      put_float(fp, v[k]);
+    }
+    fputc(')', fp);
+  } else {
+    fputs("None", fp);
+  }
+  fputs("),\n", fp);
 }
 
 /* ---- lights and camera ----------------------------------------------------- */
@@ -983,10 +1168,10 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
     iris_blender_put_bytes(fp, m->name ? m->name : name);
     fprintf(fp,
             ", nv=%u, nt=%u, pos=%lld, nrm=%lld, uv=%lld, col=%lld, idx=%lld, material=%d, "
-            "validate=%s),\n",
+            "validate=%s, uv1=%lld, alpha=%lld),\n",
             m->vertex_count, m->triangle_count, (long long)lay[i].pos, (long long)lay[i].nrm,
             (long long)lay[i].uv, (long long)lay[i].col, (long long)lay[i].idx, (int)mesh_variant[i],
-            mesh_has_degenerate(m) ? "True" : "False");
+            mesh_has_degenerate(m) ? "True" : "False", (long long)lay[i].uv1, (long long)lay[i].alpha);
   }
   fputs("]\nINSTANCES = [\n", fp);
   for (size_t i = 0; i < scene->instance_count; i++) {
@@ -1034,9 +1219,11 @@ iris_status iris_export_blender(const iris_scene *scene, const char *script_path
   /* Variants in order of first use, so equal scenes give equal scripts. */
   size_t variant_count = 0;
   for (size_t i = 0; i < nm; i++) {
-    material_variant v = {scene->meshes[i].material, scene->meshes[i].colors != NULL};
+    material_variant v = {scene->meshes[i].material, scene->meshes[i].colors != NULL,
+                          scene->meshes[i].alphas != NULL};
     size_t k = 0;
-    while (k < variant_count && !(variants[k].material == v.material && variants[k].vertex_colors == v.vertex_colors)) k++;
+    while (k < variant_count && !(variants[k].material == v.material && variants[k].vertex_colors == v.vertex_colors &&
+                                    variants[k].vertex_alpha == v.vertex_alpha)) k++;
     if (k == variant_count) variants[variant_count++] = v;
     mesh_variant[i] = (int32_t)k;
   }

@@ -126,6 +126,24 @@ static void put_finish(FILE *fp, const iris_material *m) {
   }
 }
 
+/* KHR_texture_transform as a pigment transform. In POV-Ray's uv space (u, w),
+ * w = 1 - v, the image is read at A (u, w) with
+ *   A = [[a, -b, b + c], [-d, e, 1 - e - f]]
+ * for iris's u' = a u + b v + c, v' = d u + e v + f; a transformed pigment is
+ * evaluated at the inverse transform of the point, so the pigment gets A^-1. */
+static void put_uv_transform(FILE *fp, const iris_texture *t) {
+  double c = cos((double)t->rotation), s = sin((double)t->rotation);
+  double a = c * t->scale[0], b = s * t->scale[1], cc = t->offset[0];
+  double d = -s * t->scale[0], e = c * t->scale[1], f = t->offset[1];
+  double m00 = a, m01 = -b, m02 = b + cc, m10 = -d, m11 = e, m12 = 1.0 - e - f;
+  double det = m00 * m11 - m01 * m10;
+  if (!(fabs(det) > 1e-30)) return;
+  double i00 = m11 / det, i01 = -m01 / det, i10 = -m10 / det, i11 = m00 / det;
+  double i02 = -(i00 * m02 + i01 * m12), i12 = -(i10 * m02 + i11 * m12);
+  /* POV-Ray: p' = p M with row vectors: x' = x M00 + y M10 + M30 */
+  fprintf(fp, " matrix <%.9g, %.9g, 0, %.9g, %.9g, 0, 0, 0, 1, %.9g, %.9g, 0>", i00, i10, i01, i11, i02, i12);
+}
+
 /* Pigment of a material: its colour (or its colour texture, uv-mapped) times
  * an optional vertex colour; glass and transmissive glTF filter their colour. */
 static void put_pigment(FILE *fp, const iris_scene *scene, const iris_material *m, const char *pov_path,
@@ -143,8 +161,10 @@ static void put_pigment(FILE *fp, const iris_scene *scene, const iris_material *
     const char *kind = strcmp(t->mime, "image/jpeg") == 0 ? "jpeg" : "png";
     fprintf(fp, "pigment { uv_mapping image_map { %s ", kind);
     put_string(fp, path);
-    fprintf(fp, " gamma srgb%s%s } }", t->nearest ? "" : " interpolate 2",
+    fprintf(fp, " gamma srgb%s%s }", t->nearest ? "" : " interpolate 2",
             t->wrap_s == IRIS_WRAP_CLAMP && t->wrap_t == IRIS_WRAP_CLAMP ? " once" : "");
+    if (t->has_transform) put_uv_transform(fp, t);
+    fputs(" }", fp);
     return;
   }
   if (filter > 0.0f) {
@@ -227,14 +247,19 @@ static void put_mesh(FILE *fp, const iris_scene *scene, size_t index, const char
     }
     fputs("\n  }\n", fp);
   }
-  if (m->uvs) {
+  /* POV-Ray meshes have one uv set: the one the colour texture reads. */
+  const float *uvs = m->uvs;
+  if (m->uvs1 && m->material >= 0 && scene->materials[m->material].color_texture >= 0 &&
+      scene->textures[scene->materials[m->material].color_texture].uv_set == 1)
+    uvs = m->uvs1;
+  if (uvs) {
     /* iris (glTF) v runs down from the image's top; POV-Ray's image_map has v up. */
     fprintf(fp, "  uv_vectors { %zu", nv);
     for (size_t v = 0; v < nv; v++) {
       fputs(v % 6 ? ", <" : ",\n    <", fp);
-      put_float(fp, m->uvs[2 * v]);
+      put_float(fp, uvs[2 * v]);
       fputc(',', fp);
-      put_float(fp, 1.0f - m->uvs[2 * v + 1]);
+      put_float(fp, 1.0f - uvs[2 * v + 1]);
       fputc('>', fp);
     }
     fputs("\n  }\n", fp);

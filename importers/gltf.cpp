@@ -148,11 +148,68 @@ struct DocStorage {
   std::vector<const char *> used, required;
 };
 
-iris_gltf_texture_ref texture_ref(const tinygltf::TextureInfo &t) {
+// textureInfo (any of tinygltf's three kinds) with its KHR_texture_transform.
+template <class Info>
+iris_gltf_texture_ref texture_ref(const Info &t, double scale) {
   iris_gltf_texture_ref r;
+  std::memset(&r, 0, sizeof r);
   r.texture = t.index;
   r.texcoord = t.texCoord;
+  r.scale = scale;
+  r.tscale[0] = r.tscale[1] = 1.0;
+  r.transform_texcoord = -1;
+  auto it = t.extensions.find("KHR_texture_transform");
+  if (it == t.extensions.end()) return r;
+  const tinygltf::Value &v = it->second;
+  r.has_transform = true;
+  if (!v.IsObject()) {
+    r.bad_transform = true;
+    return r;
+  }
+  auto vec2 = [&](const char *key, double *out) {
+    if (!v.Has(key)) return;
+    const tinygltf::Value &a = v.Get(key);
+    if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
+      r.bad_transform = true;
+      return;
+    }
+    out[0] = a.Get(0).GetNumberAsDouble();
+    out[1] = a.Get(1).GetNumberAsDouble();
+  };
+  vec2("offset", r.offset);
+  vec2("scale", r.tscale);
+  if (!get_number(v, "rotation", &r.rotation, nullptr)) r.bad_transform = true;
+  double tc = -1;
+  if (!get_number(v, "texCoord", &tc, nullptr) || (tc != -1 && (tc < 0 || tc != (double)(int)tc)))
+    r.bad_transform = true;
+  else
+    r.transform_texcoord = (int)tc;
   return r;
+}
+
+// A textureInfo given as a JSON value inside an extension (index, texCoord,
+// scale, KHR_texture_transform); false when present with wrong types.
+bool texture_ref_value(const tinygltf::Value &ext, const char *key, iris_gltf_texture_ref *r) {
+  tinygltf::TextureInfo none;
+  *r = texture_ref(none, 1.0);
+  if (!ext.IsObject() || !ext.Has(key)) return true;
+  const tinygltf::Value &t = ext.Get(key);
+  if (!t.IsObject() || !t.Has("index") || !t.Get("index").IsInt()) return false;
+  r->texture = t.Get("index").GetNumberAsInt();
+  if (t.Has("texCoord")) {
+    if (!t.Get("texCoord").IsInt()) return false;
+    r->texcoord = t.Get("texCoord").GetNumberAsInt();
+  }
+  if (!get_number(t, "scale", &r->scale, nullptr)) return false;
+  if (t.Has("extensions") && t.Get("extensions").IsObject() && t.Get("extensions").Has("KHR_texture_transform")) {
+    tinygltf::TextureInfo info;
+    info.index = r->texture;
+    info.texCoord = r->texcoord;
+    info.extensions["KHR_texture_transform"] = t.Get("extensions").Get("KHR_texture_transform");
+    double scale = r->scale;
+    *r = texture_ref(info, scale);
+  }
+  return true;
 }
 
 void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
@@ -160,16 +217,17 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   o->name = m.name.c_str();
   o->base_color = m.pbrMetallicRoughness.baseColorFactor.data();
   o->base_color_len = m.pbrMetallicRoughness.baseColorFactor.size();
-  o->base_color_texture = texture_ref(m.pbrMetallicRoughness.baseColorTexture);
+  o->base_color_texture = texture_ref(m.pbrMetallicRoughness.baseColorTexture, 1.0);
   o->metallic = m.pbrMetallicRoughness.metallicFactor;
   o->roughness = m.pbrMetallicRoughness.roughnessFactor;
-  o->metallic_roughness_texture = texture_ref(m.pbrMetallicRoughness.metallicRoughnessTexture);
+  o->metallic_roughness_texture = texture_ref(m.pbrMetallicRoughness.metallicRoughnessTexture, 1.0);
   o->emissive = m.emissiveFactor.data();
   o->emissive_len = m.emissiveFactor.size();
-  o->emissive_texture = texture_ref(m.emissiveTexture);
+  o->emissive_texture = texture_ref(m.emissiveTexture, 1.0);
   o->double_sided = m.doubleSided;
   o->alpha_mode = m.alphaMode.c_str();
-  o->has_normal_texture = m.normalTexture.index >= 0;
+  o->alpha_cutoff = m.alphaCutoff;
+  o->normal_texture = texture_ref(m.normalTexture, m.normalTexture.scale);
   o->has_occlusion_texture = m.occlusionTexture.index >= 0;
   o->emissive_strength = 1.0;
   o->specular = 1.0;
@@ -212,6 +270,55 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   if (const tinygltf::Value *v = ext("KHR_materials_ior")) {
     o->has_ior = true;
     if (!get_number(*v, "ior", &o->ior, nullptr)) o->bad_extension = "KHR_materials_ior";
+  }
+  {
+    tinygltf::TextureInfo none;
+    o->clearcoat_texture = o->clearcoat_roughness_texture = o->clearcoat_normal_texture =
+        o->sheen_color_texture = o->sheen_roughness_texture = texture_ref(none, 1.0);
+  }
+  if (const tinygltf::Value *v = ext("KHR_materials_clearcoat")) {
+    o->has_clearcoat = true;
+    if (!get_number(*v, "clearcoatFactor", &o->clearcoat, nullptr) ||
+        !get_number(*v, "clearcoatRoughnessFactor", &o->clearcoat_roughness, nullptr) ||
+        !texture_ref_value(*v, "clearcoatTexture", &o->clearcoat_texture) ||
+        !texture_ref_value(*v, "clearcoatRoughnessTexture", &o->clearcoat_roughness_texture) ||
+        !texture_ref_value(*v, "clearcoatNormalTexture", &o->clearcoat_normal_texture))
+      o->bad_extension = "KHR_materials_clearcoat";
+  }
+  o->attenuation_color[0] = o->attenuation_color[1] = o->attenuation_color[2] = 1.0;
+  if (const tinygltf::Value *v = ext("KHR_materials_volume")) {
+    o->has_volume = true;
+    if (!get_number(*v, "attenuationDistance", &o->attenuation_distance, &o->has_attenuation_distance))
+      o->bad_extension = "KHR_materials_volume";
+    if (v->IsObject() && v->Has("attenuationColor")) {
+      const tinygltf::Value &c = v->Get("attenuationColor");
+      if (!c.IsArray() || c.ArrayLen() != 3) {
+        o->bad_extension = "KHR_materials_volume";
+      } else {
+        for (int i = 0; i < 3; i++) {
+          if (!c.Get(i).IsNumber()) o->bad_extension = "KHR_materials_volume";
+          else o->attenuation_color[i] = c.Get(i).GetNumberAsDouble();
+        }
+      }
+    }
+  }
+  if (const tinygltf::Value *v = ext("KHR_materials_sheen")) {
+    o->has_sheen = true;
+    if (v->IsObject() && v->Has("sheenColorFactor")) {
+      const tinygltf::Value &c = v->Get("sheenColorFactor");
+      if (!c.IsArray() || c.ArrayLen() != 3) {
+        o->bad_extension = "KHR_materials_sheen";
+      } else {
+        for (int i = 0; i < 3; i++) {
+          if (!c.Get(i).IsNumber()) o->bad_extension = "KHR_materials_sheen";
+          else o->sheen_color[i] = c.Get(i).GetNumberAsDouble();
+        }
+      }
+    }
+    if (!get_number(*v, "sheenRoughnessFactor", &o->sheen_roughness, nullptr) ||
+        !texture_ref_value(*v, "sheenColorTexture", &o->sheen_color_texture) ||
+        !texture_ref_value(*v, "sheenRoughnessTexture", &o->sheen_roughness_texture))
+      o->bad_extension = "KHR_materials_sheen";
   }
 }
 

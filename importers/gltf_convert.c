@@ -1,7 +1,7 @@
 /* glTF 2.0 import, C side: validates the document the tinygltf shim filled
  * (every index, byte range and number) and turns it into an iris_scene.
  * Mapping decisions are documented in docs/import-gltf.md. */
-#include "importers/gltf_convert.h"
+#include "importers/gltf_private.h"
 
 #include <limits.h>
 #include <math.h>
@@ -14,16 +14,8 @@
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/meshproc.h"
+#include "importers/tangents.h"
 
-/* glTF constants (the numeric codes of the spec; tinygltf uses the same). */
-enum {
-  CT_BYTE = 5120, CT_UBYTE = 5121, CT_SHORT = 5122, CT_USHORT = 5123, CT_UINT = 5125, CT_FLOAT = 5126,
-  TYPE_VEC2 = 2, TYPE_VEC3 = 3, TYPE_VEC4 = 4, TYPE_MAT2 = 34, TYPE_MAT3 = 35, TYPE_MAT4 = 36,
-  TYPE_SCALAR = 65,
-  MODE_TRIANGLES = 4, MODE_STRIP = 5, MODE_FAN = 6,
-  WRAP_REPEAT = 10497, WRAP_CLAMP = 33071, WRAP_MIRROR = 33648,
-  FILTER_NEAREST = 9728, FILTER_LINEAR = 9729
-};
 
 /* Accessors without a bufferView are zero-filled from nothing but their
  * declared count; cap them so a tiny file cannot demand gigabytes. */
@@ -34,13 +26,10 @@ enum {
 /* Extensions whose content iris maps (anything else used produces one warning). */
 static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
-    "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization"};
+    "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume"};
 
 /* ---- small helpers ------------------------------------------------------ */
-
-typedef struct dmat4 {
-  double m[4][4]; /* row-major, column vectors (as iris_mat4) */
-} dmat4;
 
 static dmat4 dmat4_identity(void) {
   dmat4 r;
@@ -151,59 +140,13 @@ static float load_component(const uint8_t *p, int ct, bool normalized) {
   }
 }
 
-/* ---- conversion context ------------------------------------------------- */
-
-typedef struct converted_prim {
-  iris_mesh mesh;     /* arrays owned here until handed to the scene */
-  bool valid;         /* false: skipped (points/lines, no POSITION) */
-  int gltf_material;  /* -1: glTF default material */
-  int32_t scene_mesh; /* index in the scene once instanced, else -1 */
-} converted_prim;
-
-typedef struct ctx {
-  const iris_gltf_doc *doc;
-  const iris_import_options *opts;
-  const char *file;
-  iris_error *err;
-  iris_scene *scene;
-
-  converted_prim **prims; /* [mesh][primitive] */
-  iris_material *materials; /* validated, textures still glTF indices */
-  int32_t *material_map;    /* glTF material -> scene index, -1 not yet */
-  int32_t default_material;
-  int32_t *texture_map;     /* glTF texture -> scene index, -1 not yet, -2 dropped */
-
-  int *parent;
-  dmat4 *world;
-
-  /* Present-but-ignored features, reported once each at the end. */
-  char ignored_attributes[256];
-  size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
-  bool warned_texcoord, warned_alpha, warned_normal_occlusion, warned_spec_tex, warned_trans_tex;
-  bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
-  size_t zero_normals;
-  size_t budget_total, budget_left; /* bytes of converted mesh data allowed */
-  size_t sparse_left;               /* sparse indices the validation may still read */
-  uint32_t *vertex_mark, *vertex_remap; /* per accessor element, for primitive_vertices */
-  size_t vertex_cap;
-  uint32_t vertex_stamp;
-  uint32_t *prim_indices, *prim_used; /* one primitive's indices and used vertices */
-  size_t prim_indices_cap, prim_used_cap;
-  int32_t *image_texture;           /* image -> last scene texture made from it */
-  int *image_sampler;               /* ... and that texture's sampler */
-} ctx;
 
 /* Converted mesh data may use 16 bytes per byte of buffer plus this much. */
 #define MESH_BUDGET_SLACK ((size_t)256 << 20)
 /* Instances (nodes x primitives) are not bounded by the file size; cap them. */
 #define MAX_INSTANCES ((size_t)1 << 22)
 
-static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-static iris_status fail(ctx *c, iris_status st, const char *element, const char *fmt, ...) {
+iris_status gltf_fail(gltf_ctx *c, iris_status st, const char *element, const char *fmt, ...) {
   char msg[512];
   va_list ap;
   va_start(ap, fmt);
@@ -211,8 +154,6 @@ static iris_status fail(ctx *c, iris_status st, const char *element, const char 
   va_end(ap);
   return iris_error_set(c->err, st, c->file, 0, element, "%s", msg);
 }
-
-#define ELEMENT(buf, ...) snprintf(buf, sizeof buf, __VA_ARGS__)
 
 /* ---- container pre-checks ----------------------------------------------- */
 
@@ -310,23 +251,23 @@ iris_status iris_gltf_check_required(const char *const *names, size_t count, con
 
 /* ---- buffers, views, accessors ------------------------------------------ */
 
-static iris_status validate_views(ctx *c) {
+static iris_status validate_views(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   for (size_t i = 0; i < d->view_count; i++) {
     const iris_gltf_view *v = &d->views[i];
     ELEMENT(el, "bufferView %zu", i);
     if (v->buffer < 0 || (size_t)v->buffer >= d->buffer_count)
-      return fail(c, IRIS_ERR_INVALID, el, "buffer %d does not exist (%zu buffers)", v->buffer,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "buffer %d does not exist (%zu buffers)", v->buffer,
                   d->buffer_count);
     size_t bsize = d->buffers[v->buffer].size;
-    if (v->length < 1) return fail(c, IRIS_ERR_INVALID, el, "byteLength must be at least 1");
+    if (v->length < 1) return gltf_fail(c, IRIS_ERR_INVALID, el, "byteLength must be at least 1");
     if (v->offset > bsize || v->length > bsize - v->offset)
-      return fail(c, IRIS_ERR_INVALID, el,
+      return gltf_fail(c, IRIS_ERR_INVALID, el,
                   "byteOffset %zu + byteLength %zu exceeds buffer %d's %zu bytes", v->offset,
                   v->length, v->buffer, bsize);
     if (v->stride != 0 && (v->stride < 4 || v->stride > 252 || v->stride % 4 != 0))
-      return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is not a multiple of 4 in [4, 252]",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is not a multiple of 4 in [4, 252]",
                   v->stride);
   }
   return IRIS_OK;
@@ -341,69 +282,69 @@ static bool range_fits(const iris_gltf_view *v, size_t offset, size_t elem, size
   return stride == 0 ? true : (count - 1) <= room / stride;
 }
 
-static iris_status validate_accessors(ctx *c) {
+static iris_status validate_accessors(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   for (size_t i = 0; i < d->accessor_count; i++) {
     const iris_gltf_accessor *a = &d->accessors[i];
     ELEMENT(el, "accessor %zu", i);
     if (component_size(a->component_type) == 0)
-      return fail(c, IRIS_ERR_INVALID, el, "invalid componentType %d", a->component_type);
-    if (type_components(a->type) == 0) return fail(c, IRIS_ERR_INVALID, el, "invalid type");
-    if (a->count < 1) return fail(c, IRIS_ERR_INVALID, el, "count must be at least 1");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid componentType %d", a->component_type);
+    if (type_components(a->type) == 0) return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type");
+    if (a->count < 1) return gltf_fail(c, IRIS_ERR_INVALID, el, "count must be at least 1");
     if (a->normalized && (a->component_type == CT_FLOAT || a->component_type == CT_UINT))
-      return fail(c, IRIS_ERR_INVALID, el, "normalized is only allowed for 8- and 16-bit integers");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "normalized is only allowed for 8- and 16-bit integers");
     size_t elem = element_size(a->component_type, a->type);
     if (a->view >= 0) {
       if ((size_t)a->view >= d->view_count)
-        return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist (%zu views)", a->view,
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist (%zu views)", a->view,
                     d->view_count);
       const iris_gltf_view *v = &d->views[a->view];
       if (v->stride != 0 && v->stride < elem)
-        return fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is smaller than the %zu-byte element",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "byteStride %zu is smaller than the %zu-byte element",
                     v->stride, elem);
       size_t stride = v->stride ? v->stride : elem;
       if (!range_fits(v, a->offset, elem, stride, a->count))
-        return fail(c, IRIS_ERR_INVALID, el,
+        return gltf_fail(c, IRIS_ERR_INVALID, el,
                     "byteOffset %zu + %zu elements of %zu bytes (stride %zu) exceed bufferView "
                     "%d's %zu bytes",
                     a->offset, a->count, elem, stride, a->view, v->length);
     } else if (a->view != -1) {
-      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", a->view);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", a->view);
     } else if (a->count > ZERO_ACCESSOR_MAX_COUNT) {
-      return fail(c, IRIS_ERR_NOMEM, el, "count %zu without a bufferView exceeds the limit %zu",
+      return gltf_fail(c, IRIS_ERR_NOMEM, el, "count %zu without a bufferView exceeds the limit %zu",
                   a->count, ZERO_ACCESSOR_MAX_COUNT);
     }
     if (!a->sparse) continue;
     if (a->sparse_count < 1 || (unsigned long long)a->sparse_count > a->count)
-      return fail(c, IRIS_ERR_INVALID, el, "sparse count %lld not in [1, %zu]", a->sparse_count,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse count %lld not in [1, %zu]", a->sparse_count,
                   a->count);
     size_t n = (size_t)a->sparse_count;
     size_t isize = component_size(a->sparse_index_type);
     if (a->sparse_index_type != CT_UBYTE && a->sparse_index_type != CT_USHORT &&
         a->sparse_index_type != CT_UINT)
-      return fail(c, IRIS_ERR_INVALID, el, "sparse indices componentType %d is not unsigned",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse indices componentType %d is not unsigned",
                   a->sparse_index_type);
     int views[2] = {a->sparse_index_view, a->sparse_value_view};
     long long offsets[2] = {a->sparse_index_offset, a->sparse_value_offset};
     size_t sizes[2] = {isize, elem};
     for (int k = 0; k < 2; k++) {
       if (views[k] < 0 || (size_t)views[k] >= d->view_count)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d does not exist",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d does not exist",
                     k ? "values" : "indices", views[k]);
       const iris_gltf_view *v = &d->views[views[k]];
       if (v->stride != 0)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d must not have byteStride",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s bufferView %d must not have byteStride",
                     k ? "values" : "indices", views[k]);
       if (offsets[k] < 0 || !range_fits(v, (size_t)offsets[k], sizes[k], sizes[k], n))
-        return fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse %s exceed bufferView %d",
                     k ? "values" : "indices", views[k]);
     }
     /* Accessors that share one sparse index view would each re-read it
      * (accessors x indices): all of them together may read 4 indices per
      * buffer byte plus 2^20. */
     if (n > c->sparse_left)
-      return fail(c, IRIS_ERR_NOMEM, el,
+      return gltf_fail(c, IRIS_ERR_NOMEM, el,
                   "sparse indices of all accessors exceed 4 per buffer byte (a sparse view shared by many accessors?)");
     c->sparse_left -= n;
     const iris_gltf_view *iv = &d->views[a->sparse_index_view];
@@ -411,7 +352,7 @@ static iris_status validate_accessors(ctx *c) {
     for (size_t k = 0; k < n; k++) {
       uint32_t idx = load_u32(ip + k * isize, a->sparse_index_type);
       if (idx >= a->count)
-        return fail(c, IRIS_ERR_INVALID, el, "sparse index %u >= count %zu", idx, a->count);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "sparse index %u >= count %zu", idx, a->count);
     }
   }
   return IRIS_OK;
@@ -496,7 +437,7 @@ static int cmp_u32(const void *a, const void *b) {
  * Primitives often share one vertex buffer and draw slices of it: copying all
  * nv vertices per primitive made the work (and memory) primitives x vertices.
  * The marks are stamped per call, so the cost is O(ni log ni), not O(nv). */
-static bool primitive_vertices(ctx *c, uint32_t *idx, size_t ni, size_t nv, uint32_t **used, size_t *count) {
+static bool primitive_vertices(gltf_ctx *c, uint32_t *idx, size_t ni, size_t nv, uint32_t **used, size_t *count) {
   *used = NULL, *count = nv;
   if (nv > c->vertex_cap) {
     uint32_t *mark = realloc(c->vertex_mark, nv * sizeof *mark);
@@ -530,7 +471,7 @@ static bool primitive_vertices(ctx *c, uint32_t *idx, size_t ni, size_t nv, uint
 
 /* ---- meshes -------------------------------------------------------------- */
 
-static void note_ignored_attribute(ctx *c, const char *name) {
+static void note_ignored_attribute(gltf_ctx *c, const char *name) {
   /* Keep one entry per name; group numbered sets (TEXCOORD_1, JOINTS_0) as-is. */
   const char *p = c->ignored_attributes;
   size_t n = strlen(name);
@@ -550,12 +491,15 @@ static void free_mesh_arrays(iris_mesh *m) {
   free(m->normals);
   free(m->uvs);
   free(m->colors);
+  free(m->uvs1);
+  free(m->tangents);
+  free(m->alphas);
   free(m->indices);
   memset(m, 0, sizeof *m);
 }
 
 /* Looks up an attribute accessor; checks its type and vertex count. */
-static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, const char *name,
+static iris_status attribute_accessor(gltf_ctx *c, const iris_gltf_primitive *p, const char *name,
                                       const char *el, int want_type, int alt_type, size_t want_count,
                                       const iris_gltf_accessor **out) {
   *out = NULL;
@@ -563,10 +507,10 @@ static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, cons
     if (strcmp(p->attributes[i].name, name) != 0) continue;
     const iris_gltf_accessor *a = &c->doc->accessors[p->attributes[i].accessor];
     if (a->type != want_type && a->type != alt_type)
-      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has type %s", name,
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has type %s", name,
                   p->attributes[i].accessor, type_name(a->type));
     if (want_count && a->count != want_count)
-      return fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has %zu elements but POSITION has %zu",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s accessor %d has %zu elements but POSITION has %zu",
                   name, p->attributes[i].accessor, a->count, want_count);
     *out = a;
     return IRIS_OK;
@@ -574,16 +518,16 @@ static iris_status attribute_accessor(ctx *c, const iris_gltf_primitive *p, cons
   return IRIS_OK;
 }
 
-static iris_status check_finite_array(ctx *c, const float *v, size_t n, const char *el,
+static iris_status check_finite_array(gltf_ctx *c, const float *v, size_t n, const char *el,
                                       const char *what) {
   for (size_t i = 0; i < n; i++)
     if (!isfinite(v[i]))
-      return fail(c, IRIS_ERR_INVALID, el, "non-finite %s value %g at element %zu", what, (double)v[i],
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "non-finite %s value %g at element %zu", what, (double)v[i],
                   i);
   return IRIS_OK;
 }
 
-static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_prim *out) {
+static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converted_prim *out) {
   const iris_gltf_doc *d = c->doc;
   const iris_gltf_mesh *gm = &d->meshes[mi];
   const iris_gltf_primitive *p = &gm->primitives[pi];
@@ -596,51 +540,72 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   for (size_t i = 0; i < p->attribute_count; i++) {
     int ai = p->attributes[i].accessor;
     if (ai < 0 || (size_t)ai >= d->accessor_count)
-      return fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "attribute %s: accessor %d does not exist",
                   p->attributes[i].name, ai);
     const char *n = p->attributes[i].name;
-    if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0"))
+    if (strcmp(n, "POSITION") && strcmp(n, "NORMAL") && strcmp(n, "TEXCOORD_0") && strcmp(n, "COLOR_0") &&
+        strcmp(n, "TEXCOORD_1") && strcmp(n, "TANGENT"))
       note_ignored_attribute(c, n);
   }
   if (p->indices != -1 && (p->indices < 0 || (size_t)p->indices >= d->accessor_count))
-    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d does not exist (%zu accessors)",
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "indices accessor %d does not exist (%zu accessors)",
                 p->indices, d->accessor_count);
   if (p->material != -1 && (p->material < 0 || (size_t)p->material >= d->material_count))
-    return fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
                 d->material_count);
   int mode = p->mode < 0 ? MODE_TRIANGLES : p->mode;
-  if (mode > MODE_FAN) return fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
+  if (mode > MODE_FAN) return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
   if (p->target_count) c->warned_morph = true;
   if (mode < MODE_TRIANGLES) {
     c->skipped_points_lines++;
     return IRIS_OK;
   }
-  const iris_gltf_accessor *pos, *nrm, *uv, *col;
+  const iris_gltf_accessor *pos, *nrm, *uv, *col, *uv1, *tan;
   iris_status st = attribute_accessor(c, p, "POSITION", el, TYPE_VEC3, TYPE_VEC3, 0, &pos);
   if (st) return st;
   if (!pos) {
     c->skipped_no_position++;
     return IRIS_OK;
   }
-  if (pos->count > UINT32_MAX) return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 vertices");
+  if (pos->count > UINT32_MAX) return gltf_fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 vertices");
   size_t nv = pos->count;
   if ((st = attribute_accessor(c, p, "NORMAL", el, TYPE_VEC3, TYPE_VEC3, nv, &nrm)) ||
       (st = attribute_accessor(c, p, "TEXCOORD_0", el, TYPE_VEC2, TYPE_VEC2, nv, &uv)) ||
-      (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)))
+      (st = attribute_accessor(c, p, "COLOR_0", el, TYPE_VEC3, TYPE_VEC4, nv, &col)) ||
+      (st = attribute_accessor(c, p, "TEXCOORD_1", el, TYPE_VEC2, TYPE_VEC2, nv, &uv1)) ||
+      (st = attribute_accessor(c, p, "TANGENT", el, TYPE_VEC4, TYPE_VEC4, nv, &tan)))
     return st;
+  /* Tangent frames only for a normal map, and only with NORMAL: "When normals are
+   * not specified, [...] the provided tangents (if present) MUST be ignored". */
+  int normal_set = gltf_material_normal_uv_set(c, p->material);
+  if (normal_set >= 0 && !nrm) {
+    c->normal_map_no_normal++;
+    normal_set = -1;
+  } else if (normal_set >= 0 && !(normal_set ? uv1 : uv) && !tan) {
+    c->normal_map_no_uv++;
+    normal_set = -1;
+  }
+  if (normal_set < 0) tan = NULL;
+  /* The second uv set is kept only when the material reads it (and must then exist:
+   * the glTF validator's "material needs TEXCOORD_1" error). */
+  if (!gltf_material_uses_uv1(c, p->material)) uv1 = NULL;
+  else if (!uv1)
+    return gltf_fail(c, IRIS_ERR_INVALID, el,
+                     "material %d reads a texture through texCoord 1 but the primitive has no TEXCOORD_1",
+                     p->material);
   const iris_gltf_accessor *ia = p->indices >= 0 ? &d->accessors[p->indices] : NULL;
   if (ia && (ia->type != TYPE_SCALAR || ia->normalized ||
              (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT &&
               ia->component_type != CT_UINT)))
-    return fail(c, IRIS_ERR_INVALID, el, "indices accessor %d must be unsigned integer SCALAR",
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "indices accessor %d must be unsigned integer SCALAR",
                 p->indices);
   size_t ni = ia ? ia->count : nv;
   if (mode == MODE_TRIANGLES && ni % 3 != 0)
-    return fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "TRIANGLES with %zu indices (not a multiple of 3)", ni);
   if ((ni ? ni : 1) > c->prim_indices_cap) {
-    uint32_t *p = realloc(c->prim_indices, (ni ? ni : 1) * sizeof *p);
-    if (!p) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    c->prim_indices = p, c->prim_indices_cap = ni ? ni : 1;
+    uint32_t *pi_ = realloc(c->prim_indices, (ni ? ni : 1) * sizeof *pi_);
+    if (!pi_) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    c->prim_indices = pi_, c->prim_indices_cap = ni ? ni : 1;
   }
   uint32_t *idx = c->prim_indices;
   if (ia) {
@@ -649,7 +614,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
       if (idx[i] >= nv) {
         char iel[64];
         ELEMENT(iel, "accessor %d", p->indices);
-        return fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i, nv, el);
+        return gltf_fail(c, IRIS_ERR_INVALID, iel, "index %u at %zu >= vertex count %zu (%s)", idx[i], i, nv, el);
       }
   } else {
     for (size_t i = 0; i < ni; i++) idx[i] = (uint32_t)i;
@@ -658,19 +623,22 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   const size_t nv_file = nv;
   uint32_t *used = NULL;
   if (ia && !primitive_vertices(c, idx, ni, nv, &used, &nv))
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
 
   /* Budget: converted data may exceed the file's buffers only by the expansion of
    * small types (u8 -> float, strip -> list), unless accessors are reused by many
    * primitives or are zero-filled; both could otherwise demand unbounded memory. */
   size_t nt_max = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
-  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 28 : 0)) +
+  /* (tangents: 16 bytes, and generation may double the vertices at mirror seams) */
+  double need = (double)nv * (12.0 + (nrm ? 12 : 0) + (uv ? 8 : 0) + (col ? 32 : 0) + (uv1 ? 8 : 0) +
+                              (normal_set >= 0 ? 16.0 + 12 + 12 + (uv ? 8 : 0) + (col ? 12 : 0) + (uv1 ? 8 : 0) : 0)) +
                 (double)ni * 4.0 + (double)nt_max * 12.0;
   if (used) /* sparse accessors are decoded whole before the gather */
-    need += (double)nv_file * ((pos->sparse ? 12 : 0) + (nrm && nrm->sparse ? 12 : 0) +
-                               (uv && uv->sparse ? 8 : 0) + (col && col->sparse ? 16 : 0));
+    need += (double)nv_file * ((pos->sparse ? 12 : 0) + (nrm && nrm->sparse ? 12 : 0) + (uv && uv->sparse ? 8 : 0) +
+                               (uv1 && uv1->sparse ? 8 : 0) + (tan && tan->sparse ? 16 : 0) +
+                               (col && col->sparse ? 16 : 0));
   if (need > (double)c->budget_left)
-    return fail(c, IRIS_ERR_NOMEM, el,
+    return gltf_fail(c, IRIS_ERR_NOMEM, el,
                 "mesh data would exceed %zu MiB (%g MiB for this primitive; accessors reused by "
                 "many primitives or without a bufferView?)",
                 c->budget_total >> 20, need / 1048576.0);
@@ -681,16 +649,16 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   m->material = -1;
   m->vertex_count = (uint32_t)nv;
   m->positions = malloc(nv * 3 * sizeof(float));
-  if (!m->positions) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  if (!read_attribute(d, pos, 3, used, nv, m->positions)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (!m->positions) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (!read_attribute(d, pos, 3, used, nv, m->positions)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   char ael[128];
   ELEMENT(ael, "accessor %d", (int)(pos - d->accessors));
   if ((st = check_finite_array(c, m->positions, nv * 3, ael, "POSITION"))) return st;
 
   if (nrm) {
     m->normals = malloc(nv * 3 * sizeof(float));
-    if (!m->normals) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    if (!read_attribute(d, nrm, 3, used, nv, m->normals)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!m->normals) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!read_attribute(d, nrm, 3, used, nv, m->normals)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     if ((st = check_finite_array(c, m->normals, nv * 3, el, "NORMAL"))) return st;
     bool zero = false;
     for (size_t i = 0; i < nv; i++) {
@@ -702,7 +670,7 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
       }
       n[0] /= len, n[1] /= len, n[2] /= len;
     }
-    if (zero) { /* unusable: drop them so they get recomputed */
+    if (zero) { /* unusable: drop them, the primitive is shaded flat */
       free(m->normals);
       m->normals = NULL;
       c->zero_normals++;
@@ -710,9 +678,32 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   }
   if (uv) {
     m->uvs = malloc(nv * 2 * sizeof(float));
-    if (!m->uvs) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    if (!read_attribute(d, uv, 2, used, nv, m->uvs)) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!m->uvs) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!read_attribute(d, uv, 2, used, nv, m->uvs)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     if ((st = check_finite_array(c, m->uvs, nv * 2, el, "TEXCOORD_0"))) return st;
+  }
+  if (uv1) {
+    m->uvs1 = malloc(nv * 2 * sizeof(float));
+    if (!m->uvs1) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!read_attribute(d, uv1, 2, used, nv, m->uvs1)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if ((st = check_finite_array(c, m->uvs1, nv * 2, el, "TEXCOORD_1"))) return st;
+  }
+  if (tan && m->normals) {
+    m->tangents = malloc(nv * 4 * sizeof(float));
+    if (!m->tangents) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if (!read_attribute(d, tan, 4, used, nv, m->tangents)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    if ((st = check_finite_array(c, m->tangents, nv * 4, el, "TANGENT"))) return st;
+    for (size_t i = 0; i < nv; i++) {
+      float *t = m->tangents + 4 * i;
+      float len = sqrtf(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      if (!(len > 0.0f) || !isfinite(1.0f / len)) { /* unusable: generate instead */
+        free(m->tangents);
+        m->tangents = NULL;
+        break;
+      }
+      t[0] /= len, t[1] /= len, t[2] /= len;
+      t[3] = t[3] < 0.0f ? -1.0f : 1.0f;
+    }
   }
   if (col) {
     int nc = col->type == TYPE_VEC4 ? 4 : 3;
@@ -720,23 +711,42 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     m->colors = malloc(nv * 3 * sizeof(float));
     if (!tmp || !m->colors) {
       free(tmp);
-      return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     }
     if (!read_attribute(d, col, nc, used, nv, tmp)) {
       free(tmp);
-      return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
     }
-    for (size_t i = 0; i < nv; i++) /* alpha dropped: iris is opaque */
+    if ((st = check_finite_array(c, tmp, nv * (size_t)nc, el, "COLOR_0"))) {
+      free(tmp);
+      return st;
+    }
+    for (size_t i = 0; i < nv; i++)
       for (int k = 0; k < 3; k++) m->colors[3 * i + (size_t)k] = tmp[(size_t)nc * i + (size_t)k];
+    /* COLOR_0's alpha is kept only where it matters: a MASK/BLEND material and some alpha < 1 */
+    bool alpha = false;
+    if (nc == 4 && gltf_material_alpha_mode(c, p->material) != IRIS_ALPHA_OPAQUE)
+      for (size_t i = 0; i < nv && !alpha; i++) alpha = tmp[4 * i + 3] != 1.0f;
+    if (alpha) {
+      m->alphas = malloc(nv * sizeof(float));
+      if (!m->alphas) {
+        free(tmp);
+        return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      }
+      for (size_t i = 0; i < nv; i++) {
+        float a = tmp[4 * i + 3];
+        m->alphas[i] = a < 0.0f ? 0.0f : a > 1.0f ? 1.0f : a; /* (normalised integers are in range) */
+      }
+    }
     free(tmp);
     if ((st = check_finite_array(c, m->colors, nv * 3, el, "COLOR_0"))) return st;
   }
 
   /* Triangle list per glTF 2.0 section 3.7.2.1 (strip and fan orders). */
   size_t nt = mode == MODE_TRIANGLES ? ni / 3 : (ni >= 3 ? ni - 2 : 0);
-  if (nt > UINT32_MAX) return fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
+  if (nt > UINT32_MAX) return gltf_fail(c, IRIS_ERR_NOMEM, el, "more than 2^32 triangles");
   m->indices = malloc((nt ? nt : 1) * 3 * sizeof(uint32_t));
-  if (!m->indices) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (!m->indices) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   size_t kept = 0;
   for (size_t t = 0; t < nt; t++) {
     uint32_t a, b, e;
@@ -755,12 +765,20 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
     kept++;
   }
   m->triangle_count = (uint32_t)kept;
-  /* Shared last step (meshproc.h): zero-area triangles out, angle-weighted
-   * normals where the file has none, optional welding. */
+  /* Shared last step (meshproc.h): zero-area triangles out, optional welding.
+   * Never computed normals: glTF 2.0 section 3.7.2.1 says "When normals are not
+   * specified, client implementations MUST calculate flat normals", and a mesh
+   * without normals is shaded with its geometric (flat) normal. */
   uint32_t removed = 0;
-  if (kept > 0 && !iris_mesh_finish(m, c->opts->compute_normals, c->opts->weld, &removed))
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  if (kept > 0 && !iris_mesh_finish(m, false, c->opts->weld, &removed))
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
   c->degenerate_dropped += removed;
+  if (normal_set >= 0 && m->normals && !m->tangents && m->triangle_count > 0 && (normal_set ? m->uvs1 : m->uvs)) {
+    uint32_t split = 0;
+    if (!iris_mesh_generate_tangents(m, normal_set, &split)) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    c->tangents_generated++;
+    c->tangents_split += split;
+  }
   if (m->triangle_count == 0) {
     c->skipped_empty++;
     free_mesh_arrays(m);
@@ -777,19 +795,19 @@ static iris_status convert_primitive(ctx *c, size_t mi, size_t pi, converted_pri
   return IRIS_OK;
 }
 
-static iris_status convert_meshes(ctx *c) {
+static iris_status convert_meshes(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   c->prims = calloc(d->mesh_count ? d->mesh_count : 1, sizeof *c->prims);
-  if (!c->prims) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  if (!c->prims) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   for (size_t mi = 0; mi < d->mesh_count; mi++) {
     size_t np = d->meshes[mi].primitive_count;
     if (np == 0) {
       char el[32];
       ELEMENT(el, "mesh %zu", mi);
-      return fail(c, IRIS_ERR_INVALID, el, "has no primitives");
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "has no primitives");
     }
     c->prims[mi] = calloc(np, sizeof **c->prims);
-    if (!c->prims[mi]) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    if (!c->prims[mi]) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     for (size_t pi = 0; pi < np; pi++) {
       iris_status st = convert_primitive(c, mi, pi, &c->prims[mi][pi]);
       if (st) return st;
@@ -798,297 +816,9 @@ static iris_status convert_meshes(ctx *c) {
   return IRIS_OK;
 }
 
-/* ---- textures and materials ---------------------------------------------- */
-
-static iris_status validate_textures(ctx *c) {
-  const iris_gltf_doc *d = c->doc;
-  char el[64];
-  for (size_t i = 0; i < d->sampler_count; i++) {
-    const iris_gltf_sampler *s = &d->samplers[i];
-    ELEMENT(el, "sampler %zu", i);
-    int wraps[2] = {s->wrap_s, s->wrap_t};
-    for (int k = 0; k < 2; k++)
-      if (wraps[k] != WRAP_REPEAT && wraps[k] != WRAP_CLAMP && wraps[k] != WRAP_MIRROR)
-        return fail(c, IRIS_ERR_INVALID, el, "invalid wrap mode %d", wraps[k]);
-    if (s->mag_filter != -1 && s->mag_filter != FILTER_NEAREST && s->mag_filter != FILTER_LINEAR)
-      return fail(c, IRIS_ERR_INVALID, el, "invalid magFilter %d", s->mag_filter);
-  }
-  for (size_t i = 0; i < d->image_count; i++) {
-    const iris_gltf_image *im = &d->images[i];
-    ELEMENT(el, "image %zu", i);
-    if (im->view != -1 && (im->view < 0 || (size_t)im->view >= d->view_count))
-      return fail(c, IRIS_ERR_INVALID, el, "bufferView %d does not exist", im->view);
-  }
-  for (size_t i = 0; i < d->texture_count; i++) {
-    const iris_gltf_texture *t = &d->textures[i];
-    ELEMENT(el, "texture %zu", i);
-    if (t->source != -1 && (t->source < 0 || (size_t)t->source >= d->image_count))
-      return fail(c, IRIS_ERR_INVALID, el, "image %d does not exist (%zu images)", t->source,
-                  d->image_count);
-    if (t->sampler != -1 && (t->sampler < 0 || (size_t)t->sampler >= d->sampler_count))
-      return fail(c, IRIS_ERR_INVALID, el, "sampler %d does not exist (%zu samplers)", t->sampler,
-                  d->sampler_count);
-  }
-  return IRIS_OK;
-}
-
-static int hexval(char ch) {
-  if (ch >= '0' && ch <= '9') return ch - '0';
-  if (ch >= 'a' && ch <= 'f') return ch - 'a' + 10;
-  if (ch >= 'A' && ch <= 'F') return ch - 'A' + 10;
-  return -1;
-}
-
-/* Percent-decoding of a relative URI reference (RFC 3986). */
-static void uri_decode(const char *in, char *out, size_t size) {
-  size_t o = 0;
-  for (size_t i = 0; in[i] && o + 1 < size; i++) {
-    int h, l;
-    if (in[i] == '%' && (h = hexval(in[i + 1])) >= 0 && (l = hexval(in[i + 2])) >= 0) {
-      out[o++] = (char)(h * 16 + l);
-      i += 2;
-    } else {
-      out[o++] = in[i];
-    }
-  }
-  out[o] = '\0';
-}
-
-static void warn_dropped_image(ctx *c, size_t image, const char *why) {
-  iris_warnf("%s: image %zu: %s; the texture is ignored", c->file, image, why);
-  c->warned_bad_image = true;
-}
-
-/* Scene texture for glTF texture `ti`, created on first use; -2 when dropped with a warning. */
-static iris_status resolve_texture(ctx *c, int ti, int32_t *out) {
-  const iris_gltf_doc *d = c->doc;
-  if (c->texture_map[ti] != -1) {
-    *out = c->texture_map[ti];
-    return IRIS_OK;
-  }
-  *out = c->texture_map[ti] = -2;
-  const iris_gltf_texture *t = &d->textures[ti];
-  char el[64];
-  /* Textures naming the same image and sampler share one scene texture. */
-  if (t->source >= 0 && c->image_texture[t->source] >= 0 && c->image_sampler[t->source] == t->sampler) {
-    *out = c->texture_map[ti] = c->image_texture[t->source];
-    return IRIS_OK;
-  }
-  if (t->source < 0) {
-    iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
-    return IRIS_OK;
-  }
-  const iris_gltf_image *im = &d->images[t->source];
-  ELEMENT(el, "image %d", t->source);
-  iris_texture tex;
-  memset(&tex, 0, sizeof tex);
-  const uint8_t *bytes = NULL;
-  size_t size = 0;
-  char mime[16] = "";
-  if (im->view >= 0) {
-    const iris_gltf_view *v = &d->views[im->view];
-    bytes = d->buffers[v->buffer].data + v->offset;
-    size = v->length;
-  } else if (im->data) {
-    bytes = im->data;
-    size = im->size;
-  }
-  if (bytes) {
-    if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
-    else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
-      snprintf(mime, sizeof mime, "image/jpeg");
-    if (!mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG image");
-      return IRIS_OK;
-    }
-    tex.data = malloc(size);
-    if (!tex.data) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    memcpy(tex.data, bytes, size);
-    tex.data_size = size;
-  } else if (im->uri) {
-    if (strstr(im->uri, "://"))
-      return fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
-    if (!d->base_dir)
-      return fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
-    char rel[1024], joined[2048], abs_path[4096];
-    uri_decode(im->uri, rel, sizeof rel);
-    iris_path_join(d->base_dir, rel, joined, sizeof joined);
-    if (!im->file_found) return fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
-    /* Absolute, so the scene stays valid wherever it is written. */
-    char cwd[2048];
-    if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
-      snprintf(abs_path, sizeof abs_path, "%s", joined);
-    else
-      snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
-    if (!im->file_mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG file");
-      return IRIS_OK;
-    }
-    snprintf(mime, sizeof mime, "%s", im->file_mime);
-    tex.path = iris_strdup(abs_path);
-    if (!tex.path) return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  } else {
-    return fail(c, IRIS_ERR_INVALID, el, "has no data");
-  }
-  snprintf(tex.mime, sizeof tex.mime, "%s", mime);
-  tex.name = im->name && im->name[0] ? iris_strdup(im->name) : NULL;
-  tex.wrap_s = tex.wrap_t = IRIS_WRAP_REPEAT;
-  if (t->sampler >= 0) {
-    const iris_gltf_sampler *s = &d->samplers[t->sampler];
-    int w[2] = {s->wrap_s, s->wrap_t};
-    iris_wrap *dst[2] = {&tex.wrap_s, &tex.wrap_t};
-    for (int k = 0; k < 2; k++)
-      *dst[k] = w[k] == WRAP_CLAMP ? IRIS_WRAP_CLAMP : w[k] == WRAP_MIRROR ? IRIS_WRAP_MIRROR : IRIS_WRAP_REPEAT;
-    tex.nearest = s->mag_filter == FILTER_NEAREST;
-  }
-  int32_t id = iris_scene_add_texture(c->scene, &tex);
-  if (id < 0) {
-    free(tex.name), free(tex.path), free(tex.data);
-    return fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  }
-  *out = c->texture_map[ti] = id;
-  c->image_texture[t->source] = id;
-  c->image_sampler[t->source] = t->sampler;
-  return IRIS_OK;
-}
-
-static iris_status check_range(ctx *c, const char *el, const char *what, double v, double lo, double hi) {
-  if (!isfinite(v) || v < lo || v > hi)
-    return fail(c, IRIS_ERR_INVALID, el, "%s %g is not in [%g, %g]", what, v, lo, hi);
-  return IRIS_OK;
-}
-
-/* Texture reference check: index in range; non-zero texCoord sets are not supported. */
-static iris_status texture_ref(ctx *c, const char *el, const char *what, iris_gltf_texture_ref r,
-                               int32_t *out) {
-  *out = -1;
-  if (r.texture == -1) return IRIS_OK;
-  if (r.texture < 0 || (size_t)r.texture >= c->doc->texture_count)
-    return fail(c, IRIS_ERR_INVALID, el, "%s: texture %d does not exist (%zu textures)", what,
-                r.texture, c->doc->texture_count);
-  if (r.texcoord < 0) return fail(c, IRIS_ERR_INVALID, el, "%s: negative texCoord", what);
-  if (r.texcoord != 0) {
-    c->warned_texcoord = true;
-    return IRIS_OK;
-  }
-  *out = r.texture; /* glTF index; turned into a scene index when the material is used */
-  return IRIS_OK;
-}
-
-/* glTF 2.0 Appendix B metallic-roughness material (+ the KHR_materials_* above). */
-static iris_status validate_materials(ctx *c) {
-  const iris_gltf_doc *d = c->doc;
-  c->materials = calloc(d->material_count ? d->material_count : 1, sizeof *c->materials);
-  if (!c->materials) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-  char el[64];
-  iris_status st;
-  for (size_t i = 0; i < d->material_count; i++) {
-    const iris_gltf_material *g = &d->materials[i];
-    iris_material *m = &c->materials[i];
-    ELEMENT(el, "material %zu", i);
-    *m = iris_material_default(IRIS_MATERIAL_GLTF);
-    if (g->bad_extension)
-      return fail(c, IRIS_ERR_INVALID, el, "%s: a value has the wrong JSON type", g->bad_extension);
-    if (g->base_color_len != 4)
-      return fail(c, IRIS_ERR_INVALID, el, "baseColorFactor has %zu values (4 expected)", g->base_color_len);
-    if (g->emissive_len != 3)
-      return fail(c, IRIS_ERR_INVALID, el, "emissiveFactor has %zu values (3 expected)", g->emissive_len);
-    for (int k = 0; k < 4; k++)
-      if ((st = check_range(c, el, "baseColorFactor component", g->base_color[k], 0, 1))) return st;
-    for (int k = 0; k < 3; k++)
-      if ((st = check_range(c, el, "emissiveFactor component", g->emissive[k], 0, 1))) return st;
-    if ((st = check_range(c, el, "metallicFactor", g->metallic, 0, 1)) ||
-        (st = check_range(c, el, "roughnessFactor", g->roughness, 0, 1)) ||
-        (st = check_range(c, el, "KHR_materials_emissive_strength emissiveStrength",
-                          g->emissive_strength, 0, HUGE_VAL)) ||
-        (st = check_range(c, el, "KHR_materials_specular specularFactor", g->specular, 0, 1)) ||
-        (st = check_range(c, el, "KHR_materials_transmission transmissionFactor", g->transmission, 0, 1)))
-      return st;
-    for (int k = 0; k < 3; k++)
-      if ((st = check_range(c, el, "KHR_materials_specular specularColorFactor component",
-                            g->specular_color[k], 0, HUGE_VAL)))
-        return st;
-    if (!isfinite(g->ior) || (g->ior != 0.0 && g->ior < 1.0))
-      return fail(c, IRIS_ERR_INVALID, el, "KHR_materials_ior ior %g is neither 0 nor >= 1", g->ior);
-
-    if (g->name && g->name[0]) m->name = (char *)g->name; /* copied when added */
-    for (int k = 0; k < 3; k++) {
-      m->color[k] = (float)g->base_color[k];
-      m->emission[k] = (float)(g->emissive[k] * g->emissive_strength);
-      m->specular_color[k] = (float)g->specular_color[k];
-    }
-    m->metallic = (float)g->metallic;
-    m->roughness = (float)g->roughness;
-    m->specular = (float)g->specular;
-    m->transmission = (float)g->transmission;
-    /* ior 0 is the extension's "F0 = 1" special case, which a dielectric cannot express. */
-    if (g->ior == 0.0) iris_warnf("%s: material %zu: KHR_materials_ior ior 0 is not supported; using 1.5", c->file, i);
-    m->ior = g->ior == 0.0 ? 1.5f : (float)g->ior;
-    m->double_sided = g->double_sided;
-    m->emission_two_sided = g->double_sided;
-    if ((st = texture_ref(c, el, "baseColorTexture", g->base_color_texture, &m->color_texture)) ||
-        (st = texture_ref(c, el, "metallicRoughnessTexture", g->metallic_roughness_texture,
-                          &m->metallic_roughness_texture)) ||
-        (st = texture_ref(c, el, "emissiveTexture", g->emissive_texture, &m->emission_texture)))
-      return st;
-    if (g->alpha_mode && g->alpha_mode[0] && strcmp(g->alpha_mode, "OPAQUE") != 0) {
-      if (strcmp(g->alpha_mode, "MASK") && strcmp(g->alpha_mode, "BLEND"))
-        return fail(c, IRIS_ERR_INVALID, el, "invalid alphaMode '%s'", g->alpha_mode);
-      c->warned_alpha = true;
-    }
-    if (g->has_normal_texture || g->has_occlusion_texture) c->warned_normal_occlusion = true;
-    if (g->has_specular_textures) c->warned_spec_tex = true;
-    if (g->has_transmission_texture) c->warned_trans_tex = true;
-  }
-  return IRIS_OK;
-}
-
-/* Scene material for glTF material `gi` (-1: the glTF default material). */
-static iris_status resolve_material(ctx *c, int gi, int32_t *out) {
-  if (gi < 0) {
-    if (c->default_material < 0) {
-      /* glTF 2.0 section 3.9.6: no material = base colour 1, metallic 1, roughness 1. */
-      iris_material m = iris_material_default(IRIS_MATERIAL_GLTF);
-      m.color[0] = m.color[1] = m.color[2] = 1.0f;
-      m.metallic = 1.0f;
-      m.roughness = 1.0f;
-      m.emission_two_sided = false;
-      m.name = iris_strdup("glTF default");
-      c->default_material = iris_scene_add_material(c->scene, &m);
-      if (c->default_material < 0) {
-        free(m.name);
-        return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-      }
-    }
-    *out = c->default_material;
-    return IRIS_OK;
-  }
-  if (c->material_map[gi] >= 0) {
-    *out = c->material_map[gi];
-    return IRIS_OK;
-  }
-  iris_material m = c->materials[gi];
-  iris_status st;
-  int32_t *slots[3] = {&m.color_texture, &m.metallic_roughness_texture, &m.emission_texture};
-  for (int k = 0; k < 3; k++) {
-    if (*slots[k] < 0) continue;
-    int32_t id;
-    if ((st = resolve_texture(c, *slots[k], &id))) return st;
-    *slots[k] = id >= 0 ? id : -1;
-  }
-  m.name = m.name ? iris_strdup(m.name) : NULL;
-  int32_t id = iris_scene_add_material(c->scene, &m);
-  if (id < 0) {
-    free(m.name);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
-  }
-  *out = c->material_map[gi] = id;
-  return IRIS_OK;
-}
-
 /* ---- nodes, cameras, lights ---------------------------------------------- */
 
-static iris_status validate_cameras_lights(ctx *c) {
+static iris_status validate_cameras_lights(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   char el[64];
   iris_status st;
@@ -1097,47 +827,47 @@ static iris_status validate_cameras_lights(ctx *c) {
     ELEMENT(el, "camera %zu", i);
     if (strcmp(cam->type, "perspective") == 0) {
       if (!isfinite(cam->yfov) || cam->yfov <= 0.0 || cam->yfov >= IRIS_PI)
-        return fail(c, IRIS_ERR_INVALID, el, "yfov %g is not in (0, pi)", cam->yfov);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "yfov %g is not in (0, pi)", cam->yfov);
       if (!isfinite(cam->aspect) || cam->aspect < 0.0)
-        return fail(c, IRIS_ERR_INVALID, el, "aspectRatio %g is not positive", cam->aspect);
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "aspectRatio %g is not positive", cam->aspect);
     } else if (strcmp(cam->type, "orthographic") != 0) {
-      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", cam->type);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", cam->type);
     }
   }
   for (size_t i = 0; i < d->light_count; i++) {
     const iris_gltf_light *l = &d->lights[i];
     ELEMENT(el, "KHR_lights_punctual light %zu", i);
     if (strcmp(l->type, "point") && strcmp(l->type, "spot") && strcmp(l->type, "directional"))
-      return fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", l->type);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid type '%s'", l->type);
     if (l->color_len != 0 && l->color_len != 3)
-      return fail(c, IRIS_ERR_INVALID, el, "color has %zu values (3 expected)", l->color_len);
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "color has %zu values (3 expected)", l->color_len);
     for (size_t k = 0; k < l->color_len; k++)
-      if ((st = check_range(c, el, "color component", l->color[k], 0, 1))) return st;
-    if ((st = check_range(c, el, "intensity", l->intensity, 0, HUGE_VAL)) ||
-        (st = check_range(c, el, "range", l->range, 0, HUGE_VAL)))
+      if ((st = gltf_check_range(c, el, "color component", l->color[k], 0, 1))) return st;
+    if ((st = gltf_check_range(c, el, "intensity", l->intensity, 0, HUGE_VAL)) ||
+        (st = gltf_check_range(c, el, "range", l->range, 0, HUGE_VAL)))
       return st;
     if (strcmp(l->type, "spot") == 0) {
-      if ((st = check_range(c, el, "spot.outerConeAngle", l->outer_cone, 0, IRIS_PI / 2 + 1e-6)) ||
-          (st = check_range(c, el, "spot.innerConeAngle", l->inner_cone, 0, l->outer_cone)))
+      if ((st = gltf_check_range(c, el, "spot.outerConeAngle", l->outer_cone, 0, IRIS_PI / 2 + 1e-6)) ||
+          (st = gltf_check_range(c, el, "spot.innerConeAngle", l->inner_cone, 0, l->outer_cone)))
         return st;
       if (l->inner_cone >= l->outer_cone)
-        return fail(c, IRIS_ERR_INVALID, el, "innerConeAngle must be less than outerConeAngle");
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "innerConeAngle must be less than outerConeAngle");
     }
   }
   return IRIS_OK;
 }
 
 /* Local matrix of a node: `matrix` (column-major) or T * R * S. */
-static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
+static iris_status node_local(gltf_ctx *c, size_t ni, dmat4 *out) {
   const iris_gltf_node *n = &c->doc->nodes[ni];
   char el[32];
   ELEMENT(el, "node %zu", ni);
   if ((n->matrix_len != 0 && n->matrix_len != 16) || (n->translation_len != 0 && n->translation_len != 3) ||
       (n->rotation_len != 0 && n->rotation_len != 4) || (n->scale_len != 0 && n->scale_len != 3))
-    return fail(c, IRIS_ERR_INVALID, el, "matrix/translation/rotation/scale has the wrong length");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "matrix/translation/rotation/scale has the wrong length");
   if (!all_finite(n->matrix, n->matrix_len) || !all_finite(n->translation, n->translation_len) ||
       !all_finite(n->rotation, n->rotation_len) || !all_finite(n->scale, n->scale_len))
-    return fail(c, IRIS_ERR_INVALID, el, "non-finite transform value");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "non-finite transform value");
   *out = dmat4_identity();
   if (n->matrix_len == 16) {
     if (n->translation_len || n->rotation_len || n->scale_len) c->warned_matrix_trs = true;
@@ -1151,7 +881,7 @@ static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
   if (n->scale_len) memcpy(s, n->scale, sizeof s);
   double len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!(len > 1e-12) || !isfinite(len))
-    return fail(c, IRIS_ERR_INVALID, el, "rotation quaternion has zero length");
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "rotation quaternion has zero length");
   for (int k = 0; k < 4; k++) q[k] /= len;
   double x = q[0], y = q[1], z = q[2], w = q[3];
   double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
@@ -1165,7 +895,7 @@ static iris_status node_local(ctx *c, size_t ni, dmat4 *out) {
 }
 
 /* Parents, single-parent rule and cycles (nodes unreachable from any root). */
-static iris_status validate_node_graph(ctx *c) {
+static iris_status validate_node_graph(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   size_t nn = d->node_count;
   char el[32];
@@ -1174,7 +904,7 @@ static iris_status validate_node_graph(ctx *c) {
   bool *seen = calloc(nn ? nn : 1, sizeof *seen);
   if (!c->parent || !stack || !seen) {
     free(stack), free(seen);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   iris_status st = IRIS_OK;
   for (size_t i = 0; i < nn; i++) c->parent[i] = -1;
@@ -1182,20 +912,20 @@ static iris_status validate_node_graph(ctx *c) {
     const iris_gltf_node *n = &d->nodes[i];
     ELEMENT(el, "node %zu", i);
     if (n->mesh != -1 && (n->mesh < 0 || (size_t)n->mesh >= d->mesh_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "mesh %d does not exist (%zu meshes)", n->mesh, d->mesh_count);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "mesh %d does not exist (%zu meshes)", n->mesh, d->mesh_count);
     else if (n->camera != -1 && (n->camera < 0 || (size_t)n->camera >= d->camera_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "camera %d does not exist (%zu cameras)", n->camera, d->camera_count);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "camera %d does not exist (%zu cameras)", n->camera, d->camera_count);
     else if (n->light != -1 && (n->light < 0 || (size_t)n->light >= d->light_count))
-      st = fail(c, IRIS_ERR_INVALID, el, "KHR_lights_punctual light %d does not exist (%zu lights)",
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "KHR_lights_punctual light %d does not exist (%zu lights)",
                 n->light, d->light_count);
     for (size_t k = 0; k < n->child_count && !st; k++) {
       int ch = n->children[k];
       if (ch < 0 || (size_t)ch >= nn)
-        st = fail(c, IRIS_ERR_INVALID, el, "child %d does not exist (%zu nodes)", ch, nn);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "child %d does not exist (%zu nodes)", ch, nn);
       else if ((size_t)ch == i)
-        st = fail(c, IRIS_ERR_INVALID, el, "is its own child");
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "is its own child");
       else if (c->parent[ch] >= 0)
-        st = fail(c, IRIS_ERR_INVALID, el, "child %d already has parent node %d (a node may have one parent)",
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "child %d already has parent node %d (a node may have one parent)",
                   ch, c->parent[ch]);
       else
         c->parent[ch] = (int)i;
@@ -1215,7 +945,7 @@ static iris_status validate_node_graph(ctx *c) {
   for (size_t i = 0; i < nn && !st; i++)
     if (!seen[i]) {
       ELEMENT(el, "node %zu", i);
-      st = fail(c, IRIS_ERR_INVALID, el, "is part of a cycle in the node hierarchy");
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "is part of a cycle in the node hierarchy");
     }
   free(stack);
   free(seen);
@@ -1226,30 +956,30 @@ typedef struct camera_hit {
   int node, camera;
 } camera_hit;
 
-static iris_status add_instance_prims(ctx *c, int mesh, const dmat4 *world) {
+static iris_status add_instance_prims(gltf_ctx *c, int mesh, const dmat4 *world) {
   const iris_gltf_mesh *gm = &c->doc->meshes[mesh];
   iris_status st;
   for (size_t pi = 0; pi < gm->primitive_count; pi++) {
     converted_prim *cp = &c->prims[mesh][pi];
     if (!cp->valid) continue;
     if (cp->scene_mesh < 0) {
-      if ((st = resolve_material(c, cp->gltf_material, &cp->mesh.material))) return st;
+      if ((st = gltf_resolve_material(c, cp->gltf_material, &cp->mesh.material))) return st;
       int32_t id = iris_scene_add_mesh(c->scene, &cp->mesh);
-      if (id < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      if (id < 0) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
       memset(&cp->mesh, 0, sizeof cp->mesh); /* the scene owns the arrays now */
       cp->scene_mesh = id;
     }
     if (c->scene->instance_count >= MAX_INSTANCES)
-      return fail(c, IRIS_ERR_NOMEM, NULL, "more than %zu mesh instances", MAX_INSTANCES);
+      return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "more than %zu mesh instances", MAX_INSTANCES);
     iris_instance inst;
     inst.mesh = (uint32_t)cp->scene_mesh;
     inst.transform = dmat4_to_float(world);
-    if (iris_scene_add_instance(c->scene, &inst) < 0) return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    if (iris_scene_add_instance(c->scene, &inst) < 0) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   return IRIS_OK;
 }
 
-static iris_status add_light(ctx *c, int node, const dmat4 *w) {
+static iris_status add_light(gltf_ctx *c, int node, const dmat4 *w) {
   const iris_gltf_light *g = &c->doc->lights[c->doc->nodes[node].light];
   iris_light l;
   memset(&l, 0, sizeof l);
@@ -1274,7 +1004,7 @@ static iris_status add_light(ctx *c, int node, const dmat4 *w) {
   l.name = name && name[0] ? iris_strdup(name) : NULL;
   if (iris_scene_add_light(c->scene, &l) < 0) {
     free(l.name);
-    return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   return IRIS_OK;
 }
@@ -1298,14 +1028,14 @@ static bool camera_frame(const dmat4 *w, iris_mat4 *out) {
   return true;
 }
 
-static const char *camera_label(ctx *c, const camera_hit *h) {
+static const char *camera_label(gltf_ctx *c, const camera_hit *h) {
   const char *n = c->doc->cameras[h->camera].name;
   if (n && n[0]) return n;
   n = c->doc->nodes[h->node].name;
   return n && n[0] ? n : NULL;
 }
 
-static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
+static iris_status add_cameras(gltf_ctx *c, const camera_hit *hits, size_t n) {
   size_t chosen = 0;
   const char *want = c->opts ? c->opts->camera_name : NULL;
   if (want && want[0]) {
@@ -1322,7 +1052,7 @@ static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
         int w = snprintf(list + used, sizeof list - used, "%s'%s'", k ? ", " : "", l ? l : "(unnamed)");
         if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
       }
-      return fail(c, IRIS_ERR_USAGE, "cameras", "no perspective camera named '%s' (available: %s)", want,
+      return gltf_fail(c, IRIS_ERR_USAGE, "cameras", "no perspective camera named '%s' (available: %s)", want,
                   n ? list : "none");
     }
     chosen = i;
@@ -1343,13 +1073,13 @@ static iris_status add_cameras(ctx *c, const camera_hit *hits, size_t n) {
     cam.name = l ? iris_strdup(l) : NULL;
     if (iris_scene_add_camera(c->scene, &cam) < 0) {
       free(cam.name);
-      return fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+      return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     }
   }
   return IRIS_OK;
 }
 
-static iris_status traverse(ctx *c) {
+static iris_status traverse(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   size_t nn = d->node_count;
   char el[32];
@@ -1364,11 +1094,11 @@ static iris_status traverse(ctx *c) {
   iris_status st = IRIS_OK;
   size_t hit_count = 0;
   if (!all_roots || !stack || !hits || !listed || !c->world) {
-    st = fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
+    st = gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   if (d->default_scene != -1 && (d->default_scene < 0 || (size_t)d->default_scene >= d->scene_count)) {
-    st = fail(c, IRIS_ERR_INVALID, "scene", "default scene %d does not exist (%zu scenes)",
+    st = gltf_fail(c, IRIS_ERR_INVALID, "scene", "default scene %d does not exist (%zu scenes)",
               d->default_scene, d->scene_count);
     goto done;
   }
@@ -1377,11 +1107,11 @@ static iris_status traverse(ctx *c) {
       int r = d->scenes[s].nodes[k];
       ELEMENT(el, "scene %zu", s);
       if (r < 0 || (size_t)r >= nn) {
-        st = fail(c, IRIS_ERR_INVALID, el, "node %d does not exist (%zu nodes)", r, nn);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "node %d does not exist (%zu nodes)", r, nn);
         goto done;
       }
       if (c->parent[r] >= 0) {
-        st = fail(c, IRIS_ERR_INVALID, el, "node %d is not a root (child of node %d)", r, c->parent[r]);
+        st = gltf_fail(c, IRIS_ERR_INVALID, el, "node %d is not a root (child of node %d)", r, c->parent[r]);
         goto done;
       }
     }
@@ -1401,7 +1131,7 @@ static iris_status traverse(ctx *c) {
     int root = roots[r];
     if (listed[root]) {
       ELEMENT(el, "scene");
-      st = fail(c, IRIS_ERR_INVALID, el, "root node %d is listed twice", root);
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "root node %d is listed twice", root);
       goto done;
     }
     listed[root] = true;
@@ -1440,13 +1170,13 @@ done:
 
 /* ---- top level ----------------------------------------------------------- */
 
-static iris_status check_asset(ctx *c) {
+static iris_status check_asset(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   const char *v = d->version ? d->version : "";
   if (strncmp(v, "2.", 2) != 0)
-    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "version '%s' is not glTF 2.x", v);
+    return gltf_fail(c, IRIS_ERR_UNSUPPORTED, "asset", "version '%s' is not glTF 2.x", v);
   if (d->min_version && d->min_version[0] && strcmp(d->min_version, "2.0") != 0)
-    return fail(c, IRIS_ERR_UNSUPPORTED, "asset", "minVersion '%s' is newer than 2.0", d->min_version);
+    return gltf_fail(c, IRIS_ERR_UNSUPPORTED, "asset", "minVersion '%s' is newer than 2.0", d->min_version);
   iris_status st = iris_gltf_check_required(d->extensions_required, d->extensions_required_count,
                                             c->file, c->err);
   if (st) return st;
@@ -1461,7 +1191,7 @@ static iris_status check_asset(ctx *c) {
   return IRIS_OK;
 }
 
-static void report_ignored(ctx *c) {
+static void report_ignored(gltf_ctx *c) {
   const char *f = c->file;
   if (c->ignored_attributes[0]) iris_warnf("%s: ignoring vertex attributes: %s", f, c->ignored_attributes);
   if (c->skipped_points_lines)
@@ -1473,10 +1203,18 @@ static void report_ignored(ctx *c) {
     iris_warnf("%s: dropped %zu degenerate triangle(s) (repeated vertex or zero area)", f,
                c->degenerate_dropped);
   if (c->zero_normals)
-    iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped", f, c->zero_normals);
-  if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_1 or higher are ignored", f);
-  if (c->warned_alpha) iris_warnf("%s: alphaMode MASK/BLEND ignored (rendered opaque)", f);
-  if (c->warned_normal_occlusion) iris_warnf("%s: normal and occlusion textures are ignored", f);
+    iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
+  if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_2 or higher are ignored", f);
+  if (c->warned_alpha_emission)
+    iris_warnf("%s: emissive MASK/BLEND materials: light sampling does not see their alpha (emission "
+               "from cut-out parts is still sampled)", f);
+  if (c->warned_occlusion) iris_warnf("%s: occlusion textures are ignored (a path tracer has its own)", f);
+  if (c->normal_map_no_normal)
+    iris_warnf("%s: %zu primitive(s) without NORMAL are shaded flat, without their normal map", f,
+               c->normal_map_no_normal);
+  if (c->normal_map_no_uv)
+    iris_warnf("%s: %zu primitive(s) lack the uv set of their normal map, which is not applied", f,
+               c->normal_map_no_uv);
   if (c->warned_spec_tex) iris_warnf("%s: KHR_materials_specular textures are ignored", f);
   if (c->warned_trans_tex) iris_warnf("%s: KHR_materials_transmission texture is ignored", f);
   if (c->warned_morph) iris_warnf("%s: morph targets ignored (base shape used)", f);
@@ -1487,7 +1225,7 @@ static void report_ignored(ctx *c) {
   if (c->scene->instance_count == 0) iris_warnf("%s: the scene has no mesh instances", f);
 }
 
-static void ctx_free(ctx *c) {
+static void ctx_free(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
   if (c->prims) {
     for (size_t mi = 0; mi < d->mesh_count; mi++) {
@@ -1499,9 +1237,8 @@ static void ctx_free(ctx *c) {
   }
   free(c->materials);
   free(c->material_map);
-  free(c->texture_map);
-  free(c->image_texture);
-  free(c->image_sampler);
+  free(c->slots);
+  free(c->tex_keys);
   free(c->parent);
   free(c->world);
   free(c->vertex_mark), free(c->vertex_remap), free(c->prim_indices), free(c->prim_used);
@@ -1509,7 +1246,7 @@ static void ctx_free(ctx *c) {
 
 iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_options *opts,
                               iris_scene **out, iris_error *err) {
-  ctx c;
+  gltf_ctx c;
   memset(&c, 0, sizeof c);
   iris_import_options defaults = iris_import_options_default();
   c.doc = doc;
@@ -1522,16 +1259,11 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   if (st) return st;
   c.scene = iris_scene_create();
   c.material_map = malloc((doc->material_count ? doc->material_count : 1) * sizeof *c.material_map);
-  c.texture_map = malloc((doc->texture_count ? doc->texture_count : 1) * sizeof *c.texture_map);
-  c.image_texture = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_texture);
-  c.image_sampler = malloc((doc->image_count ? doc->image_count : 1) * sizeof *c.image_sampler);
-  if (!c.scene || !c.material_map || !c.texture_map || !c.image_texture || !c.image_sampler) {
-    st = fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
+  if (!c.scene || !c.material_map) {
+    st = gltf_fail(&c, IRIS_ERR_NOMEM, NULL, "out of memory");
     goto done;
   }
   for (size_t i = 0; i < doc->material_count; i++) c.material_map[i] = -1;
-  for (size_t i = 0; i < doc->texture_count; i++) c.texture_map[i] = -1;
-  for (size_t i = 0; i < doc->image_count; i++) c.image_texture[i] = -1, c.image_sampler[i] = -2;
   c.budget_total = MESH_BUDGET_SLACK;
   for (size_t i = 0; i < doc->buffer_count; i++) {
     size_t add = doc->buffers[i].size > SIZE_MAX / 32 ? SIZE_MAX / 32 : doc->buffers[i].size * 16;
@@ -1542,8 +1274,8 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
   for (size_t i = 0; i < doc->buffer_count; i++)
     c.sparse_left += doc->buffers[i].size > SIZE_MAX / 8 ? SIZE_MAX / 8 : 4 * doc->buffers[i].size;
   /* Validate everything first (even what the scene does not use), then build. */
-  if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = validate_textures(&c)) ||
-      (st = validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
+  if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = gltf_validate_textures(&c)) ||
+      (st = gltf_validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
       (st = validate_node_graph(&c)) || (st = convert_meshes(&c)) || (st = traverse(&c)))
     goto done;
   snprintf(c.scene->units, sizeof c.scene->units, "m"); /* glTF 2.0: metres */

@@ -74,6 +74,11 @@ typedef struct iris_gltf_node {
 typedef struct iris_gltf_texture_ref {
   int texture; /* -1 = none */
   int texcoord;
+  double scale; /* normalTexture.scale (1 when absent; unused elsewhere) */
+  /* KHR_texture_transform on this textureInfo */
+  bool has_transform, bad_transform; /* bad: a value of the wrong JSON type or length */
+  double offset[2], rotation, tscale[2];
+  int transform_texcoord; /* its texCoord override, -1 when absent */
 } iris_gltf_texture_ref;
 
 typedef struct iris_gltf_material {
@@ -88,7 +93,9 @@ typedef struct iris_gltf_material {
   iris_gltf_texture_ref emissive_texture;
   bool double_sided;
   const char *alpha_mode;
-  bool has_normal_texture, has_occlusion_texture;
+  double alpha_cutoff;
+  iris_gltf_texture_ref normal_texture;
+  bool has_occlusion_texture;
   /* Extensions; `bad_extension` names one whose values have the wrong JSON type. */
   const char *bad_extension;
   bool has_emissive_strength;
@@ -101,6 +108,14 @@ typedef struct iris_gltf_material {
   bool has_transmission_texture;
   bool has_ior;
   double ior;
+  bool has_clearcoat;
+  double clearcoat, clearcoat_roughness;
+  iris_gltf_texture_ref clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+  bool has_sheen;
+  double sheen_color[3], sheen_roughness;
+  iris_gltf_texture_ref sheen_color_texture, sheen_roughness_texture;
+  bool has_volume, has_attenuation_distance;
+  double attenuation_distance, attenuation_color[3];
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {

@@ -26,7 +26,8 @@ typedef struct iris_import_stats {
 typedef struct iris_import_options {
   const char *camera_name;  /* glTF: pick this camera (default: the first one) */
   bool weld;                /* weld coincident vertices (OpenMesh) */
-  bool compute_normals;     /* compute angle-weighted normals where absent (default true) */
+  bool compute_normals;     /* OBJ, PLY: angle-weighted normals where absent (default true);
+                               glTF is always shaded flat where NORMAL is absent (its spec) */
   bool keep_materials;      /* keep glTF materials that are exactly Lambert as gltf (default:
                                they become diffuse, scene/material_class.h) */
   iris_import_stats *stats; /* optional (default NULL): work counters are added here */

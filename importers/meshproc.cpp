@@ -140,7 +140,7 @@ extern "C" uint32_t iris_mesh_remove_degenerate(const float *positions, uint32_t
 
 namespace {
 struct VertexKey {
-  float f[11];
+  float f[18]; /* position, normal, uv, colour, uv1, tangent, alpha */
   int count;
   bool operator==(const VertexKey &o) const {
     return count == o.count && std::memcmp(f, o.f, sizeof(float) * count) == 0;
@@ -176,6 +176,11 @@ extern "C" int64_t iris_mesh_weld(iris_mesh *m) {
         for (int c = 0; c < 2; c++) k.f[k.count++] = m->uvs[2 * (size_t)v + c];
       if (m->colors)
         for (int c = 0; c < 3; c++) k.f[k.count++] = m->colors[3 * (size_t)v + c];
+      if (m->uvs1)
+        for (int c = 0; c < 2; c++) k.f[k.count++] = m->uvs1[2 * (size_t)v + c];
+      if (m->tangents)
+        for (int c = 0; c < 4; c++) k.f[k.count++] = m->tangents[4 * (size_t)v + c];
+      if (m->alphas) k.f[k.count++] = m->alphas[v];
       // -0.0 and 0.0 differ bitwise but are the same vertex.
       for (int c = 0; c < k.count; c++)
         if (k.f[c] == 0.0f) k.f[c] = 0.0f;
@@ -191,6 +196,10 @@ extern "C" int64_t iris_mesh_weld(iris_mesh *m) {
       if (m->uvs) std::memmove(m->uvs + 2 * (size_t)out, m->uvs + 2 * (size_t)v, 2 * sizeof(float));
       if (m->colors)
         std::memmove(m->colors + 3 * (size_t)out, m->colors + 3 * (size_t)v, 3 * sizeof(float));
+      if (m->uvs1) std::memmove(m->uvs1 + 2 * (size_t)out, m->uvs1 + 2 * (size_t)v, 2 * sizeof(float));
+      if (m->tangents)
+        std::memmove(m->tangents + 4 * (size_t)out, m->tangents + 4 * (size_t)v, 4 * sizeof(float));
+      if (m->alphas) m->alphas[out] = m->alphas[v];
       out++;
     }
     for (size_t i = 0; i < 3 * (size_t)m->triangle_count; i++) m->indices[i] = remap[m->indices[i]];

@@ -23,7 +23,7 @@ typedef enum ply_type { T_I8, T_U8, T_I16, T_U16, T_I32, T_U32, T_F32, T_F64, T_
 static const size_t type_size[] = {1, 1, 2, 2, 4, 4, 4, 8};
 
 typedef enum ply_role {
-  R_NONE = 0, R_X, R_Y, R_Z, R_NX, R_NY, R_NZ, R_R, R_G, R_B, R_U, R_V, R_INDICES
+  R_NONE = 0, R_X, R_Y, R_Z, R_NX, R_NY, R_NZ, R_R, R_G, R_B, R_U, R_V, R_INDICES, R_STRIP
 } ply_role;
 
 typedef struct ply_prop {
@@ -64,6 +64,7 @@ typedef struct ply_ctx {
   size_t face_count, size_cap;
   bool all_triangles;
   long dropped_faces;
+  size_t strip_degenerate; /* strip triangles with a repeated vertex */
   char ignored[512];
 } ply_ctx;
 
@@ -304,6 +305,49 @@ static iris_status data_error(ply_ctx *c, const ply_element *el, uint64_t row, c
   return iris_error_set(c->err, IRIS_ERR_PARSE, c->path, 0, elem, "%s", what);
 }
 
+/* Appends one face of n >= 3 corners. */
+static bool add_face(ply_ctx *c, const uint32_t *list, size_t n) {
+  if (n != 3 && c->all_triangles) {
+    /* First polygon: from now on keep per-face sizes. */
+    if (!grow((void **)&c->sizes, &c->size_cap, c->face_count + 1, sizeof(uint32_t))) return false;
+    for (size_t f = 0; f < c->face_count; f++) c->sizes[f] = 3;
+    c->all_triangles = false;
+  }
+  if (!grow((void **)&c->corners, &c->corner_cap, c->corner_count + n, sizeof(uint32_t)) ||
+      (!c->all_triangles && !grow((void **)&c->sizes, &c->size_cap, c->face_count + 1, sizeof(uint32_t))))
+    return false;
+  memcpy(c->corners + c->corner_count, list, n * sizeof(uint32_t));
+  c->corner_count += n;
+  if (!c->all_triangles) c->sizes[c->face_count] = (uint32_t)n;
+  c->face_count++;
+  return true;
+}
+
+#define STRIP_RESTART UINT32_MAX
+
+/* Appends the triangles of a triangle strip list (PLY `element tristrips`, as
+ * written by the Stanford tools: STRIP_RESTART (-1 in the file) starts a new
+ * strip). Triangle i of a strip is (v_i, v_i+1, v_i+2), every odd one reversed
+ * so all keep the first triangle's orientation; triangles that repeat a vertex
+ * (the padding some writers use instead of restarts) are skipped. */
+static bool add_strip(ply_ctx *c, const uint32_t *list, size_t n) {
+  size_t start = 0;
+  for (size_t k = 0; k <= n; k++) {
+    if (k < n && list[k] != STRIP_RESTART) continue;
+    for (size_t i = start; i + 2 < k; i++) {
+      uint32_t t[3] = {list[i], list[i + 1], list[i + 2]};
+      if ((i - start) % 2) t[0] = list[i + 1], t[1] = list[i];
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+        c->strip_degenerate++;
+        continue;
+      }
+      if (!add_face(c, t, 3)) return false;
+    }
+    start = k + 1;
+  }
+  return true;
+}
+
 static iris_status read_element(ply_ctx *c, ply_element *el, bool is_vertex, bool is_face) {
   const bool swap = c->format != F_ASCII && ((c->format == F_LE) != host_little_endian());
   uint32_t *list = NULL;
@@ -349,7 +393,8 @@ static iris_status read_element(ply_ctx *c, ply_element *el, bool is_vertex, boo
         goto done;
       }
       const bool want = pr->role == R_INDICES && !indices_seen;
-      if (want && !grow((void **)&list, &list_cap, n, sizeof(uint32_t))) {
+      const bool strip = pr->role == R_STRIP && !indices_seen;
+      if ((want || strip) && !grow((void **)&list, &list_cap, n, sizeof(uint32_t))) {
         st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, el->name, "out of memory");
         goto done;
       }
@@ -368,6 +413,18 @@ static iris_status read_element(ply_ctx *c, ply_element *el, bool is_vertex, boo
             goto done;
           }
           list[k] = (uint32_t)v;
+        } else if (strip) { /* -1 restarts the strip */
+          /* -1, or its unsigned 32-bit pattern when the list type is uint */
+          if (v == 4294967295.0 && pr->type == T_U32) v = -1;
+          if (!(v == -1 || (v >= 0 && v < (double)c->vertex_count))) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "strip index %.0f out of range (%llu vertices; -1 restarts)", v,
+                     (unsigned long long)c->vertex_count);
+            st = iris_error_set(c->err, IRIS_ERR_INVALID, c->path, c->format == F_ASCII ? c->line : 0, NULL,
+                                "%s %llu: %s", el->name, (unsigned long long)row, msg);
+            goto done;
+          }
+          list[k] = v < 0 ? STRIP_RESTART : (uint32_t)v;
         }
       }
       if (want) {
@@ -376,24 +433,17 @@ static iris_status read_element(ply_ctx *c, ply_element *el, bool is_vertex, boo
           c->dropped_faces++;
           continue;
         }
-        if (n != 3 && c->all_triangles) {
-          /* First polygon: from now on keep per-face sizes. */
-          if (!grow((void **)&c->sizes, &c->size_cap, c->face_count + 1, sizeof(uint32_t))) {
-            st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, el->name, "out of memory");
-            goto done;
-          }
-          for (size_t f = 0; f < c->face_count; f++) c->sizes[f] = 3;
-          c->all_triangles = false;
-        }
-        if (!grow((void **)&c->corners, &c->corner_cap, c->corner_count + n, sizeof(uint32_t)) ||
-            (!c->all_triangles && !grow((void **)&c->sizes, &c->size_cap, c->face_count + 1, sizeof(uint32_t)))) {
+        if (!add_face(c, list, n)) {
           st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, el->name, "out of memory");
           goto done;
         }
-        memcpy(c->corners + c->corner_count, list, n * sizeof(uint32_t));
-        c->corner_count += n;
-        if (!c->all_triangles) c->sizes[c->face_count] = (uint32_t)n;
-        c->face_count++;
+      }
+      if (strip) {
+        indices_seen = true;
+        if (!add_strip(c, list, n)) {
+          st = iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, el->name, "out of memory");
+          goto done;
+        }
       }
     }
     if (is_vertex) {
@@ -419,7 +469,7 @@ static iris_status import_ply(ply_ctx *c, const char *data, size_t size, const i
                               iris_scene *scene) {
   iris_status st = parse_header(c, data, size);
   if (st != IRIS_OK) return st;
-  ply_element *vertex = NULL, *face = NULL;
+  ply_element *vertex = NULL, *face = NULL, *strips = NULL;
   for (size_t i = 0; i < c->element_count; i++) {
     ply_element *el = &c->elements[i];
     if (!strcmp(el->name, "vertex") && !vertex) {
@@ -444,6 +494,19 @@ static iris_status import_ply(ply_ctx *c, const char *data, size_t size, const i
         pr->role = first ? R_INDICES : R_NONE;
         if (pr->role == R_NONE) note_ignored(c, el->name, pr->name);
       }
+    } else if (!strcmp(el->name, "tristrips") && !strips) {
+      strips = el;
+      for (size_t j = 0; j < el->prop_count; j++) {
+        ply_prop *pr = &el->props[j];
+        bool idx = pr->is_list && (!strcmp(pr->name, "vertex_indices") || !strcmp(pr->name, "vertex_index"));
+        if (idx && (pr->type == T_F32 || pr->type == T_F64))
+          return iris_error_set(c->err, IRIS_ERR_PARSE, c->path, c->header_lines, "tristrips",
+                                "vertex indices must have an integer type");
+        bool first = idx;
+        for (size_t k = 0; k < j && first; k++) first = el->props[k].role != R_STRIP;
+        pr->role = first ? R_STRIP : R_NONE;
+        if (pr->role == R_NONE) note_ignored(c, el->name, pr->name);
+      }
     } else if (el->count > 0) {
       note_ignored(c, el->name, NULL);
     }
@@ -451,16 +514,20 @@ static iris_status import_ply(ply_ctx *c, const char *data, size_t size, const i
   if (!vertex || !has_role(vertex, R_X) || !has_role(vertex, R_Y) || !has_role(vertex, R_Z))
     return iris_error_set(c->err, IRIS_ERR_INVALID, c->path, c->header_lines, NULL,
                           "no 'vertex' element with x, y and z properties");
-  if (!face)
+  if (!face && !strips)
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, c->header_lines, NULL,
-                          "no 'face' element: this is a point cloud, and iris renders surfaces only");
-  if (!has_role(face, R_INDICES))
+                          "no 'face' or 'tristrips' element: this is a point cloud, and iris renders "
+                          "surfaces only");
+  if (face && !has_role(face, R_INDICES))
     return iris_error_set(c->err, IRIS_ERR_INVALID, c->path, c->header_lines, NULL,
                           "the 'face' element has no 'vertex_indices' (or 'vertex_index') list");
-  if (face->count == 0)
+  if (strips && !has_role(strips, R_STRIP))
+    return iris_error_set(c->err, IRIS_ERR_INVALID, c->path, c->header_lines, NULL,
+                          "the 'tristrips' element has no 'vertex_indices' list");
+  if ((face ? face->count : 0) + (strips ? strips->count : 0) == 0)
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, c->header_lines, NULL,
                           "0 faces: this is a point cloud, and iris renders surfaces only");
-  if (vertex->count > UINT32_MAX || face->count > UINT32_MAX / 3)
+  if (vertex->count > UINT32_MAX || (face && face->count > UINT32_MAX / 3))
     return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, c->header_lines, NULL,
                           "more than 2^32 vertices or triangles");
   /* Every declared row needs at least min_row bytes: refuse counts the file
@@ -508,8 +575,12 @@ static iris_status import_ply(ply_ctx *c, const char *data, size_t size, const i
   }
   if (c->ignored[0]) iris_warnf("%s: PLY properties/elements ignored: %s", c->path, c->ignored);
   if (c->dropped_faces) iris_warnf("%s: %ld face(s) with fewer than 3 corners dropped", c->path, c->dropped_faces);
+  if (c->strip_degenerate)
+    iris_warnf("%s: %zu tristrips triangle(s) with a repeated vertex skipped", c->path, c->strip_degenerate);
   if (c->face_count == 0)
     return iris_error_set(c->err, IRIS_ERR_INVALID, c->path, 0, NULL, "no face has 3 or more corners");
+  if (c->face_count > UINT32_MAX / 3)
+    return iris_error_set(c->err, IRIS_ERR_UNSUPPORTED, c->path, 0, NULL, "more than 2^32 triangles");
 
   iris_mesh m;
   memset(&m, 0, sizeof m);

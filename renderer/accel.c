@@ -7,12 +7,18 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/rng.h"
+#include "renderer/texture.h"
+
 typedef struct accel_instance {
   const iris_mesh *mesh;
   float *positions;  /* world space, 3 * vertex_count (+ padding for Embree) */
   float nm[3][3];    /* normal matrix (cofactor form, sign kept for mirrors) */
+  float m3[3][3];    /* upper 3x3 of the transform (tangents are surface directions) */
   bool mirrored;     /* det < 0: object-space CCW is world-space CW */
   uint32_t first_prim;
+  const iris_material *alpha_material; /* MASK/BLEND material, else NULL (no filter) */
+  const struct iris_accel *owner;
 } accel_instance;
 
 struct iris_accel {
@@ -26,6 +32,7 @@ struct iris_accel {
   bool has_bounds;
   size_t own_bytes;
   atomic_llong embree_bytes;
+  const iris_textures *textures; /* for alpha textures; may be NULL */
 };
 
 static bool memory_monitor(void *ptr, ssize_t bytes, bool post) {
@@ -34,6 +41,76 @@ static bool memory_monitor(void *ptr, ssize_t bytes, bool post) {
   atomic_fetch_add(&a->embree_bytes, (long long)bytes);
   return true;
 }
+
+static float instance_alpha(const iris_accel *a, const accel_instance *ai, uint32_t local, float b1,
+                            float b2) {
+  const iris_material *m = ai->alpha_material;
+  const iris_mesh *mesh = ai->mesh;
+  const uint32_t *idx = mesh->indices + 3 * (size_t)local;
+  float b0 = 1.0f - b1 - b2;
+  float alpha = m->alpha;
+  if (mesh->alphas)
+    alpha *= b0 * mesh->alphas[idx[0]] + b1 * mesh->alphas[idx[1]] + b2 * mesh->alphas[idx[2]];
+  if (m->color_texture >= 0 && a->textures) {
+    float uv[2] = {0, 0}, uv1[2];
+    if (mesh->uvs) {
+      const float *t = mesh->uvs;
+      uv[0] = b0 * t[2 * idx[0]] + b1 * t[2 * idx[1]] + b2 * t[2 * idx[2]];
+      uv[1] = b0 * t[2 * idx[0] + 1] + b1 * t[2 * idx[1] + 1] + b2 * t[2 * idx[2] + 1];
+    }
+    uv1[0] = uv[0], uv1[1] = uv[1];
+    if (mesh->uvs1) {
+      const float *t = mesh->uvs1;
+      uv1[0] = b0 * t[2 * idx[0]] + b1 * t[2 * idx[1]] + b2 * t[2 * idx[2]];
+      uv1[1] = b0 * t[2 * idx[0] + 1] + b1 * t[2 * idx[1] + 1] + b2 * t[2 * idx[2] + 1];
+    }
+    float rgba[4];
+    iris_texture_sample(a->textures, m->color_texture, uv, uv1, false, rgba);
+    alpha *= rgba[3];
+  }
+  return alpha;
+}
+
+static uint32_t float_bits(float f) {
+  uint32_t u;
+  memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+/* Embree filter for MASK/BLEND geometry (registered on those only): rejects
+ * the hit where the surface is cut out or, for BLEND, transparent this time.
+ * Ray and hit packets are structures of arrays (Embree's RTCRayN/RTCHitN
+ * layout; its accessors are C++ only): org x, y, z at 0, 1, 2 N, dir at
+ * 4, 5, 6 N; hit u, v at 3, 4 N, primID at 5 N. */
+static void alpha_filter(const struct RTCFilterFunctionNArguments *args) {
+  const accel_instance *ai = (const accel_instance *)args->geometryUserPtr;
+  const iris_material *m = ai->alpha_material;
+  const unsigned n = args->N;
+  const float *ray = (const float *)args->ray, *hit = (const float *)args->hit;
+  const unsigned *hit_u32 = (const unsigned *)args->hit;
+  for (unsigned i = 0; i < n; i++) {
+    if (args->valid[i] != -1) continue;
+    uint32_t prim = hit_u32[5 * n + i];
+    float alpha = instance_alpha(ai->owner, ai, prim, hit[3 * n + i], hit[4 * n + i]);
+    bool keep;
+    if (m->alpha_mode == IRIS_ALPHA_MASK) {
+      keep = alpha >= m->alpha_cutoff;
+    } else if (!(alpha < 1.0f)) {
+      keep = true;
+    } else {
+      /* a uniform number from the ray and the triangle: deterministic per ray */
+      uint64_t h = iris_hash4(((uint64_t)float_bits(ray[0 * n + i]) << 32) | float_bits(ray[1 * n + i]),
+                              ((uint64_t)float_bits(ray[2 * n + i]) << 32) | float_bits(ray[4 * n + i]),
+                              ((uint64_t)float_bits(ray[5 * n + i]) << 32) | float_bits(ray[6 * n + i]),
+                              ((uint64_t)ai->first_prim + prim) ^ 0xa1fa0000000000ULL);
+      float xi = (float)(h >> 40) * 0x1p-24f;
+      keep = xi < alpha;
+    }
+    if (!keep) args->valid[i] = 0;
+  }
+}
+
+void iris_accel_set_textures(iris_accel *a, const iris_textures *tex) { a->textures = tex; }
 
 static const char *rtc_error_text(RTCDevice device) {
   switch (rtcGetDeviceError(device)) {
@@ -88,7 +165,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     ai->mirrored = iris_mat4_det3(&inst->transform) < 0.0f;
     iris_mat4 nm = iris_mat4_normal_matrix(&inst->transform);
     for (int r = 0; r < 3; r++)
-      for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c];
+      for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c], ai->m3[r][c] = inst->transform.m[r][c];
     /* Embree reads vertices with 16-byte loads: pad one float past the end. */
     ai->positions = malloc(sizeof(float) * (3 * (size_t)mesh->vertex_count + 4));
     if (!ai->positions) {
@@ -109,6 +186,14 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
                                3 * sizeof(float), mesh->vertex_count);
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh->indices, 0,
                                3 * sizeof(uint32_t), mesh->triangle_count);
+    ai->owner = a;
+    if (mesh->material >= 0 && (size_t)mesh->material < scene->material_count &&
+        scene->materials[mesh->material].alpha_mode != IRIS_ALPHA_OPAQUE) {
+      ai->alpha_material = &scene->materials[mesh->material];
+      rtcSetGeometryUserData(g, ai);
+      rtcSetGeometryIntersectFilterFunction(g, alpha_filter);
+      rtcSetGeometryOccludedFilterFunction(g, alpha_filter);
+    }
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(a->rtc, g, (unsigned)i);
     rtcReleaseGeometry(g);
@@ -223,15 +308,34 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
                            ai->nm[1][0] * no.x + ai->nm[1][1] * no.y + ai->nm[1][2] * no.z,
                            ai->nm[2][0] * no.x + ai->nm[2][1] * no.y + ai->nm[2][2] * no.z);
     float len = iris_length(nw);
+    bool flipped = false;
     if (len > 0.0f && isfinite(len)) {
       nw = iris_scale(nw, 1.0f / len);
-      if (iris_dot(nw, ng) < 0.0f) nw = iris_neg(nw);
+      flipped = iris_dot(nw, ng) < 0.0f;
+      if (flipped) nw = iris_neg(nw);
       si->ns = nw;
     } else {
       si->ns = ng;
     }
+    si->has_tangent = m->tangents != NULL;
+    if (m->tangents) { /* B = w (n x t) in object space, both carried by the transform */
+      const float *tg = m->tangents;
+      iris_vec3 to = iris_add(iris_add(iris_scale(iris_v3_load(tg + 4 * (size_t)idx[0]), b0),
+                                       iris_scale(iris_v3_load(tg + 4 * (size_t)idx[1]), b1)),
+                              iris_scale(iris_v3_load(tg + 4 * (size_t)idx[2]), b2));
+      iris_vec3 bo = iris_scale(iris_cross(no, to), tg[4 * (size_t)idx[0] + 3]);
+      iris_vec3 tw = iris_v3(ai->m3[0][0] * to.x + ai->m3[0][1] * to.y + ai->m3[0][2] * to.z,
+                             ai->m3[1][0] * to.x + ai->m3[1][1] * to.y + ai->m3[1][2] * to.z,
+                             ai->m3[2][0] * to.x + ai->m3[2][1] * to.y + ai->m3[2][2] * to.z);
+      iris_vec3 bw = iris_v3(ai->m3[0][0] * bo.x + ai->m3[0][1] * bo.y + ai->m3[0][2] * bo.z,
+                             ai->m3[1][0] * bo.x + ai->m3[1][1] * bo.y + ai->m3[1][2] * bo.z,
+                             ai->m3[2][0] * bo.x + ai->m3[2][1] * bo.y + ai->m3[2][2] * bo.z);
+      si->tangent = flipped ? iris_neg(tw) : tw;
+      si->bitangent = flipped ? iris_neg(bw) : bw;
+    }
   } else {
     si->ns = ng;
+    si->has_tangent = false;
   }
   if (m->uvs) {
     const float *t = m->uvs;
@@ -239,6 +343,13 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
     si->uv[1] = b0 * t[2 * idx[0] + 1] + b1 * t[2 * idx[1] + 1] + b2 * t[2 * idx[2] + 1];
   } else {
     si->uv[0] = si->uv[1] = 0.0f;
+  }
+  if (m->uvs1) {
+    const float *t = m->uvs1;
+    si->uv1[0] = b0 * t[2 * idx[0]] + b1 * t[2 * idx[1]] + b2 * t[2 * idx[2]];
+    si->uv1[1] = b0 * t[2 * idx[0] + 1] + b1 * t[2 * idx[1] + 1] + b2 * t[2 * idx[2] + 1];
+  } else {
+    si->uv1[0] = si->uv[0], si->uv1[1] = si->uv[1];
   }
   if (m->colors) {
     const float *c = m->colors;
@@ -265,6 +376,13 @@ void iris_accel_surface_at(const iris_accel *a, uint32_t prim, float b1, float b
                            iris_interaction *si) {
   size_t inst = instance_of(a, prim);
   fill_interaction(a, inst, prim - a->instances[inst].first_prim, b1, b2, si);
+}
+
+float iris_accel_alpha(const iris_accel *a, uint32_t prim, float b1, float b2) {
+  size_t inst = instance_of(a, prim);
+  const accel_instance *ai = &a->instances[inst];
+  if (!ai->alpha_material) return 1.0f;
+  return instance_alpha(a, ai, prim - ai->first_prim, b1, b2);
 }
 
 uint32_t iris_accel_triangle_count(const iris_accel *a) { return a->triangle_count; }

@@ -39,11 +39,15 @@ typedef struct iris_interaction {
   iris_vec3 ng;      /* unit geometric normal of the front (counter-clockwise) face */
   iris_vec3 ns;      /* unit shading normal, flipped onto ng's side */
   float uv[2];       /* (0, 0) when the mesh has none */
+  float uv1[2];      /* second uv set; = uv when the mesh has none */
   iris_vec3 color;   /* vertex colour; (1, 1, 1) when the mesh has none */
   int32_t material;  /* index into scene->materials, -1 = default */
   uint32_t prim;     /* global triangle index */
   uint32_t instance; /* scene instance */
   bool front;        /* the ray arrived on the front side (dot(d, ng) < 0) */
+  bool has_tangent;  /* the mesh has tangents: the two vectors below are set */
+  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed),
+                                   interpolated, not normalised; flipped with ns */
 } iris_interaction;
 
 typedef struct iris_accel iris_accel;
@@ -53,7 +57,20 @@ typedef struct iris_accel iris_accel;
 iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err);
 void iris_accel_destroy(iris_accel *accel);
 
-/* Closest hit in (tmin, tmax); false on a miss. */
+/* Textures for the coverage (alpha) of MASK/BLEND materials' colour textures;
+ * until set (or with NULL) only their alpha factor and vertex alpha count.
+ * `tex` must outlive the accel's use. */
+struct iris_textures;
+void iris_accel_set_textures(iris_accel *accel, const struct iris_textures *tex);
+/* The coverage alpha of a hit on triangle `prim` at barycentrics (b1, b2):
+ * material alpha x vertex alpha x colour texture alpha (1 for opaque materials). */
+float iris_accel_alpha(const iris_accel *accel, uint32_t prim, float b1, float b2);
+
+/* Closest hit in (tmin, tmax); false on a miss. Surfaces of MASK materials
+ * are skipped where alpha < cutoff, surfaces of BLEND materials with
+ * probability 1 - alpha, decided by a hash of the ray and the triangle (so the
+ * same ray always gets the same answer, whatever thread casts it);
+ * docs/rendering.md, "Alpha". Opaque geometry has no filter and pays nothing. */
 bool iris_accel_intersect(const iris_accel *accel, const iris_ray *ray, iris_hit *hit);
 /* Any hit in (tmin, tmax). */
 bool iris_accel_occluded(const iris_accel *accel, const iris_ray *ray);

@@ -5,6 +5,7 @@
 
 #include "renderer/microfacet.h"
 #include "renderer/sampling.h"
+#include "renderer/sheen_table.h"
 
 /* Cycles 3.4 treats a microfacet closure as singular when alpha_x * alpha_y
  * <= 1e-7 (bsdf_microfacet.h); iris uses the same test so that the delta/rough
@@ -328,22 +329,22 @@ static float gltf_pdf_local(const gltf_setup *g, iris_vec3 wo, iris_vec3 wi) {
   return g->p_trans * ggx_refract_pdf(g->alpha, g->eta, wo, wi);
 }
 
-static iris_vec3 gltf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+static iris_vec3 gltf_base_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   gltf_setup g;
   if (!gltf_begin(b, &wo, &g)) return zero3;
   if (g.inside) wi = flip_z(wi);
   return gltf_eval_local(b, &g, wo, wi);
 }
 
-static float gltf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+static float gltf_base_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   gltf_setup g;
   if (!gltf_begin(b, &wo, &g)) return 0.0f;
   if (g.inside) wi = flip_z(wi);
   return gltf_pdf_local(&g, wo, wi);
 }
 
-static bool gltf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
-                        struct iris_bsdf_sample *s) {
+static bool gltf_base_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, float u1,
+                             struct iris_bsdf_sample *s) {
   gltf_setup g;
   if (!gltf_begin(b, &wo, &g)) return false;
   iris_vec3 n = iris_v3(0.0f, 0.0f, 1.0f);
@@ -384,6 +385,182 @@ static bool gltf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0
   return s->pdf > 0.0f;
 }
 
+/* ---- gltf layers: KHR_materials_sheen and KHR_materials_clearcoat -------- */
+
+/* Sheen (KHR_materials_sheen): f = colour D V with the Charlie distribution
+ * D = (2 + 1/a) sin^(1/a)(theta_h) / (2 pi), a = roughness^2, and the
+ * Estevez-Kulla visibility V = 1 / ((1 + L(wo) + L(wi)) 4 cos_o cos_i). */
+#define SHEEN_MIN_ALPHA 1e-3f
+
+static float sheen_l(float x, float ag) {
+  float t = iris_sqr(1.0f - ag);
+  float a = 21.5473f + (25.3245f - 21.5473f) * t, bb = 3.82987f + (3.32435f - 3.82987f) * t;
+  float c = 0.19823f + (0.16801f - 0.19823f) * t, d = -1.97760f + (-1.27393f + 1.97760f) * t;
+  float e = -4.32054f + (-4.85967f + 4.32054f) * t;
+  return a / (1.0f + bb * powf(x, c)) + d * x + e;
+}
+
+static float sheen_lambda(float cos_t, float ag) {
+  cos_t = fabsf(cos_t);
+  return cos_t < 0.5f ? expf(sheen_l(cos_t, ag)) : expf(2.0f * sheen_l(0.5f, ag) - sheen_l(1.0f - cos_t, ag));
+}
+
+static float sheen_alpha(float roughness) { return fmaxf(iris_sqr(iris_clampf(roughness, 0.0f, 1.0f)), SHEEN_MIN_ALPHA); }
+
+/* The sheen lobe for colour 1, without the cosine. */
+static float sheen_f(float ag, iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 h = iris_normalize(iris_add(wo, wi));
+  float sin2 = fmaxf(0.0f, 1.0f - h.z * h.z);
+  float d = (2.0f + 1.0f / ag) * powf(sin2, 0.5f / ag) * (0.5f * IRIS_INV_PI);
+  float v = 1.0f / ((1.0f + sheen_lambda(wo.z, ag) + sheen_lambda(wi.z, ag)) * 4.0f * wo.z * wi.z);
+  return d * v;
+}
+
+/* Its directional albedo (tools/gen_sheen_table.py), bilinear in (roughness, cos). */
+static float sheen_albedo(float cos_t, float roughness) {
+  const int n = IRIS_SHEEN_TABLE_N;
+  float x = iris_clampf(cos_t, 0.0f, 1.0f) * (float)(n - 1), y = iris_clampf(roughness, 0.0f, 1.0f) * (float)(n - 1);
+  int x0 = (int)x, y0 = (int)y;
+  if (x0 > n - 2) x0 = n - 2;
+  if (y0 > n - 2) y0 = n - 2;
+  float fx = x - (float)x0, fy = y - (float)y0;
+  const float(*t)[IRIS_SHEEN_TABLE_N] = iris_sheen_albedo;
+  return (1 - fy) * ((1 - fx) * t[y0][x0] + fx * t[y0][x0 + 1]) + fy * ((1 - fx) * t[y0 + 1][x0] + fx * t[y0 + 1][x0 + 1]);
+}
+
+/* Sampled like a Lambert lobe (the Charlie lobe is broad). */
+static float sheen_pdf(iris_vec3 wi) { return wi.z > 0.0f ? iris_sample_cosine_hemisphere_pdf(wi.z) : 0.0f; }
+
+#define COAT_F0 0.04f /* ior 1.5, as the extension fixes it */
+
+typedef struct layers {
+  float cc, cc_alpha;
+  bool cc_smooth;
+  iris_frame cf;        /* frame of the coat normal, in the BSDF's local frame */
+  float fc_o;           /* coat Fresnel at wo (about the coat normal) */
+  float coat_below_o;   /* 1 - cc F_c(wo): what the coat lets through to the layers below */
+  iris_vec3 sheen;      /* sheen colour */
+  float sheen_max, sheen_r, sheen_ag, e_o, sheen_k; /* k = min(1, 1/E(wo)): no energy gain */
+  float p_coat, p_sheen; /* lobe probabilities; the base gets the rest */
+} layers;
+
+static bool has_layers(const iris_bsdf *b) {
+  return b->clearcoat > 0.0f || b->sheen_color.x > 0.0f || b->sheen_color.y > 0.0f || b->sheen_color.z > 0.0f;
+}
+
+static void layers_begin(const iris_bsdf *b, iris_vec3 wo, layers *l) {
+  l->cc = iris_clampf(sanitize1(b->clearcoat), 0.0f, 1.0f);
+  l->cc_alpha = alpha_of(b->clearcoat_roughness);
+  l->cc_smooth = alpha_is_singular(l->cc_alpha);
+  iris_vec3 cn = iris_isfinite3(b->coat_n) && iris_length(b->coat_n) > 0.5f ? iris_normalize(b->coat_n) : iris_v3(0, 0, 1);
+  l->cf = iris_frame_from_normal(cn);
+  float co = iris_dot(wo, cn);
+  l->fc_o = co > 0.0f ? iris_fresnel_schlick(COAT_F0, co) : 0.0f;
+  l->coat_below_o = 1.0f - l->cc * l->fc_o;
+  l->sheen = sanitize3(b->sheen_color);
+  l->sheen_max = iris_max3(l->sheen);
+  l->sheen_r = iris_clampf(b->sheen_roughness, 0.0f, 1.0f);
+  l->sheen_ag = sheen_alpha(l->sheen_r);
+  l->e_o = l->sheen_max > 0.0f ? sheen_albedo(wo.z, l->sheen_r) : 0.0f;
+  l->sheen_k = l->e_o > 1.0f ? 1.0f / l->e_o : 1.0f;
+  l->p_coat = l->cc > 0.0f ? fminf(0.5f, l->cc * (0.1f + 2.0f * l->fc_o)) : 0.0f;
+  l->p_sheen = l->sheen_max > 0.0f ? fminf(0.3f, 0.05f + l->sheen_max * fminf(l->e_o, 1.0f)) : 0.0f;
+}
+
+/* Albedo scaling of the base under the sheen (the extension's
+ * min(1 - max(c) E(wo), 1 - max(c) E(wi)); wo only for transmitted wi). */
+static float sheen_scale(const layers *l, iris_vec3 wi) {
+  if (!(l->sheen_max > 0.0f)) return 1.0f;
+  float s = 1.0f - l->sheen_max * l->e_o;
+  if (wi.z > 0.0f) s = fminf(s, 1.0f - l->sheen_max * sheen_albedo(wi.z, l->sheen_r));
+  return fmaxf(s, 0.0f);
+}
+
+/* The coat lobe (no delta part): cc F(wo.m) D G / (4 cos cos) about the coat normal. */
+static float coat_f(const layers *l, iris_vec3 wo, iris_vec3 wi) {
+  if (!(l->cc > 0.0f) || l->cc_smooth) return 0.0f;
+  iris_vec3 o = iris_frame_to_local(&l->cf, wo), i = iris_frame_to_local(&l->cf, wi);
+  if (o.z < IRIS_BSDF_MIN_COS || i.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 m = iris_normalize(iris_add(o, i));
+  return l->cc * iris_fresnel_schlick(COAT_F0, iris_dot(o, m)) * ggx_reflect_f(l->cc_alpha, o, i, true);
+}
+
+static float coat_pdf(const layers *l, iris_vec3 wo, iris_vec3 wi) {
+  if (!(l->cc > 0.0f) || l->cc_smooth) return 0.0f;
+  return ggx_reflect_pdf(l->cc_alpha, iris_frame_to_local(&l->cf, wo), iris_frame_to_local(&l->cf, wi));
+}
+
+static iris_vec3 layered_eval(const iris_bsdf *b, const layers *l, iris_vec3 wo, iris_vec3 wi) {
+  iris_vec3 below = iris_scale(gltf_base_eval(b, wo, wi), sheen_scale(l, wi));
+  if (l->sheen_max > 0.0f) below = iris_add(below, iris_scale(l->sheen, l->sheen_k * sheen_f(l->sheen_ag, wo, wi)));
+  float c = coat_f(l, wo, wi);
+  return iris_add(iris_scale(below, l->coat_below_o), iris_v3(c, c, c));
+}
+
+static float layered_pdf(const iris_bsdf *b, const layers *l, iris_vec3 wo, iris_vec3 wi) {
+  float p_base = 1.0f - l->p_coat - l->p_sheen;
+  return l->p_coat * coat_pdf(l, wo, wi) + l->p_sheen * sheen_pdf(wi) + p_base * gltf_base_pdf(b, wo, wi);
+}
+
+/* The layered paths are kept out of line so that the plain glTF BSDF inlines
+ * into the dispatch as it did before the layers existed (measured: docs/performance.md). */
+#if defined(__GNUC__)
+#define IRIS_NOINLINE __attribute__((noinline))
+#else
+#define IRIS_NOINLINE
+#endif
+
+static IRIS_NOINLINE iris_vec3 gltf_layered_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  layers l;
+  layers_begin(b, wo, &l);
+  return layered_eval(b, &l, wo, wi);
+}
+
+static IRIS_NOINLINE float gltf_layered_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
+  layers l;
+  layers_begin(b, wo, &l);
+  return layered_pdf(b, &l, wo, wi);
+}
+
+static IRIS_NOINLINE bool gltf_layered_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0,
+                                               float u1, struct iris_bsdf_sample *s) {
+  layers l;
+  layers_begin(b, wo, &l);
+  if (u_lobe < l.p_coat) {
+    iris_vec3 o = iris_frame_to_local(&l.cf, wo);
+    if (o.z < IRIS_BSDF_MIN_COS) return false;
+    if (l.cc_smooth) { /* mirror about the coat normal: a delta lobe */
+      s->wi = iris_frame_to_world(&l.cf, iris_v3(-o.x, -o.y, o.z));
+      if (fabsf(s->wi.z) < IRIS_BSDF_MIN_COS) return false;
+      float f = l.cc * l.fc_o / fabsf(s->wi.z);
+      s->f = iris_v3(f, f, f);
+      s->pdf = l.p_coat;
+      s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_DELTA;
+      return true;
+    }
+    iris_vec3 i = iris_reflect(o, iris_ggx_sample_vndf(l.cc_alpha, o, u0, u1));
+    if (i.z < IRIS_BSDF_MIN_COS) return false;
+    s->wi = iris_frame_to_world(&l.cf, i);
+    s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
+  } else if (u_lobe < l.p_coat + l.p_sheen) {
+    s->wi = iris_sample_cosine_hemisphere(u0, u1);
+    s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
+  } else {
+    float p_base = 1.0f - l.p_coat - l.p_sheen;
+    float u = iris_clampf((u_lobe - l.p_coat - l.p_sheen) / p_base, 0.0f, 0.99999994f);
+    if (!gltf_base_sample(b, wo, u, u0, u1, s)) return false;
+    if (s->lobe & IRIS_LOBE_DELTA) { /* the layers' share of a delta direction */
+      s->f = iris_scale(s->f, l.coat_below_o * sheen_scale(&l, s->wi));
+      s->pdf *= p_base;
+      return s->pdf > 0.0f;
+    }
+  }
+  s->f = sanitize3(layered_eval(b, &l, wo, s->wi));
+  s->pdf = sanitize1(layered_pdf(b, &l, wo, s->wi));
+  return s->pdf > 0.0f;
+}
+
 /* ---- public dispatch ----------------------------------------------------- */
 
 static iris_vec3 color_from(const float *c) {
@@ -410,6 +587,9 @@ iris_bsdf iris_bsdf_from_material(const iris_material *mat, iris_vec3 color, flo
   b.specular = sanitize1(mat->specular);
   b.specular_color = color_from(mat->specular_color);
   b.transmission = iris_clampf(isfinite(mat->transmission) ? mat->transmission : 0.0f, 0.0f, 1.0f);
+  b.clearcoat = b.clearcoat_roughness = b.sheen_roughness = 0.0f;
+  b.coat_n = iris_v3(0.0f, 0.0f, 1.0f);
+  b.sheen_color = zero3;
   return b;
 }
 
@@ -419,7 +599,9 @@ iris_vec3 iris_bsdf_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
     case IRIS_BSDF_DIFFUSE: f = diffuse_eval(b, wo, wi); break;
     case IRIS_BSDF_GLOSSY: f = glossy_eval(b, wo, wi); break;
     case IRIS_BSDF_GLASS: f = glass_eval(b, wo, wi); break;
-    case IRIS_BSDF_GLTF: f = gltf_eval(b, wo, wi); break;
+    case IRIS_BSDF_GLTF: /* layers are outside only */
+      f = has_layers(b) && wo.z > 0.0f ? gltf_layered_eval(b, wo, wi) : gltf_base_eval(b, wo, wi);
+      break;
     default: f = zero3; break;
   }
   return sanitize3(f);
@@ -431,7 +613,9 @@ float iris_bsdf_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
     case IRIS_BSDF_DIFFUSE: p = diffuse_pdf(wo, wi); break;
     case IRIS_BSDF_GLOSSY: p = glossy_pdf(b, wo, wi); break;
     case IRIS_BSDF_GLASS: p = glass_pdf(b, wo, wi); break;
-    case IRIS_BSDF_GLTF: p = gltf_pdf(b, wo, wi); break;
+    case IRIS_BSDF_GLTF:
+      p = has_layers(b) && wo.z > 0.0f ? gltf_layered_pdf(b, wo, wi) : gltf_base_pdf(b, wo, wi);
+      break;
     default: p = 0.0f; break;
   }
   return sanitize1(p);
@@ -448,7 +632,10 @@ bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, 
     case IRIS_BSDF_DIFFUSE: ok = diffuse_sample(b, wo, u0, u1, s); break;
     case IRIS_BSDF_GLOSSY: ok = glossy_sample(b, wo, u0, u1, s); break;
     case IRIS_BSDF_GLASS: ok = glass_sample(b, wo, u_lobe, u0, u1, s); break;
-    case IRIS_BSDF_GLTF: ok = gltf_sample(b, wo, u_lobe, u0, u1, s); break;
+    case IRIS_BSDF_GLTF:
+      ok = has_layers(b) && wo.z > 0.0f ? gltf_layered_sample(b, wo, u_lobe, u0, u1, s)
+                                        : gltf_base_sample(b, wo, u_lobe, u0, u1, s);
+      break;
     default: ok = false; break;
   }
   s->f = sanitize3(s->f);
@@ -478,6 +665,9 @@ uint32_t iris_bsdf_lobes(const iris_bsdf *b) {
       if (metallic < 1.0f && transmission < 1.0f) l |= IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
       if (metallic > 0.0f || b->specular > 0.0f) l |= IRIS_LOBE_REFLECTION | spec;
       if (metallic < 1.0f && transmission > 0.0f) l |= IRIS_LOBE_TRANSMISSION | spec;
+      if (b->clearcoat > 0.0f)
+        l |= IRIS_LOBE_REFLECTION | (alpha_is_singular(alpha_of(b->clearcoat_roughness)) ? IRIS_LOBE_DELTA : IRIS_LOBE_GLOSSY);
+      if (iris_max3(b->sheen_color) > 0.0f) l |= IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
       return l;
     }
     default: return 0;

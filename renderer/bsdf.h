@@ -41,6 +41,15 @@ typedef struct iris_bsdf {
   float specular;           /* gltf KHR_materials_specular factor */
   iris_vec3 specular_color; /* gltf */
   float transmission;       /* gltf */
+  /* gltf layers over the base (0 = absent; docs/materials.md, "Clearcoat and sheen"):
+   * KHR_materials_clearcoat, a GGX dielectric coat (F0 0.04) with its own normal
+   * (local to this BSDF's frame; (0, 0, 1) when the coat follows the shading
+   * normal), and KHR_materials_sheen, a Charlie-distribution lobe with the
+   * extension's albedo scaling of what lies below. Set by the caller. */
+  float clearcoat, clearcoat_roughness;
+  iris_vec3 coat_n;
+  iris_vec3 sheen_color;
+  float sheen_roughness;
 } iris_bsdf;
 
 /* Lobe flags of a sample (and of a BSDF as a whole). */

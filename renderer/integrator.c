@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "renderer/normal_map.h"
+
 static const char *const METHOD_NAMES[IRIS_METHOD_COUNT] = {"bsdf", "nee", "mis", "guided",
                                                              "guided-nee"};
 
@@ -46,6 +48,63 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
   return it;
 }
 
+/* KHR_materials_volume: a segment that ends on the back of a surface whose
+ * material attenuates ran inside it (closed meshes), and its throughput is
+ * exp(-sigma d), sigma = -ln(attenuation_color) / attenuation_distance. */
+iris_vec3 iris_integrator_volume_transmittance(const iris_integrator *it, const iris_interaction *si, float d) {
+  if (si->material < 0 || (size_t)si->material >= it->scene->material_count) return iris_v3(1, 1, 1);
+  const iris_material *m = &it->scene->materials[si->material];
+  if (!(m->attenuation_distance > 0.0f)) return iris_v3(1, 1, 1);
+  float t[3];
+  for (int k = 0; k < 3; k++)
+    t[k] = m->attenuation_color[k] > 0.0f ? powf(m->attenuation_color[k], d / m->attenuation_distance) : 0.0f;
+  return iris_v3(t[0], t[1], t[2]);
+}
+
+/* KHR_materials_clearcoat / _sheen values at the point (textures applied) into
+ * the BSDF; the coat normal is the unmapped shading normal or the coat's own
+ * normal map, expressed in the shading frame. Only for materials that have them. */
+static void shade_layers(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
+                         iris_shading_point *sp) {
+  float t[4];
+  if (m->clearcoat > 0.0f) {
+    float cc = m->clearcoat, ccr = m->clearcoat_roughness;
+    if (m->clearcoat_texture >= 0) {
+      iris_texture_sample(it->textures, m->clearcoat_texture, si->uv, si->uv1, false, t);
+      cc *= t[0];
+    }
+    if (m->clearcoat_roughness_texture >= 0) {
+      iris_texture_sample(it->textures, m->clearcoat_roughness_texture, si->uv, si->uv1, false, t);
+      ccr *= t[1];
+    }
+    iris_vec3 cn = si->ns;
+    if (m->clearcoat_normal_texture >= 0 && si->has_tangent) {
+      iris_texture_sample(it->textures, m->clearcoat_normal_texture, si->uv, si->uv1, false, t);
+      cn = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->clearcoat_normal_scale);
+    }
+    if (iris_dot(sp->si.ns, si->ns) < 0.0f) cn = iris_neg(cn); /* flipped with the shading normal */
+    sp->bsdf.clearcoat = cc;
+    sp->bsdf.clearcoat_roughness = ccr;
+    sp->bsdf.coat_n = iris_frame_to_local(&sp->frame, cn);
+  }
+  iris_vec3 sheen = iris_v3_load(m->sheen_color);
+  if (iris_max3(sheen) > 0.0f) {
+    float sr = m->sheen_roughness;
+    if (m->sheen_color_texture >= 0) {
+      iris_texture_sample(it->textures, m->sheen_color_texture, si->uv, si->uv1, true, t);
+      sheen = iris_mul(sheen, iris_v3(t[0], t[1], t[2]));
+    }
+    if (m->sheen_roughness_texture >= 0) {
+      iris_texture_sample(it->textures, m->sheen_roughness_texture, si->uv, si->uv1, false, t);
+      sr *= t[3];
+    }
+    sp->bsdf.sheen_color = sheen;
+    sp->bsdf.sheen_roughness = sr;
+  }
+  sp->lobes = iris_bsdf_lobes(&sp->bsdf);
+  sp->delta = iris_bsdf_is_delta(&sp->bsdf);
+}
+
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp) {
   const iris_material *m = si->material >= 0 && (size_t)si->material < it->scene->material_count
@@ -54,17 +113,27 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   iris_vec3 color = iris_mul(iris_v3_load(m->color), si->color);
   if (m->color_texture >= 0) {
     float t[4];
-    iris_texture_lookup(it->textures, m->color_texture, si->uv[0], si->uv[1], true, t);
+    iris_texture_sample(it->textures, m->color_texture, si->uv, si->uv1, true, t);
     color = iris_mul(color, iris_v3(t[0], t[1], t[2]));
   }
   float roughness = m->roughness, metallic = m->metallic;
   if (m->type == IRIS_MATERIAL_GLTF && m->metallic_roughness_texture >= 0) {
     float t[4];
-    iris_texture_lookup(it->textures, m->metallic_roughness_texture, si->uv[0], si->uv[1], false, t);
+    iris_texture_sample(it->textures, m->metallic_roughness_texture, si->uv, si->uv1, false, t);
     roughness *= t[1];
     metallic *= t[2];
   }
   sp->si = *si;
+  if (m->normal_texture >= 0 && si->has_tangent) { /* docs/rendering.md, "Normal maps" */
+    float t[4];
+    iris_texture_sample(it->textures, m->normal_texture, si->uv, si->uv1, false, t);
+    iris_vec3 n = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->normal_scale);
+    /* seen from wo's side, as the BSDF will see it */
+    bool back = iris_dot(wo, si->ng) < 0.0f;
+    iris_vec3 ngw = back ? iris_neg(si->ng) : si->ng;
+    n = iris_normal_make_valid(ngw, wo, back ? iris_neg(n) : n);
+    sp->si.ns = back ? iris_neg(n) : n;
+  }
   sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);
@@ -79,6 +148,8 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   }
   sp->frame = iris_frame_from_normal(sp->si.ns);
   sp->wo_local = iris_frame_to_local(&sp->frame, wo);
+  if (m->type == IRIS_MATERIAL_GLTF && (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f))
+    shade_layers(it, m, si, sp);
 }
 
 /* A direction that leaves a non-transmissive surface below its geometric
@@ -195,6 +266,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
     }
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
+    if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the point is shaded. */
     iris_light_choice choice = {0, 0.0f};

@@ -154,6 +154,11 @@ iris_integrator iris_integrator_default(const iris_scene *scene, const iris_acce
                                         const iris_lights *lights, const iris_textures *textures);
 
 /* Fills the shading point for a hit (material, textures, vertex colour, frame). */
+/* KHR_materials_volume (docs/rendering.md): the throughput of a segment of
+ * length d that ends at si, exp(-sigma d) when it ends on the back of an
+ * attenuating material (the segment ran inside it), else 1. */
+iris_vec3 iris_integrator_volume_transmittance(const iris_integrator *it, const iris_interaction *si, float d);
+
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp);
 

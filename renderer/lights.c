@@ -493,7 +493,7 @@ static iris_vec3 surface_emission(const iris_lights *lights, const iris_material
   iris_vec3 le = iris_v3_load(m->emission);
   if (m->emission_texture >= 0) {
     float t[4];
-    iris_texture_lookup(lights->textures, m->emission_texture, si->uv[0], si->uv[1], true, t);
+    iris_texture_sample(lights->textures, m->emission_texture, si->uv, si->uv1, true, t);
     le = iris_mul(le, iris_v3(t[0], t[1], t[2]));
   }
   return le;

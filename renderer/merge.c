@@ -54,6 +54,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     if (t->data) hash_bytes(&s, t->data, t->data_size);
     hash_str(&s, t->mime);
     hash_u64(&s, ((uint64_t)t->wrap_s << 16) | ((uint64_t)t->wrap_t << 8) | (t->nearest ? 1u : 0u));
+    if (t->uv_set || t->has_transform) { /* (scenes without them hash as before) */
+      float x[] = {t->offset[0], t->offset[1], t->rotation, t->scale[0], t->scale[1]};
+      hash_u64(&s, ((uint64_t)t->uv_set << 8) | (t->has_transform ? 1u : 0u));
+      if (t->has_transform) hash_floats(&s, x, 5);
+    }
   }
   hash_u64(&s, scene->material_count);
   for (size_t i = 0; i < scene->material_count; i++) {
@@ -67,6 +72,28 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_u64(&s, (uint64_t)(int64_t)m->metallic_roughness_texture);
     hash_u64(&s, (uint64_t)(int64_t)m->emission_texture);
     hash_u64(&s, (m->emission_two_sided ? 2u : 0u) | (m->double_sided ? 1u : 0u));
+    if (m->alpha_mode != IRIS_ALPHA_OPAQUE || m->alpha != 1.0f) { /* (opaque scenes hash as before) */
+      float a[2] = {m->alpha, m->alpha_cutoff};
+      hash_u64(&s, (uint64_t)m->alpha_mode);
+      hash_floats(&s, a, 2);
+    }
+    if (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f) { /* (others hash as before) */
+      float l[8] = {m->clearcoat, m->clearcoat_roughness, m->clearcoat_normal_scale, m->sheen_color[0],
+                    m->sheen_color[1], m->sheen_color[2], m->sheen_roughness, 0};
+      hash_floats(&s, l, 8);
+      int32_t t[5] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+                      m->sheen_color_texture, m->sheen_roughness_texture};
+      for (int k = 0; k < 5; k++) hash_u64(&s, (uint64_t)(int64_t)t[k]);
+    }
+    if (m->attenuation_distance > 0.0f) { /* (others hash as before) */
+      float v[4] = {m->attenuation_color[0], m->attenuation_color[1], m->attenuation_color[2],
+                    m->attenuation_distance};
+      hash_floats(&s, v, 4);
+    }
+    if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
+      hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
+      hash_floats(&s, &m->normal_scale, 1);
+    }
   }
   hash_u64(&s, scene->mesh_count);
   for (size_t i = 0; i < scene->mesh_count; i++) {
@@ -76,6 +103,9 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_floats(&s, m->normals, 3 * (size_t)m->vertex_count);
     hash_floats(&s, m->uvs, 2 * (size_t)m->vertex_count);
     hash_floats(&s, m->colors, 3 * (size_t)m->vertex_count);
+    if (m->uvs1) hash_floats(&s, m->uvs1, 2 * (size_t)m->vertex_count);
+    if (m->tangents) hash_floats(&s, m->tangents, 4 * (size_t)m->vertex_count);
+    if (m->alphas) hash_floats(&s, m->alphas, (size_t)m->vertex_count);
     if (m->indices) hash_bytes(&s, m->indices, 3 * (size_t)m->triangle_count * sizeof(uint32_t));
     hash_u64(&s, (uint64_t)(int64_t)m->material);
   }

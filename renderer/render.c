@@ -127,6 +127,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   iris_path_stats *stats = NULL;
   st = iris_accel_build(scene, &accel, err);
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
+  if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
   if (st == IRIS_OK) iris_lights_set_triangle_sampling(&lights, p.light_sampling);
   iris_integrator it;

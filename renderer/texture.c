@@ -29,8 +29,40 @@ iris_status iris_textures_load(const iris_scene *scene, iris_textures *out, iris
     out->images[i].wrap_s = t->wrap_s;
     out->images[i].wrap_t = t->wrap_t;
     out->images[i].nearest = t->nearest;
+    out->images[i].uv_set = t->uv_set;
+    out->images[i].has_transform = t->has_transform;
+    iris_texture_transform_matrix(t, out->images[i].xf);
   }
   return IRIS_OK;
+}
+
+void iris_texture_transform_matrix(const iris_texture *t, float xf[2][3]) {
+  if (!t->has_transform) {
+    const float id[2][3] = {{1, 0, 0}, {0, 1, 0}};
+    memcpy(xf, id, sizeof id);
+    return;
+  }
+  /* T(offset) R(rotation) S(scale) with R = [[c, s], [-s, c]]: the rotation the
+   * KHR_texture_transform sample model (TextureTransformTest's markers) checks. */
+  double c = cos((double)t->rotation), s = sin((double)t->rotation);
+  xf[0][0] = (float)(c * t->scale[0]), xf[0][1] = (float)(s * t->scale[1]), xf[0][2] = t->offset[0];
+  xf[1][0] = (float)(-s * t->scale[0]), xf[1][1] = (float)(c * t->scale[1]), xf[1][2] = t->offset[1];
+}
+
+void iris_texture_sample(const iris_textures *tex, int32_t index, const float uv[2], const float uv1[2],
+                         bool srgb, float rgba[4]) {
+  if (!tex || index < 0 || (size_t)index >= tex->count) {
+    rgba[0] = rgba[1] = rgba[2] = rgba[3] = 1.0f;
+    return;
+  }
+  const iris_texture_image *t = &tex->images[index];
+  const float *p = t->uv_set ? uv1 : uv;
+  float u = p[0], v = p[1];
+  if (t->has_transform) {
+    u = t->xf[0][0] * p[0] + t->xf[0][1] * p[1] + t->xf[0][2];
+    v = t->xf[1][0] * p[0] + t->xf[1][1] * p[1] + t->xf[1][2];
+  }
+  iris_texture_lookup(tex, index, u, v, srgb, rgba);
 }
 
 void iris_textures_destroy(iris_textures *tex) {
@@ -78,10 +110,12 @@ void iris_texture_lookup(const iris_textures *tex, int32_t index, float u, float
     return;
   }
   const iris_texture_image *t = &tex->images[index];
-  /* Keep the coordinates in a range where float->int is exact; wrapping is periodic
-   * (period 2 for mirror), so subtracting an even integer does not change the result. */
-  u -= 2.0f * floorf(u * 0.5f);
-  v -= 2.0f * floorf(v * 0.5f);
+  /* Keep the coordinates in a range where float->int is exact; repeat and mirror are
+   * periodic (period 2 for mirror), so subtracting an even integer does not change
+   * the result; clamp is not periodic, and every coordinate outside [-1, 2] reads
+   * the same edge texels as that bound. */
+  u = t->wrap_s == IRIS_WRAP_CLAMP ? fminf(fmaxf(u, -1.0f), 2.0f) : u - 2.0f * floorf(u * 0.5f);
+  v = t->wrap_t == IRIS_WRAP_CLAMP ? fminf(fmaxf(v, -1.0f), 2.0f) : v - 2.0f * floorf(v * 0.5f);
   float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
   if (t->nearest) {
     texel(tex, t, (int)floorf(x + 0.5f), (int)floorf(y + 0.5f), srgb, rgba);

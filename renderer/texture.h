@@ -22,6 +22,9 @@ typedef struct iris_texture_image {
   uint8_t *rgba;      /* 8-bit texels as stored in the file, top row first */
   iris_wrap wrap_s, wrap_t;
   bool nearest;
+  uint8_t uv_set;     /* which uv set of the surface (iris_texture.uv_set) */
+  bool has_transform; /* uv' = xf * (u, v, 1) (iris_texture's KHR_texture_transform) */
+  float xf[2][3];
 } iris_texture_image;
 
 typedef struct iris_textures {
@@ -39,6 +42,14 @@ void iris_textures_destroy(iris_textures *tex);
  * An index out of range gives (1, 1, 1, 1). */
 void iris_texture_lookup(const iris_textures *tex, int32_t index, float u, float v, bool srgb,
                          float rgba[4]);
+
+/* The texture as placed on a surface: picks the texture's uv set (uv1 is the
+ * surface's second set, equal to uv when the mesh has none), applies its
+ * transform, then looks up like iris_texture_lookup. */
+void iris_texture_sample(const iris_textures *tex, int32_t index, const float uv[2], const float uv1[2],
+                         bool srgb, float rgba[4]);
+/* The KHR_texture_transform matrix of a texture: u' = xf[0] . (u, v, 1), v' = xf[1] . (u, v, 1). */
+void iris_texture_transform_matrix(const iris_texture *t, float xf[2][3]);
 
 /* Texel coordinate after applying a wrap mode to integer index i of n. */
 int iris_texture_wrap(int i, int n, iris_wrap mode);

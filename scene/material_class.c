@@ -8,6 +8,10 @@
 
 iris_gltf_class iris_material_gltf_class(const iris_material *m) {
   if (m->type != IRIS_MATERIAL_GLTF) return IRIS_GLTF_NOT_GLTF;
+  /* clearcoat and sheen layers: no Cycles node reproduces them (Principled v1
+   * approximates them), whatever the base is */
+  if (m->clearcoat > 0.0f || m->sheen_color[0] > 0.0f || m->sheen_color[1] > 0.0f || m->sheen_color[2] > 0.0f)
+    return IRIS_GLTF_GENERAL;
   /* metallic = factor x texture B, so a factor of 0 is 0 whatever the texture;
    * a factor of 1 is 1 only without a texture. */
   bool metal0 = m->metallic == 0.0f;
@@ -37,6 +41,13 @@ bool iris_material_gltf_smooth(const iris_material *m) {
 
 bool iris_material_canonicalize(iris_material *m) {
   if (iris_material_gltf_class(m) != IRIS_GLTF_LAMBERT) return false;
+  /* Only a material that is a Lambert and nothing else: layers (clearcoat,
+   * sheen) exist for gltf materials only, and normal maps and alpha are kept
+   * where every consumer (renderer, exporters) reads them on gltf materials. */
+  if (m->clearcoat > 0.0f || m->sheen_color[0] > 0.0f || m->sheen_color[1] > 0.0f ||
+      m->sheen_color[2] > 0.0f || m->normal_texture >= 0 || m->alpha_mode != IRIS_ALPHA_OPAQUE ||
+      m->alpha < 1.0f)
+    return false;
   /* A diffuse material keeps what applies to it; fields that do not apply are
    * reset to the diffuse defaults so that equal materials stay equal. */
   iris_material d = iris_material_default(IRIS_MATERIAL_DIFFUSE);

@@ -27,12 +27,15 @@ static uint32_t get_u32(const uint8_t *p) {
 
 uint32_t iris_mesh_file_flags(const iris_mesh *mesh) {
   return (mesh->normals ? IRIS_MESH_HAS_NORMALS : 0u) | (mesh->uvs ? IRIS_MESH_HAS_UVS : 0u) |
-         (mesh->colors ? IRIS_MESH_HAS_COLORS : 0u);
+         (mesh->colors ? IRIS_MESH_HAS_COLORS : 0u) | (mesh->uvs1 ? IRIS_MESH_HAS_UVS1 : 0u) |
+         (mesh->tangents ? IRIS_MESH_HAS_TANGENTS : 0u) | (mesh->alphas ? IRIS_MESH_HAS_ALPHAS : 0u);
 }
 
 uint64_t iris_mesh_file_size(uint32_t flags, uint64_t vertex_count, uint64_t triangle_count) {
   uint64_t per_vertex = 12 + (flags & IRIS_MESH_HAS_NORMALS ? 12 : 0) +
-                        (flags & IRIS_MESH_HAS_UVS ? 8 : 0) + (flags & IRIS_MESH_HAS_COLORS ? 12 : 0);
+                        (flags & IRIS_MESH_HAS_UVS ? 8 : 0) + (flags & IRIS_MESH_HAS_COLORS ? 12 : 0) +
+                        (flags & IRIS_MESH_HAS_UVS1 ? 8 : 0) + (flags & IRIS_MESH_HAS_TANGENTS ? 16 : 0) +
+                        (flags & IRIS_MESH_HAS_ALPHAS ? 4 : 0);
   return IRIS_MESH_HEADER_SIZE + per_vertex * vertex_count + 12 * triangle_count;
 }
 
@@ -55,13 +58,16 @@ iris_status iris_mesh_write_file(const iris_mesh *mesh, const char *path, iris_e
   struct {
     const void *data;
     size_t size;
-  } parts[5] = {{mesh->positions, 12 * nv},
+  } parts[8] = {{mesh->positions, 12 * nv},
                 {mesh->normals, mesh->normals ? 12 * nv : 0},
                 {mesh->uvs, mesh->uvs ? 8 * nv : 0},
                 {mesh->colors, mesh->colors ? 12 * nv : 0},
+                {mesh->uvs1, mesh->uvs1 ? 8 * nv : 0},
+                {mesh->tangents, mesh->tangents ? 16 * nv : 0},
+                {mesh->alphas, mesh->alphas ? 4 * nv : 0},
                 {mesh->indices, 12 * nt}};
   uint32_t crc = (uint32_t)crc32(0L, Z_NULL, 0);
-  for (int i = 0; i < 5; i++)
+  for (int i = 0; i < 8; i++)
     if (parts[i].size) crc = crc_update(crc, parts[i].data, parts[i].size);
 
   uint8_t header[IRIS_MESH_HEADER_SIZE];
@@ -77,7 +83,7 @@ iris_status iris_mesh_write_file(const iris_mesh *mesh, const char *path, iris_e
   iris_status st = iris_atomic_open(&f, path, err);
   if (st != IRIS_OK) return st;
   bool ok = fwrite(header, 1, sizeof header, f.fp) == sizeof header;
-  for (int i = 0; ok && i < 5; i++)
+  for (int i = 0; ok && i < 8; i++)
     if (parts[i].size) ok = fwrite(parts[i].data, 1, parts[i].size, f.fp) == parts[i].size;
   if (!ok) {
     iris_atomic_abort(&f);
@@ -126,7 +132,7 @@ iris_status iris_mesh_read_map(const iris_file_map *map, const char *path, iris_
   const uint8_t *q = p + IRIS_MESH_HEADER_SIZE;
   const float *positions = (const float *)q;
   q += 12 * (size_t)nv;
-  const float *normals = NULL, *uvs = NULL, *colors = NULL;
+  const float *normals = NULL, *uvs = NULL, *colors = NULL, *uvs1 = NULL, *tangents = NULL, *alphas = NULL;
   if (flags & IRIS_MESH_HAS_NORMALS) {
     normals = (const float *)q;
     q += 12 * (size_t)nv;
@@ -139,6 +145,18 @@ iris_status iris_mesh_read_map(const iris_file_map *map, const char *path, iris_
     colors = (const float *)q;
     q += 12 * (size_t)nv;
   }
+  if (flags & IRIS_MESH_HAS_UVS1) {
+    uvs1 = (const float *)q;
+    q += 8 * (size_t)nv;
+  }
+  if (flags & IRIS_MESH_HAS_TANGENTS) {
+    tangents = (const float *)q;
+    q += 16 * (size_t)nv;
+  }
+  if (flags & IRIS_MESH_HAS_ALPHAS) {
+    alphas = (const float *)q;
+    q += 4 * (size_t)nv;
+  }
   const uint32_t *indices = (const uint32_t *)q;
 
   char element[64];
@@ -146,8 +164,10 @@ iris_status iris_mesh_read_map(const iris_file_map *map, const char *path, iris_
     const float *v;
     int width;
     const char *what;
-  } arrays[4] = {{positions, 3, "position"}, {normals, 3, "normal"}, {uvs, 2, "uv"}, {colors, 3, "color"}};
-  for (int a = 0; a < 4; a++) {
+  } arrays[7] = {{positions, 3, "position"}, {normals, 3, "normal"}, {uvs, 2, "uv"},
+                  {colors, 3, "color"},       {uvs1, 2, "uv1"},       {tangents, 4, "tangent"},
+                  {alphas, 1, "alpha"}};
+  for (int a = 0; a < 7; a++) {
     if (!arrays[a].v) continue;
     size_t n = (size_t)arrays[a].width * nv;
     for (size_t i = 0; i < n; i++)
@@ -170,6 +190,9 @@ iris_status iris_mesh_read_map(const iris_file_map *map, const char *path, iris_
   mesh->normals = (float *)(uintptr_t)normals;
   mesh->uvs = (float *)(uintptr_t)uvs;
   mesh->colors = (float *)(uintptr_t)colors;
+  mesh->uvs1 = (float *)(uintptr_t)uvs1;
+  mesh->tangents = (float *)(uintptr_t)tangents;
+  mesh->alphas = (float *)(uintptr_t)alphas;
   mesh->indices = (uint32_t *)(uintptr_t)indices;
   mesh->owned = false;
   return IRIS_OK;

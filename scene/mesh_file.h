@@ -19,7 +19,10 @@ enum {
   IRIS_MESH_HAS_NORMALS = 1u << 0,
   IRIS_MESH_HAS_UVS = 1u << 1,
   IRIS_MESH_HAS_COLORS = 1u << 2,
-  IRIS_MESH_ALL_FLAGS = 7u
+  IRIS_MESH_HAS_UVS1 = 1u << 3,
+  IRIS_MESH_HAS_TANGENTS = 1u << 4,
+  IRIS_MESH_HAS_ALPHAS = 1u << 5,
+  IRIS_MESH_ALL_FLAGS = 63u
 };
 
 /* Attribute flags of a mesh (which optional arrays are present). */

@@ -28,6 +28,9 @@ static void free_mesh(iris_mesh *m) {
     free(m->normals);
     free(m->uvs);
     free(m->colors);
+    free(m->uvs1);
+    free(m->tangents);
+    free(m->alphas);
     free(m->indices);
   }
 }
@@ -169,6 +172,16 @@ iris_material iris_material_default(iris_material_type type) {
   m.emission_texture = -1;
   m.emission_two_sided = true;
   m.double_sided = false;
+  m.normal_texture = -1;
+  m.normal_scale = 1.0f;
+  m.alpha_mode = IRIS_ALPHA_OPAQUE;
+  m.alpha = 1.0f;
+  m.alpha_cutoff = 0.5f;
+  m.clearcoat_texture = m.clearcoat_roughness_texture = m.clearcoat_normal_texture = -1;
+  m.clearcoat_normal_scale = 1.0f;
+  m.sheen_color_texture = m.sheen_roughness_texture = -1;
+  m.attenuation_color[0] = m.attenuation_color[1] = m.attenuation_color[2] = 1.0f;
+  m.attenuation_distance = 0.0f;
   return m;
 }
 
@@ -205,6 +218,12 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     m->color_texture = shift_ref(m->color_texture, tex0);
     m->metallic_roughness_texture = shift_ref(m->metallic_roughness_texture, tex0);
     m->emission_texture = shift_ref(m->emission_texture, tex0);
+    m->normal_texture = shift_ref(m->normal_texture, tex0);
+    m->clearcoat_texture = shift_ref(m->clearcoat_texture, tex0);
+    m->clearcoat_roughness_texture = shift_ref(m->clearcoat_roughness_texture, tex0);
+    m->clearcoat_normal_texture = shift_ref(m->clearcoat_normal_texture, tex0);
+    m->sheen_color_texture = shift_ref(m->sheen_color_texture, tex0);
+    m->sheen_roughness_texture = shift_ref(m->sheen_roughness_texture, tex0);
   }
   for (size_t i = 0; i < src->mesh_count; i++)
     src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
@@ -318,6 +337,36 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
   if ((st = check_texture_ref(m->metallic_roughness_texture, s->texture_count,
                               "metallic_roughness_texture", file, element, err)))
     return st;
+  if (!isfinite(m->normal_scale)) FAIL("normal_scale %g is not finite", (double)m->normal_scale);
+  if ((unsigned)m->alpha_mode > IRIS_ALPHA_BLEND) FAIL("unknown alpha mode %d", (int)m->alpha_mode);
+  if (!isfinite(m->alpha) || m->alpha < 0.0f || m->alpha > 1.0f) FAIL("alpha %g outside [0, 1]", (double)m->alpha);
+  if (!isfinite(m->alpha_cutoff) || m->alpha_cutoff < 0.0f)
+    FAIL("alpha_cutoff %g must be finite and non-negative", (double)m->alpha_cutoff);
+  if ((st = check_texture_ref(m->normal_texture, s->texture_count, "normal_texture", file, element, err)))
+    return st;
+  if (!isfinite(m->clearcoat) || m->clearcoat < 0.0f || m->clearcoat > 1.0f)
+    FAIL("clearcoat %g outside [0, 1]", (double)m->clearcoat);
+  if (!isfinite(m->clearcoat_roughness) || m->clearcoat_roughness < 0.0f || m->clearcoat_roughness > 1.0f)
+    FAIL("clearcoat_roughness %g outside [0, 1]", (double)m->clearcoat_roughness);
+  if (!isfinite(m->clearcoat_normal_scale)) FAIL("clearcoat_normal_scale is not finite");
+  if (!nonneg_finite_n(m->sheen_color, 3) || m->sheen_color[0] > 1.0f || m->sheen_color[1] > 1.0f ||
+      m->sheen_color[2] > 1.0f)
+    FAIL("sheen_color must be in [0, 1]");
+  if (!nonneg_finite_n(m->attenuation_color, 3) || m->attenuation_color[0] > 1.0f ||
+      m->attenuation_color[1] > 1.0f || m->attenuation_color[2] > 1.0f)
+    FAIL("attenuation_color must be in [0, 1]");
+  if (!isfinite(m->attenuation_distance) || m->attenuation_distance < 0.0f)
+    FAIL("attenuation_distance %g must be finite and >= 0 (0: none)", (double)m->attenuation_distance);
+  if (!isfinite(m->sheen_roughness) || m->sheen_roughness < 0.0f || m->sheen_roughness > 1.0f)
+    FAIL("sheen_roughness %g outside [0, 1]", (double)m->sheen_roughness);
+  {
+    const int32_t refs[5] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+                             m->sheen_color_texture, m->sheen_roughness_texture};
+    const char *names[5] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                            "sheen_color_texture", "sheen_roughness_texture"};
+    for (int k = 0; k < 5; k++)
+      if ((st = check_texture_ref(refs[k], s->texture_count, names[k], file, element, err))) return st;
+  }
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,
                            element, err);
 }
@@ -339,6 +388,19 @@ static iris_status validate_mesh(const iris_scene *s, const iris_mesh *m, const 
     FAIL("uv of vertex %zu is not finite", bad / 2);
   if (m->colors && (bad = first_nonfinite(m->colors, 3 * nv)) < 3 * nv)
     FAIL("color of vertex %zu is not finite", bad / 3);
+  if (m->uvs1 && (bad = first_nonfinite(m->uvs1, 2 * nv)) < 2 * nv)
+    FAIL("uv1 of vertex %zu is not finite", bad / 2);
+  if (m->alphas)
+    for (size_t v = 0; v < nv; v++)
+      if (!(m->alphas[v] >= 0.0f && m->alphas[v] <= 1.0f)) FAIL("alpha of vertex %zu is not in [0, 1]", v);
+  if (m->tangents) {
+    if (!m->normals) FAIL("mesh has tangents but no normals");
+    if ((bad = first_nonfinite(m->tangents, 4 * nv)) < 4 * nv)
+      FAIL("tangent of vertex %zu is not finite", bad / 4);
+    for (size_t v = 0; v < nv; v++)
+      if (m->tangents[4 * v + 3] != 1.0f && m->tangents[4 * v + 3] != -1.0f)
+        FAIL("tangent of vertex %zu: w %g is not +1 or -1", v, (double)m->tangents[4 * v + 3]);
+  }
   size_t ni = 3 * (size_t)m->triangle_count;
   for (size_t i = 0; i < ni; i++)
     if (m->indices[i] >= m->vertex_count)
@@ -382,6 +444,9 @@ iris_status iris_scene_validate(const iris_scene *s, const char *file, iris_erro
     if (t->data && t->data_size == 0) FAIL("texture data is empty");
     if ((unsigned)t->wrap_s > IRIS_WRAP_MIRROR || (unsigned)t->wrap_t > IRIS_WRAP_MIRROR)
       FAIL("unknown wrap mode");
+    if (t->uv_set > 1) FAIL("uv_set %u is not 0 or 1", (unsigned)t->uv_set);
+    if (t->has_transform && !(finite_n(t->offset, 2) && isfinite(t->rotation) && finite_n(t->scale, 2)))
+      FAIL("transform is not finite");
     if (t->data && strcmp(t->mime, "image/png") != 0 && strcmp(t->mime, "image/jpeg") != 0)
       FAIL("unsupported image type '%.16s' (PNG and JPEG are supported)", t->mime);
   }

@@ -35,6 +35,13 @@ typedef struct iris_texture {
   char mime[16];        /* "image/png" or "image/jpeg" */
   iris_wrap wrap_s, wrap_t;
   bool nearest;         /* magnification filter NEAREST instead of bilinear */
+  /* Where the image lies on the surface (glTF textureInfo.texCoord and
+   * KHR_texture_transform): uv' = T(offset) R(rotation) S(scale) uv of set
+   * `uv_set`, i.e. u' = ox + c sx u + s sy v, v' = oy - s sx u + c sy v with
+   * c, s = cos, sin(rotation). Defaults: set 0, identity. */
+  uint8_t uv_set;       /* 0: mesh uvs, 1: mesh uvs1 (the uvs when a mesh has no uvs1) */
+  bool has_transform;   /* false: offset 0, rotation 0, scale 1 (not read) */
+  float offset[2], rotation, scale[2];
 } iris_texture;
 
 /* ---- materials --------------------------------------------------------- */
@@ -45,6 +52,14 @@ typedef enum iris_material_type {
   IRIS_MATERIAL_GLASS,       /* dielectric, exact Fresnel, GGX if rough    <-> Glass BSDF (GGX) */
   IRIS_MATERIAL_GLTF         /* glTF 2.0 metallic-roughness (Appendix B)   <-> Principled BSDF */
 } iris_material_type;
+
+/* glTF alphaMode: how the coverage alpha = `alpha` x colour texture alpha x
+ * vertex alpha is used (docs/materials.md, "Alpha"). */
+typedef enum iris_alpha_mode {
+  IRIS_ALPHA_OPAQUE = 0, /* alpha ignored */
+  IRIS_ALPHA_MASK,       /* the surface exists where alpha >= alpha_cutoff */
+  IRIS_ALPHA_BLEND       /* rays pass through with probability 1 - alpha */
+} iris_alpha_mode;
 
 typedef struct iris_material {
   char *name;
@@ -62,6 +77,26 @@ typedef struct iris_material {
   int32_t emission_texture;/* multiplies emission (sRGB-decoded); -1 none */
   bool emission_two_sided; /* true: emits from both faces (Cycles' behaviour) */
   bool double_sided;       /* glTF doubleSided (informational for back-face shading) */
+  int32_t normal_texture;  /* tangent-space normal map (linear, glTF convention), -1 none;
+                              used on meshes with tangents */
+  float normal_scale;      /* glTF normalTexture.scale: scales the map's x and y (1 default) */
+  iris_alpha_mode alpha_mode;
+  float alpha;             /* glTF baseColorFactor.a, [0, 1] (1 default) */
+  float alpha_cutoff;      /* MASK threshold, >= 0 (0.5 default) */
+  /* gltf KHR_materials_clearcoat: factor x texture R, roughness x texture G,
+   * the coat's own normal map (else the coat follows the unmapped normal) */
+  float clearcoat, clearcoat_roughness;
+  int32_t clearcoat_texture, clearcoat_roughness_texture, clearcoat_normal_texture;
+  float clearcoat_normal_scale;
+  /* gltf KHR_materials_sheen: colour x texture RGB (sRGB), roughness x texture A */
+  float sheen_color[3];
+  float sheen_roughness;
+  int32_t sheen_color_texture, sheen_roughness_texture;
+  /* gltf KHR_materials_volume: Beer-Lambert absorption inside the (closed,
+   * transmissive) mesh, sigma = -ln(attenuation_color) / attenuation_distance;
+   * distance 0 = no attenuation (the extension's infinity) */
+  float attenuation_color[3];
+  float attenuation_distance;
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */
@@ -77,6 +112,12 @@ typedef struct iris_mesh {
   float *normals;     /* 3 * vertex_count or NULL */
   float *uvs;         /* 2 * vertex_count or NULL (glTF convention: v down, (0,0) top-left of the image) */
   float *colors;      /* 3 * vertex_count or NULL (linear RGB) */
+  float *uvs1;        /* 2 * vertex_count or NULL: a second uv set (glTF TEXCOORD_1) */
+  float *tangents;    /* 4 * vertex_count or NULL: xyz unit tangent along +u, w = +-1 the
+                         bitangent sign, B = w (N x T) (glTF TANGENT or generated; only
+                         with normals, for normal maps) */
+  float *alphas;      /* vertex_count or NULL: vertex alpha in [0, 1] (glTF COLOR_0.a; only for
+                         MASK/BLEND materials) */
   uint32_t *indices;  /* 3 * triangle_count, counter-clockwise = front */
   int32_t material;   /* index or -1 for the default material (diffuse 0.8) */
   bool owned;

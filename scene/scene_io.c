@@ -27,7 +27,10 @@
 static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
 static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
 static const char *const WRAP_MODES[] = {"repeat", "clamp", "mirror"};
-static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors"};
+/* In IRIS_MESH_HAS_* bit order. */
+static const char *const ATTRIBUTE_NAMES[] = {"normals", "uvs", "colors", "uvs1", "tangents", "alphas"};
+#define ATTRIBUTE_COUNT 6
+static const char *const ALPHA_MODES[] = {"opaque", "mask", "blend"};
 
 /* ====================================================================== */
 /* Numbers                                                                 */
@@ -185,12 +188,35 @@ static cJSON *write_material(const iris_material *m) {
     if (!floats_equal(m->specular_color, d.specular_color, 3))
       add_floats(o, "specular_color", m->specular_color, 3);
     if (m->transmission != d.transmission) add_float(o, "transmission", m->transmission);
+    if (m->clearcoat != d.clearcoat) add_float(o, "clearcoat", m->clearcoat);
+    if (m->clearcoat_roughness != d.clearcoat_roughness) add_float(o, "clearcoat_roughness", m->clearcoat_roughness);
+    if (m->clearcoat_texture >= 0) cJSON_AddNumberToObject(o, "clearcoat_texture", m->clearcoat_texture);
+    if (m->clearcoat_roughness_texture >= 0)
+      cJSON_AddNumberToObject(o, "clearcoat_roughness_texture", m->clearcoat_roughness_texture);
+    if (m->clearcoat_normal_texture >= 0)
+      cJSON_AddNumberToObject(o, "clearcoat_normal_texture", m->clearcoat_normal_texture);
+    if (m->clearcoat_normal_scale != d.clearcoat_normal_scale)
+      add_float(o, "clearcoat_normal_scale", m->clearcoat_normal_scale);
+    if (!floats_equal(m->sheen_color, d.sheen_color, 3)) add_floats(o, "sheen_color", m->sheen_color, 3);
+    if (m->sheen_roughness != d.sheen_roughness) add_float(o, "sheen_roughness", m->sheen_roughness);
+    if (m->sheen_color_texture >= 0) cJSON_AddNumberToObject(o, "sheen_color_texture", m->sheen_color_texture);
+    if (m->sheen_roughness_texture >= 0)
+      cJSON_AddNumberToObject(o, "sheen_roughness_texture", m->sheen_roughness_texture);
+    if (!floats_equal(m->attenuation_color, d.attenuation_color, 3))
+      add_floats(o, "attenuation_color", m->attenuation_color, 3);
+    if (m->attenuation_distance != d.attenuation_distance)
+      add_float(o, "attenuation_distance", m->attenuation_distance);
   }
   if (!floats_equal(m->emission, d.emission, 3)) add_floats(o, "emission", m->emission, 3);
   if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
   if (m->emission_two_sided != d.emission_two_sided)
     cJSON_AddBoolToObject(o, "emission_two_sided", m->emission_two_sided);
   if (m->double_sided != d.double_sided) cJSON_AddBoolToObject(o, "double_sided", m->double_sided);
+  if (m->normal_texture >= 0) cJSON_AddNumberToObject(o, "normal_texture", m->normal_texture);
+  if (m->normal_scale != d.normal_scale) add_float(o, "normal_scale", m->normal_scale);
+  if (m->alpha_mode != IRIS_ALPHA_OPAQUE) cJSON_AddStringToObject(o, "alpha_mode", ALPHA_MODES[m->alpha_mode]);
+  if (m->alpha != d.alpha) add_float(o, "alpha", m->alpha);
+  if (m->alpha_cutoff != d.alpha_cutoff) add_float(o, "alpha_cutoff", m->alpha_cutoff);
   return o;
 }
 
@@ -309,6 +335,13 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
       if (t->wrap_s != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_s", WRAP_MODES[t->wrap_s]);
       if (t->wrap_t != IRIS_WRAP_REPEAT) cJSON_AddStringToObject(o, "wrap_t", WRAP_MODES[t->wrap_t]);
       if (t->nearest) cJSON_AddStringToObject(o, "filter", "nearest");
+      if (t->uv_set) cJSON_AddNumberToObject(o, "uv_set", t->uv_set);
+      if (t->has_transform) {
+        cJSON *x = cJSON_AddObjectToObject(o, "transform");
+        add_floats(x, "offset", t->offset, 2);
+        add_float(x, "rotation", t->rotation);
+        add_floats(x, "scale", t->scale, 2);
+      }
       cJSON_AddItemToArray(a, o);
     }
   }
@@ -335,8 +368,8 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
     cJSON_AddNumberToObject(o, "vertices", m->vertex_count);
     cJSON_AddNumberToObject(o, "triangles", m->triangle_count);
     cJSON *attrs = cJSON_AddArrayToObject(o, "attributes");
-    const void *present[3] = {m->normals, m->uvs, m->colors};
-    for (int k = 0; k < 3; k++)
+    const void *present[ATTRIBUTE_COUNT] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents, m->alphas};
+    for (int k = 0; k < ATTRIBUTE_COUNT; k++)
       if (present[k]) cJSON_AddItemToArray(attrs, cJSON_CreateString(ATTRIBUTE_NAMES[k]));
     cJSON_AddItemToArray(meshes, o);
   }
@@ -624,7 +657,13 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   static const char *const keys[] = {"name", "type", "color", "color_texture", "roughness", "ior",
                                      "metallic", "metallic_roughness_texture", "specular",
                                      "specular_color", "transmission", "emission", "emission_texture",
-                                     "emission_two_sided", "double_sided"};
+                                     "emission_two_sided", "double_sided", "normal_texture",
+                                     "normal_scale", "alpha_mode", "alpha", "alpha_cutoff", "clearcoat",
+                                     "clearcoat_roughness", "clearcoat_texture",
+                                     "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                                     "clearcoat_normal_scale", "sheen_color", "sheen_roughness",
+                                     "sheen_color_texture", "sheen_roughness_texture",
+                                     "attenuation_color", "attenuation_distance"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -637,7 +676,12 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     const char *key;
     unsigned types; /* bit per iris_material_type */
   } applies[] = {{"roughness", 0xE}, {"ior", 0xC}, {"metallic", 0x8}, {"metallic_roughness_texture", 0x8},
-                 {"specular", 0x8}, {"specular_color", 0x8}, {"transmission", 0x8}};
+                 {"specular", 0x8}, {"specular_color", 0x8}, {"transmission", 0x8},
+                 {"clearcoat", 0x8}, {"clearcoat_roughness", 0x8}, {"clearcoat_texture", 0x8},
+                 {"clearcoat_roughness_texture", 0x8}, {"clearcoat_normal_texture", 0x8},
+                 {"clearcoat_normal_scale", 0x8}, {"sheen_color", 0x8}, {"sheen_roughness", 0x8},
+                 {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8},
+                 {"attenuation_color", 0x8}, {"attenuation_distance", 0x8}};
   for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
     if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
       iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
@@ -656,6 +700,13 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   TRY(get_i32(c, o, "emission_texture", -1, INT32_MAX, &full.emission_texture));
   TRY(get_bool(c, o, "emission_two_sided", &full.emission_two_sided));
   TRY(get_bool(c, o, "double_sided", &full.double_sided));
+  TRY(get_i32(c, o, "normal_texture", -1, INT32_MAX, &m->normal_texture));
+  TRY(get_float(c, o, "normal_scale", &m->normal_scale));
+  int alpha_mode = IRIS_ALPHA_OPAQUE;
+  TRY(get_enum(c, o, "alpha_mode", ALPHA_MODES, 3, &alpha_mode));
+  m->alpha_mode = (iris_alpha_mode)alpha_mode;
+  TRY(get_float(c, o, "alpha", &m->alpha));
+  TRY(get_float(c, o, "alpha_cutoff", &m->alpha_cutoff));
   memcpy(m->color, full.color, sizeof m->color);
   m->color_texture = full.color_texture;
   if (type != IRIS_MATERIAL_DIFFUSE) m->roughness = full.roughness;
@@ -666,6 +717,20 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     m->specular = full.specular;
     memcpy(m->specular_color, full.specular_color, sizeof m->specular_color);
     m->transmission = full.transmission;
+  }
+  if (type == IRIS_MATERIAL_GLTF) {
+    TRY(get_float(c, o, "clearcoat", &m->clearcoat));
+    TRY(get_float(c, o, "clearcoat_roughness", &m->clearcoat_roughness));
+    TRY(get_i32(c, o, "clearcoat_texture", -1, INT32_MAX, &m->clearcoat_texture));
+    TRY(get_i32(c, o, "clearcoat_roughness_texture", -1, INT32_MAX, &m->clearcoat_roughness_texture));
+    TRY(get_i32(c, o, "clearcoat_normal_texture", -1, INT32_MAX, &m->clearcoat_normal_texture));
+    TRY(get_float(c, o, "clearcoat_normal_scale", &m->clearcoat_normal_scale));
+    TRY(get_floats(c, o, "sheen_color", m->sheen_color, 3));
+    TRY(get_float(c, o, "sheen_roughness", &m->sheen_roughness));
+    TRY(get_i32(c, o, "sheen_color_texture", -1, INT32_MAX, &m->sheen_color_texture));
+    TRY(get_i32(c, o, "sheen_roughness_texture", -1, INT32_MAX, &m->sheen_roughness_texture));
+    TRY(get_floats(c, o, "attenuation_color", m->attenuation_color, 3));
+    TRY(get_float(c, o, "attenuation_distance", &m->attenuation_distance));
   }
   memcpy(m->emission, full.emission, sizeof m->emission);
   m->emission_texture = full.emission_texture;
@@ -695,7 +760,7 @@ static iris_status load_texture_file(jctx *c, const char *dir, const char *file,
 }
 
 static iris_status load_texture(jctx *c, const cJSON *o, const char *dir, iris_texture *t) {
-  static const char *const keys[] = {"name", "file", "wrap_s", "wrap_t", "filter"};
+  static const char *const keys[] = {"name", "file", "wrap_s", "wrap_t", "filter", "uv_set", "transform"};
   static const char *const filters[] = {"linear", "nearest"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(get_name(c, o, &t->name));
@@ -706,6 +771,19 @@ static iris_status load_texture(jctx *c, const cJSON *o, const char *dir, iris_t
   t->wrap_s = (iris_wrap)ws;
   t->wrap_t = (iris_wrap)wt;
   t->nearest = filter == 1;
+  int32_t uv_set = 0;
+  TRY(get_i32(c, o, "uv_set", 0, 1, &uv_set));
+  t->uv_set = (uint8_t)uv_set;
+  const cJSON *x = item(o, "transform");
+  if (x) {
+    static const char *const xkeys[] = {"offset", "rotation", "scale"};
+    TRY(check_keys(c, x, xkeys, sizeof xkeys / sizeof *xkeys));
+    t->has_transform = true;
+    t->scale[0] = t->scale[1] = 1.0f;
+    TRY(get_floats(c, x, "offset", t->offset, 2));
+    TRY(get_float(c, x, "rotation", &t->rotation));
+    TRY(get_floats(c, x, "scale", t->scale, 2));
+  }
   TRY(require(c, o, "file"));
   const char *file = NULL;
   TRY(get_string(c, o, "file", &file));
@@ -740,10 +818,11 @@ static iris_status load_mesh_desc(jctx *c, const cJSON *o, iris_mesh *m, mesh_de
     d->attributes = 0;
     for (const cJSON *e = a->child; e; e = e->next) {
       int k = 0;
-      while (k < 3 && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
-      if (k == 3)
+      while (k < ATTRIBUTE_COUNT && !(cJSON_IsString(e) && strcmp(e->valuestring, ATTRIBUTE_NAMES[k]) == 0)) k++;
+      if (k == ATTRIBUTE_COUNT)
         return jfail(c, IRIS_ERR_INVALID,
-                     "'attributes' entries must be \"normals\", \"uvs\" or \"colors\"");
+                     "'attributes' entries must be \"normals\", \"uvs\", \"colors\", \"uvs1\", "
+                     "\"tangents\" or \"alphas\"");
       if (d->attributes & (1 << k)) return jfail(c, IRIS_ERR_INVALID, "'%s' listed twice in 'attributes'", ATTRIBUTE_NAMES[k]);
       d->attributes |= 1 << k;
     }

@@ -15,7 +15,8 @@
 static const char *const CMD = "info";
 static const char *const MATERIAL_TYPES[] = {"diffuse", "glossy", "glass", "gltf"};
 static const char *const LIGHT_TYPES[] = {"point", "spot", "directional"};
-static const char *const ATTRIBUTES[] = {"normals", "uvs", "colors"};
+static const char *const ATTRIBUTES[] = {"normals", "uvs", "colors", "uvs1", "tangents", "alphas"};
+static const int ATTRIBUTE_BYTES[] = {12, 8, 12, 8, 16, 4};
 
 static void print_help(void) {
   printf("Usage: iris info FILE [--json]\n"
@@ -36,7 +37,7 @@ static void print_help(void) {
 typedef struct scene_stats {
   uint64_t vertices, triangles, world_triangles, emissive_world_triangles;
   uint64_t mesh_bytes, texture_bytes;
-  size_t materials_by_type[4], lights_by_type[3], meshes_with[3];
+  size_t materials_by_type[4], lights_by_type[3], meshes_with[6];
   size_t embedded_textures;
   bool has_bounds;
   iris_vec3 lo, hi;
@@ -53,12 +54,12 @@ static scene_stats compute_stats(const iris_scene *s) {
     const iris_mesh *m = &s->meshes[i];
     st.vertices += m->vertex_count;
     st.triangles += m->triangle_count;
-    const void *attrs[3] = {m->normals, m->uvs, m->colors};
+    const void *attrs[6] = {m->normals, m->uvs, m->colors, m->uvs1, m->tangents, m->alphas};
     uint64_t per_vertex = 12;
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 6; k++)
       if (attrs[k]) {
         st.meshes_with[k]++;
-        per_vertex += k == 1 ? 8 : 12;
+        per_vertex += (uint64_t)ATTRIBUTE_BYTES[k];
       }
     st.mesh_bytes += per_vertex * m->vertex_count + 12ull * m->triangle_count;
   }
@@ -97,7 +98,7 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
   cJSON_AddNumberToObject(meshes, "triangles", (double)st->triangles);
   cJSON_AddNumberToObject(meshes, "bytes", (double)st->mesh_bytes);
   cJSON *with = cJSON_AddObjectToObject(meshes, "with_attribute");
-  for (int k = 0; k < 3; k++) cJSON_AddNumberToObject(with, ATTRIBUTES[k], (double)st->meshes_with[k]);
+  for (int k = 0; k < 6; k++) cJSON_AddNumberToObject(with, ATTRIBUTES[k], (double)st->meshes_with[k]);
   cJSON *inst = cJSON_AddObjectToObject(o, "instances");
   cJSON_AddNumberToObject(inst, "count", (double)s->instance_count);
   cJSON_AddNumberToObject(inst, "world_triangles", (double)st->world_triangles);
@@ -168,8 +169,11 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
   printf("units        %s\n", s->units);
   printf("meshes       %zu (%llu vertices, %llu triangles)\n", s->mesh_count,
          (unsigned long long)st->vertices, (unsigned long long)st->triangles);
-  printf("attributes   normals %zu, uvs %zu, colors %zu of %zu meshes\n", st->meshes_with[0],
-         st->meshes_with[1], st->meshes_with[2], s->mesh_count);
+  printf("attributes   normals %zu, uvs %zu, colors %zu", st->meshes_with[0], st->meshes_with[1],
+         st->meshes_with[2]);
+  if (st->meshes_with[3] || st->meshes_with[4] || st->meshes_with[5]) /* only scenes that have them */
+    printf(", uvs1 %zu, tangents %zu, alphas %zu", st->meshes_with[3], st->meshes_with[4], st->meshes_with[5]);
+  printf(" of %zu meshes\n", s->mesh_count);
   printf("instances    %zu (%llu triangles in the world, %llu emissive)\n", s->instance_count,
          (unsigned long long)st->world_triangles, (unsigned long long)st->emissive_world_triangles);
   printf("materials    %zu (diffuse %zu, glossy %zu, glass %zu, gltf %zu)\n", s->material_count,

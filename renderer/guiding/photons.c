@@ -83,6 +83,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
     if (!iris_accel_intersect(s->accel, &ray, &hit)) return;
     iris_interaction si;
     iris_accel_interaction(s->accel, ray.d, &hit, &si);
+    if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(s->integrator, &si, hit.t * iris_length(ray.d)));
     iris_vec3 wo = iris_normalize(iris_neg(ray.d));
     iris_shading_point sp;
     iris_integrator_shade(s->integrator, &si, wo, bounce, &sp);

@@ -9,6 +9,14 @@
  *    noise-free): point, spot (glTF falloff) and sun on a Lambert plane against
  *    rho/pi I cos/d^2 and rho/pi E cos; light0 has its mesh data embedded and a
  *    shading normal tilted 16.7 degrees from the geometric one (custom normals).
+ *  - scene "features" (glTF features, same environment and camera): the checker
+ *    texture read through the second uv set with a KHR_texture_transform offset
+ *    of (0.5, 0.5) (quadrants swapped diagonally; the first uv set points at one
+ *    texel, so reading it would show a single colour); a Lambert quad of albedo
+ *    0.5 with alphaMode MASK, cutoff 0.25 and a vertex-alpha ramp 0 -> 1 across
+ *    x (its left quarter cut: 1/6 E + 5/6 x 0.5 E over the 12x12 interior that
+ *    is averaged); one with BLEND, alpha 0.5
+ *    (0.5 E + 0.5 x 0.5 E).
  * SKIPs (exit 77) when `blender` is not installed. */
 #include <math.h>
 #include <stdio.h>
@@ -206,6 +214,62 @@ static iris_scene *cells_scene(void) {
   return s;
 }
 
+static iris_scene *features_scene(void) {
+  iris_scene *s = iris_scene_create();
+  s->has_environment = true;
+  memcpy(s->environment, ENV, sizeof ENV);
+  fixture_add_top_camera(s, CAM_Z, HALF, 1.0f);
+  iris_material white = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  white.color[0] = white.color[1] = white.color[2] = 1.0f;
+  int32_t tex = add_checker_texture(s);
+  s->textures[tex].uv_set = 1;
+  s->textures[tex].has_transform = true;
+  s->textures[tex].offset[0] = s->textures[tex].offset[1] = 0.5f;
+  s->textures[tex].scale[0] = s->textures[tex].scale[1] = 1.0f;
+  iris_material textured = white;
+  textured.color_texture = tex;
+  fixture_quad t = {0};
+  t.cx = -0.5f, t.cy = -0.5f, t.hx = t.hy = 0.5f, t.uvs = true, t.normals = true;
+  t.material = add_material(s, textured, "placed");
+  int32_t tq = fixture_add_quad(s, "placed", &t);
+  iris_mesh *m = &s->meshes[tq];
+  m->uvs1 = m->uvs;
+  m->uvs = malloc(8 * sizeof(float));
+  for (int i = 0; i < 8; i++) m->uvs[i] = 0.25f; /* set 0: the red texel only */
+  fixture_add_instance(s, tq, 0, 0, 0);
+  iris_material half = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  half.color[0] = half.color[1] = half.color[2] = 0.5f;
+  iris_material mask = half, blend = half;
+  mask.alpha_mode = IRIS_ALPHA_MASK, mask.alpha_cutoff = 0.25f;
+  blend.alpha_mode = IRIS_ALPHA_BLEND, blend.alpha = 0.5f;
+  fixture_quad q = {0};
+  q.hx = q.hy = 0.25f;
+  q.cx = cell_x(0), q.cy = cell_y(0), q.material = add_material(s, mask, "mask");
+  int32_t mq = fixture_add_quad(s, "mask", &q);
+  s->meshes[mq].alphas = malloc(4 * sizeof(float));
+  const float ramp[4] = {0, 1, 1, 0}; /* corners bottom-left, bottom-right, top-right, top-left */
+  memcpy(s->meshes[mq].alphas, ramp, sizeof ramp);
+  fixture_add_instance(s, mq, 0, 0, 0);
+  q.cx = cell_x(1), q.material = add_material(s, blend, "blend");
+  fixture_add_instance(s, fixture_add_quad(s, "blend", &q), 0, 0, 0);
+  return s;
+}
+
+static void check_features(const iris_image *img) {
+  const double rel = 0.03;
+  const float texel[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
+  for (int c = 0; c < 3; c++) {
+    for (int k = 0; k < 4; k++) { /* quadrant k shows texel 3 - k */
+      double m = cell_mean(img, k % 2, 2 + k / 2, c), want = texel[3 - k][c] * ENV[c];
+      CHECK_NEAR(m, want, rel * ENV[c]);
+    }
+    /* MASK: the cut part x < 1/4 of the quad is 2 of the 12 interior columns
+     * cell_mean averages (pixels 2..13 of 16): 1/6 E + 5/6 x 0.5 E */
+    CHECK_NEAR(cell_mean(img, 0, 0, c), (1.0 / 6.0 + 5.0 / 12.0) * ENV[c], rel * ENV[c]);
+    CHECK_NEAR(cell_mean(img, 1, 0, c), 0.75 * ENV[c], 2 * rel * ENV[c]); /* BLEND (stochastic) */
+  }
+}
+
 static void check_cells(const iris_image *img) {
   const double rel = 0.03; /* 16 spp x 144 pixels of a noisy environment estimate */
   for (int c = 0; c < 3; c++) {
@@ -367,6 +431,17 @@ int main(void) {
   snprintf(exr, sizeof exr, "%s/cells.exr", g_dir);
   iris_image img = {0};
   if (render(script, exr, 16) && load(exr, &img)) check_cells(&img);
+  iris_image_destroy(&img);
+  iris_scene_destroy(s);
+
+  /* 1b. glTF features: second uv set, texture transform, MASK and BLEND alpha. */
+  s = features_scene();
+  snprintf(script, sizeof script, "%s/features.py", g_dir);
+  iris_error_clear(&err);
+  CHECK_OK(iris_export_blender(s, script, &p, &err), &err);
+  snprintf(exr, sizeof exr, "%s/features.exr", g_dir);
+  memset(&img, 0, sizeof img);
+  if (render(script, exr, 32) && load(exr, &img)) check_features(&img);
   iris_image_destroy(&img);
   iris_scene_destroy(s);
 

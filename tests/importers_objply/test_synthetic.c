@@ -208,6 +208,38 @@ static void ply_cases(void) {
   const char *zero = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
                      "element face 0\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n";
   expect_reject("ply", zero, strlen(zero), 0, "point cloud");
+  /* element tristrips (Stanford tools): a 2x3 grid of vertices, z = 0,
+   *   3 4 5
+   *   0 1 2
+   * strip 0 3 1 4 2 5, then -1 restarts with 5 4 (too short: nothing), then
+   * 0 1 1 (a padding triangle with a repeated vertex: skipped).
+   * Triangles: (0,3,1) (3,1,4)->(1,3,4) (1,4,2) (4,2,5)->(2,4,5): all with the
+   * first one's orientation, whose normal is -z ((3-0) x (1-0) = y x x = -z). */
+  const char *strips =
+      "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n12 0 3 1 4 2 5 -1 5 4 -1 0 1 1\n";
+  s = load("ply", strips, strlen(strips), &st, &err);
+  CHECK_OK(st, &err);
+  if (s) {
+    const iris_mesh *m = &s->meshes[0];
+    CHECK_EQ_INT(m->triangle_count, 4);
+    const uint32_t want[12] = {0, 3, 1, 1, 3, 4, 1, 4, 2, 2, 4, 5};
+    if (m->triangle_count == 4) CHECK(memcmp(m->indices, want, sizeof want) == 0);
+    double nsum[3];
+    CHECK_NEAR(objply_mesh_area(m, nsum), 2.0, 1e-9); /* the whole 2x1 grid, no overlap */
+    CHECK_NEAR(nsum[2], -2.0, 1e-9);                   /* one orientation throughout */
+    iris_scene_destroy(s);
+  }
+  /* Strip index out of range (-2 is not a restart) and an only-strips point cloud. */
+  const char *bad_strip =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -2\n";
+  expect_reject("ply", bad_strip, strlen(bad_strip), 13, "out of range");
+  const char *no_strips =
+      "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 0\nproperty list int int vertex_indices\nend_header\n0 0 0\n";
+  expect_reject("ply", no_strips, strlen(no_strips), 0, "point cloud");
   /* ASCII truncated mid-row, with its line number (line 12 is the cut row). */
   const char *cut = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                     "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1";

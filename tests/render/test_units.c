@@ -8,6 +8,7 @@
 #include "chi2.h"
 #include "renderer/accel.h"
 #include "renderer/camera.h"
+#include "renderer/normal_map.h"
 #include "renderer/texture.h"
 #include "scenes/builtin.h"
 
@@ -28,7 +29,9 @@ static void test_lookup(void) {
   iris_textures tex;
   memset(&tex, 0, sizeof tex);
   for (int i = 0; i < 256; i++) tex.srgb_table[i] = iris_srgb_to_linear((float)i / 255.0f);
-  iris_texture_image img = {2, 1, px, IRIS_WRAP_CLAMP, IRIS_WRAP_CLAMP, false};
+  iris_texture_image img;
+  memset(&img, 0, sizeof img);
+  img.width = 2, img.height = 1, img.rgba = px, img.wrap_s = img.wrap_t = IRIS_WRAP_CLAMP;
   tex.images = &img;
   tex.count = 1;
   float c[4];
@@ -43,6 +46,27 @@ static void test_lookup(void) {
   CHECK_NEAR(c[0], 0.0, 1e-6);
   iris_texture_lookup(&tex, 0, 0.0f, 0.5f, true, c); /* clamp: the edge texel */
   CHECK_NEAR(c[0], 0.0, 1e-6);
+  /* clamp is not periodic: u = -0.5 and -3.5 read the left edge, 1.5 the right one */
+  iris_texture_lookup(&tex, 0, -0.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 0.0, 1e-6);
+  iris_texture_lookup(&tex, 0, -3.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 0.0, 1e-6);
+  iris_texture_lookup(&tex, 0, 1.5f, 0.5f, false, c);
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  /* uv set and transform: set 1 with offset (0.5, 0) reads u1 + 0.5 */
+  img.uv_set = 1;
+  iris_texture tdesc;
+  memset(&tdesc, 0, sizeof tdesc);
+  tdesc.has_transform = true, tdesc.offset[0] = 0.5f, tdesc.scale[0] = tdesc.scale[1] = 1.0f;
+  img.has_transform = true;
+  iris_texture_transform_matrix(&tdesc, img.xf);
+  const float uv0[2] = {0.5f, 0.5f}, uv1[2] = {0.25f, 0.5f};
+  iris_texture_sample(&tex, 0, uv0, uv1, false, c); /* u = 0.75: the white texel's centre */
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  img.uv_set = 0;
+  iris_texture_sample(&tex, 0, uv1, uv0, false, c); /* set 0 = (0.25, 0.5) + 0.5 */
+  CHECK_NEAR(c[0], 1.0, 1e-6);
+  img.uv_set = 0, img.has_transform = false;
   img.wrap_s = IRIS_WRAP_REPEAT; /* repeat: u = 0 is halfway between last and first */
   iris_texture_lookup(&tex, 0, 0.0f, 0.5f, false, c);
   CHECK_NEAR(c[0], 0.5, 1e-6);
@@ -53,6 +77,76 @@ static void test_lookup(void) {
   CHECK_NEAR(c[0], 1.0, 1e-6);
   iris_texture_lookup(&tex, 7, 0.6f, 0.5f, false, c); /* out of range: white */
   CHECK_NEAR(c[0], 1.0, 1e-6);
+}
+
+/* KHR_texture_transform against the Khronos TextureTransformTest model's markers:
+ * each quad spans uv (0,0)-(1,1) over its local [-0.5, 0.5]^2 (u = x + 0.5,
+ * v = 0.5 - y); the arrow's tip is at texture uv (0.7778, 0.7778) (the "not
+ * supported" marker, local (0.2778, -0.2778)); with the right transform the tip
+ * shows at the "correct" marker, with the rotation reversed at the "error" one. */
+static void test_texture_transform(void) {
+  const float tip[2] = {0.77781746f, 0.77781746f};
+  struct {
+    float offset[2], rotation, scale[2];
+    float x, y;   /* marker's local position */
+    double tol;   /* the marker quads are 0.1-0.15 wide */
+    bool hit;
+  } cases[] = {
+      {{0, 0}, 0.39269908f, {1, 1}, -0.07904822f, -0.51626749f, 1e-4, true},   /* Rotation - Correct */
+      {{0, 0}, 0.39269908f, {1, 1}, 0.51626749f, 0.07904822f, 0.1, false},     /* Rotation - Error */
+      {{0, 0}, 0, {1.5f, 1.5f}, 0.01854497f, -0.01854497f, 1e-4, true},        /* Scale - Correct */
+      {{-0.2f, -0.1f}, 0.3f, {1.5f, 1.5f}, -0.07f, -0.25f, 0.05, true},        /* All - Correct */
+  };
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
+    iris_texture t;
+    memset(&t, 0, sizeof t);
+    t.has_transform = true;
+    memcpy(t.offset, cases[i].offset, sizeof t.offset);
+    t.rotation = cases[i].rotation;
+    memcpy(t.scale, cases[i].scale, sizeof t.scale);
+    float xf[2][3];
+    iris_texture_transform_matrix(&t, xf);
+    float u = cases[i].x + 0.5f, v = 0.5f - cases[i].y;
+    float tu = xf[0][0] * u + xf[0][1] * v + xf[0][2], tv = xf[1][0] * u + xf[1][1] * v + xf[1][2];
+    double dist = hypot(tu - tip[0], tv - tip[1]);
+    if (cases[i].hit) {
+      if (!CHECK(dist < cases[i].tol)) printf("  case %zu: tip at (%g, %g), distance %g\n", i, tu, tv, dist);
+    } else {
+      CHECK(dist > cases[i].tol);
+    }
+  }
+}
+
+/* Normal maps: the flat texel (0.5, 0.5, 1) gives N back; x along T, y along B;
+ * a normal bent so far that wo's mirror image would go below the surface is
+ * pulled back just enough (reflection height = min(0.9 cos, 0.01)), and valid
+ * ones are kept. */
+static void test_normal_map(void) {
+  iris_vec3 t = iris_v3(1, 0, 0), b = iris_v3(0, 1, 0), n = iris_v3(0, 0, 1);
+  const float flat[3] = {0.5f, 0.5f, 1.0f}, tilt[3] = {1.0f, 0.5f, 0.5f + 0.5f * 1.0f};
+  iris_vec3 r = iris_normal_map_apply(t, b, n, flat, 1.0f);
+  CHECK(fabsf(r.z - 1.0f) < 1e-6f);
+  r = iris_normal_map_apply(t, b, n, tilt, 1.0f); /* (1, 0, 1) normalised */
+  CHECK(fabsf(r.x - 0.70710678f) < 1e-5f && fabsf(r.z - 0.70710678f) < 1e-5f);
+  r = iris_normal_map_apply(t, b, n, tilt, 0.0f); /* scale 0: flat */
+  CHECK(fabsf(r.z - 1.0f) < 1e-6f);
+  iris_vec3 ng = iris_v3(0, 0, 1);
+  for (int i = 0; i < 200; i++) {
+    float th = 0.05f + 1.4f * (float)i / 200.0f, ph = 0.7f * (float)i;
+    iris_vec3 wo = iris_v3(sinf(th) * cosf(ph), sinf(th) * sinf(ph), cosf(th));
+    float bend = 1.5f * (float)((i * 37) % 200) / 200.0f;
+    iris_vec3 sn = iris_normalize(iris_v3(sinf(bend) * cosf(ph + 2.0f), sinf(bend) * sinf(ph + 2.0f), cosf(bend)));
+    iris_vec3 v = iris_normal_make_valid(ng, wo, sn);
+    iris_vec3 refl = iris_sub(iris_scale(sn, 2.0f * iris_dot(sn, wo)), wo);
+    float thr = fminf(0.9f * wo.z, 0.01f);
+    if (refl.z >= thr) {
+      CHECK(v.x == sn.x && v.y == sn.y && v.z == sn.z);
+    } else {
+      iris_vec3 rv = iris_sub(iris_scale(v, 2.0f * iris_dot(v, wo)), wo);
+      if (!CHECK(fabsf(iris_length(v) - 1.0f) < 1e-4f && rv.z >= thr - 2e-4f && v.z > 0.0f))
+        printf("  case %d: reflection height %g (threshold %g)\n", i, rv.z, thr);
+    }
+  }
 }
 
 /* One triangle in the z = 0 plane, front +z, with a vertex normal field. */
@@ -189,6 +283,8 @@ static void test_camera(void) {
 int main(void) {
   test_wrap();
   test_lookup();
+  test_texture_transform();
+  test_normal_map();
   test_instances();
   test_offsets();
   test_camera();

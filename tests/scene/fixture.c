@@ -87,6 +87,10 @@ iris_scene *fixture_rich_scene(const char *dir) {
   memset(&t, 0, sizeof t);
   t.path = iris_strdup(path);
   strcpy(t.mime, "image/png");
+  /* placed through the second uv set with a KHR_texture_transform */
+  t.uv_set = 1;
+  t.has_transform = true;
+  t.offset[0] = 0.5f, t.offset[1] = -0.1f, t.rotation = 0.39269908f, t.scale[0] = 30.0f, t.scale[1] = -30.0f;
   iris_scene_add_texture(s, &t);
 
   iris_material m = iris_material_default(IRIS_MATERIAL_DIFFUSE);
@@ -121,10 +125,20 @@ iris_scene *fixture_rich_scene(const char *dir) {
   m.emission[2] = 1e-3f;
   m.emission_texture = 0;
   m.ior = 1.33f;
+  m.normal_texture = 1;
+  m.normal_scale = 0.75f;
   iris_scene_add_material(s, &m);
 
   iris_mesh cube = fixture_cube("cube", true, true, true);
   cube.material = 1;
+  /* second uv set and tangents (w = -1 on mirrored-uv vertices) */
+  cube.uvs1 = malloc(16 * sizeof(float));
+  cube.tangents = malloc(32 * sizeof(float));
+  for (int i = 0; i < 8; i++) {
+    cube.uvs1[2 * i] = 1.0f - cube.uvs[2 * i], cube.uvs1[2 * i + 1] = cube.uvs[2 * i + 1] * 3.0f;
+    const float tg[4] = {0.6f, 0.0f, -0.8f, i % 3 ? 1.0f : -1.0f};
+    memcpy(cube.tangents + 4 * i, tg, sizeof tg);
+  }
   iris_scene_add_mesh(s, &cube);
   cube = fixture_cube(NULL, false, true, false);
   cube.material = 4;

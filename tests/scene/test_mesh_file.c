@@ -130,8 +130,8 @@ static void test_rejects(void) {
   expect_reject(b, n, &(corruption){"magic", IRIS_ERR_PARSE, "header", "bad magic"});
   memcpy(b, good, n), wr32(b + 8, 2);
   expect_reject(b, n, &(corruption){"version", IRIS_ERR_UNSUPPORTED, "header", "version 2"});
-  memcpy(b, good, n), wr32(b + 12, 2 | 8);
-  expect_reject(b, n, &(corruption){"flags", IRIS_ERR_UNSUPPORTED, "header", "flags 0x8"});
+  memcpy(b, good, n), wr32(b + 12, 2 | 64);
+  expect_reject(b, n, &(corruption){"flags", IRIS_ERR_UNSUPPORTED, "header", "flags 0x40"});
   memcpy(b, good, n), b[40] = 1;
   expect_reject(b, n, &(corruption){"reserved", IRIS_ERR_PARSE, "header", "reserved"});
   memcpy(b, good, n), wr32(b + 16, 0);

@@ -41,6 +41,13 @@ static void compare_scenes(const iris_scene *a, const iris_scene *b) {
     CHECK_EQ_INT(x->wrap_s, y->wrap_s);
     CHECK_EQ_INT(x->wrap_t, y->wrap_t);
     CHECK_EQ_INT(x->nearest, y->nearest);
+    CHECK_EQ_INT(x->uv_set, y->uv_set);
+    CHECK_EQ_INT(x->has_transform, y->has_transform);
+    if (x->has_transform && y->has_transform) {
+      CHECK(same_floats(x->offset, y->offset, 2));
+      CHECK(same_floats(&x->rotation, &y->rotation, 1));
+      CHECK(same_floats(x->scale, y->scale, 2));
+    }
   }
   for (size_t i = 0; i < a->material_count && i < b->material_count; i++) {
     const iris_material *x = &a->materials[i], *y = &b->materials[i];
@@ -51,6 +58,8 @@ static void compare_scenes(const iris_scene *a, const iris_scene *b) {
     CHECK(same_floats(x->emission, y->emission, 3));
     CHECK_EQ_INT(x->emission_texture, y->emission_texture);
     CHECK_EQ_INT(x->emission_two_sided, y->emission_two_sided);
+    CHECK_EQ_INT(x->normal_texture, y->normal_texture);
+    CHECK(same_floats(&x->normal_scale, &y->normal_scale, 1));
     CHECK_EQ_INT(x->double_sided, y->double_sided);
     if (x->type != IRIS_MATERIAL_DIFFUSE) CHECK(same_floats(&x->roughness, &y->roughness, 1));
     if (x->type == IRIS_MATERIAL_GLASS || x->type == IRIS_MATERIAL_GLTF) CHECK(same_floats(&x->ior, &y->ior, 1));
@@ -75,6 +84,9 @@ static void compare_scenes(const iris_scene *a, const iris_scene *b) {
     CHECK((!x->normals && !y->normals) || (x->normals && y->normals && memcmp(x->normals, y->normals, 12 * nv) == 0));
     CHECK((!x->uvs && !y->uvs) || (x->uvs && y->uvs && memcmp(x->uvs, y->uvs, 8 * nv) == 0));
     CHECK((!x->colors && !y->colors) || (x->colors && y->colors && memcmp(x->colors, y->colors, 12 * nv) == 0));
+    CHECK((!x->uvs1 && !y->uvs1) || (x->uvs1 && y->uvs1 && memcmp(x->uvs1, y->uvs1, 8 * nv) == 0));
+    CHECK((!x->tangents && !y->tangents) ||
+          (x->tangents && y->tangents && memcmp(x->tangents, y->tangents, 16 * nv) == 0));
     CHECK(memcmp(x->indices, y->indices, 12 * (size_t)x->triangle_count) == 0);
   }
   for (size_t i = 0; i < a->instance_count && i < b->instance_count; i++) {

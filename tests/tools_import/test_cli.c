@@ -154,6 +154,38 @@ static void test_bad_input(void) {
   EXPECT_RUN("import a.json --camera nope -o out.json", 2, "no camera named 'nope'");
   CHECK(strstr(err_text, "'front'") != NULL);
   CHECK(!exists("out.json"));
+  /* glTF: an out-of-range extension factor and a texCoord set the primitive lacks
+   * (one triangle, data URI buffer): one line "iris: FILE: ...", exit 2, no output. */
+  static const char *const head =
+      "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"byteLength\":36,\"uri\":\"data:application/"
+      "octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}],\"bufferViews\":[{\"buffer\":0,"
+      "\"byteLength\":36}],\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":"
+      "\"VEC3\"}],\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0},\"material\":0}]}],"
+      "\"nodes\":[{\"mesh\":0}],";
+  const struct {
+    const char *file, *materials, *needle;
+  } bad[] = {
+      {"sheen.gltf", "\"materials\":[{\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":2}}}]}",
+       "sheen.gltf: material 0: KHR_materials_sheen sheenRoughnessFactor 2 is not in [0, 1]"},
+      {"texcoord.gltf",
+       "\"images\":[{\"uri\":\"data:image/png;base64,iVBORw0KGgo=\"}],\"textures\":[{\"source\":0}],"
+       "\"materials\":[{\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0,\"texCoord\":1}}}]}",
+       "has no TEXCOORD_1"},
+  };
+  for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+    char path[700];
+    snprintf(path, sizeof path, "%s/%s", dir, bad[i].file);
+    FILE *f = fopen(path, "w");
+    if (!CHECK(f != NULL)) continue;
+    fprintf(f, "%s%s", head, bad[i].materials);
+    fclose(f);
+    char args[200];
+    snprintf(args, sizeof args, "import %s -o gltf-out.json", bad[i].file);
+    EXPECT_RUN(args, 2, bad[i].needle);
+    const char *nl = strchr(err_text, '\n');
+    CHECK(strstr(err_text, "iris: ") == err_text && nl && nl[1] == '\0'); /* exactly one line */
+    CHECK(!exists("gltf-out.json") && !exists("gltf-out.meshes"));
+  }
 }
 
 static void test_quiet(void) {
