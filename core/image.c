@@ -621,6 +621,21 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
   if (!what) what = "image";
   if (!data || size == 0) return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "empty image data");
   if (size > (size_t)INT32_MAX) return iris_error_set(err, IRIS_ERR_NOMEM, what, 0, NULL, "image data is too large");
+  /* stb_image grows its buffer to each PNG chunk's declared length before
+   * reading it: a 143-byte file declaring a 1.5 GB IDAT made it allocate 2 GB
+   * (found by fuzz_texture). Every chunk must fit in the bytes present. */
+  const unsigned char *pb = data;
+  if (size >= 8 && !memcmp(pb, "\x89PNG\r\n\x1a\n", 8)) {
+    size_t at = 8;
+    while (at + 12 <= size) {
+      const size_t len = (size_t)pb[at] << 24 | (size_t)pb[at + 1] << 16 | (size_t)pb[at + 2] << 8 | pb[at + 3];
+      if (len > size - at - 12)
+        return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL,
+                              "PNG chunk of %zu bytes at offset %zu exceeds the data (truncated or corrupt)", len, at);
+      if (!memcmp(pb + at + 4, "IEND", 4)) break;
+      at += len + 12;
+    }
+  }
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(data, (int)size, &w, &h, &n))
     return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "cannot decode image: %s", stbi_failure_reason());
