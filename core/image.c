@@ -621,11 +621,22 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
   if (!what) what = "image";
   if (!data || size == 0) return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "empty image data");
   if (size > (size_t)INT32_MAX) return iris_error_set(err, IRIS_ERR_NOMEM, what, 0, NULL, "image data is too large");
+  /* Only PNG and JPEG reach stb_image: its other decoders are not needed and
+   * not safe (fuzz_texture crashed Debian's stb_image with a 12-byte PNM).
+   * A JPEG may start with 0xFF fill bytes before its SOI marker. */
+  {
+    const unsigned char *q = data;
+    size_t i = 0;
+    while (i < size && q[i] == 0xFF) i++;
+    const bool png = size >= 8 && !memcmp(q, "\x89PNG\r\n\x1a\n", 8), jpeg = i >= 1 && i < size && q[i] == 0xD8;
+    if (!png && !jpeg)
+      return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "cannot decode image: not a PNG or JPEG");
+  }
   /* stb_image grows its buffer to each PNG chunk's declared length before
    * reading it: a 143-byte file declaring a 1.5 GB IDAT made it allocate 2 GB
    * (found by fuzz_texture). Every chunk must fit in the bytes present. */
   const unsigned char *pb = data;
-  if (size >= 8 && !memcmp(pb, "\x89PNG\r\n\x1a\n", 8)) {
+  if (size >= 8 && !memcmp(pb, "\x89PNG\r\n\x1a\n", 8)) { /* PNG signature */
     size_t at = 8;
     while (at + 12 <= size) {
       const size_t len = (size_t)pb[at] << 24 | (size_t)pb[at + 1] << 16 | (size_t)pb[at + 2] << 8 | pb[at + 3];
@@ -641,11 +652,12 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
     return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL, "cannot decode image: %s", stbi_failure_reason());
   if (w <= 0 || h <= 0 || w > IMAGE_MAX_DIM || h > IMAGE_MAX_DIM || (uint64_t)w * (uint64_t)h > LDR_MAX_PIXELS)
     return iris_error_set(err, IRIS_ERR_INVALID, what, 0, NULL, "image size %dx%d is out of range", w, h);
-  const unsigned char *b = data;
-  if (size >= 2 && b[0] == 0xFF && b[1] == 0xD8 &&
-      (uint64_t)w * (uint64_t)h > JPEG_MAX_PIXELS_PER_BYTE * (uint64_t)size + JPEG_SMALL_IMAGE_PIXELS)
+  /* Any format but PNG (stb_image also finds a JPEG behind leading 0xFF fill
+   * bytes, so there is no reliable JPEG signature to test for). */
+  const bool is_png = size >= 8 && !memcmp(data, "\x89PNG\r\n\x1a\n", 8);
+  if (!is_png && (uint64_t)w * (uint64_t)h > JPEG_MAX_PIXELS_PER_BYTE * (uint64_t)size + JPEG_SMALL_IMAGE_PIXELS)
     return iris_error_set(err, IRIS_ERR_INVALID, what, 0, NULL,
-                          "JPEG declares %dx%d pixels, more than its %zu bytes can hold (truncated or corrupt)",
+                          "image declares %dx%d pixels, more than its %zu bytes can hold (truncated or corrupt)",
                           w, h, size);
   uint8_t *rgba = stbi_load_from_memory(data, (int)size, &w, &h, &n, 4);
   if (!rgba)
