@@ -541,7 +541,6 @@ float iris_lights_triangle_solid_angle(const iris_light_tri *t, iris_vec3 ref) {
   float omega = iris_spherical_triangle_area(a, iris_add(a, e1), iris_add(a, e2));
   return omega >= IRIS_SOLID_ANGLE_MIN && omega <= IRIS_SOLID_ANGLE_MAX ? omega : 0.0f;
 }
-#define tri_solid_angle iris_lights_triangle_solid_angle
 
 const char *iris_triangle_sampling_name(iris_triangle_sampling m) {
   return m == IRIS_TRIANGLE_SAMPLING_AREA ? "area" : "solid-angle";
@@ -606,7 +605,7 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
   if (i < lights->tri_count) { /* a triangle: only its cache line is read */
     const iris_light_tri *t = &lights->tris[i];
     s->delta = false;
-    float omega = tri_solid_angle(t, ref);
+    float omega = iris_lights_triangle_solid_angle(t, ref);
     float b1, b2; /* p = v0 + b1 e1 + b2 e2 */
     iris_interaction si;
     if (omega > 0.0f) {
@@ -709,7 +708,7 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
   if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && iris_dot(to, si->ng) >= 0.0f)
     return 0.0f; /* never sampled from behind */
   float pmf = select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group);
-  float omega = tri_solid_angle(t, ref);
+  float omega = iris_lights_triangle_solid_angle(t, ref);
   if (omega > 0.0f) return pmf / omega;
   float d2 = iris_dot(to, to);
   float cos_l = fabsf(iris_dot(to, si->ng)) / sqrtf(d2);
