@@ -140,7 +140,8 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   }
   if (st == IRIS_OK && iris_method_uses_guiding(p.method)) {
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
-                           p.guide_options};
+                           p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
+                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);

@@ -32,6 +32,9 @@ typedef struct iris_guide_setup {
   uint64_t seed;
   int threads;
   const void *options; /* the guide's own options (iris_render_params.guide_options) */
+  int spp;             /* the render's samples per pixel (0 with a time budget) */
+  double time_budget;  /* the render's wall-clock budget in seconds (0: spp decides) */
+  iris_sampler_kind sampler; /* the render's sampler (training paths use it too) */
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;

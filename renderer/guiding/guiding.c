@@ -30,6 +30,8 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.splat = IRIS_SPLAT_BILINEAR; /* thesis: nearest; measured in docs/guiding.md */
   p.direct_photons = -1;
   p.adjoint_rr = true;
+  p.train_spp = -1;
+  p.learn_alpha = true;
   return p;
 }
 
@@ -534,6 +536,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     /* Keep the caches that received photons; their tables stay where they are. */
     size_t kept = 0;
     for (size_t i = 0; i < total; ++i) {
+      g->caches[i].alpha = -1.0f; /* until training learns it */
       if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
       else g->stats.empty_caches++;
     }

@@ -52,6 +52,11 @@ typedef struct iris_guiding_params {
   bool use_nee;         /* the render also samples lights (guided-nee): skip if lit only directly */
   int direct_photons;   /* splat photons straight from a light: -1 auto (not with NEE), 0 no, 1 yes */
   bool adjoint_rr;      /* Russian roulette from the caches' radiance estimates (default on) */
+  int train_spp;        /* training passes from camera paths (--train-spp): total samples per
+                           pixel spent on training; -1 auto (from the render's spp / time),
+                           0 photons only (docs/guiding.md, "Training") */
+  bool learn_alpha;     /* learn each cache's selection probability from the training samples
+                           (default on; off: alpha = min(roughness, alpha_max)) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* Inspection (outputs of the build, NULL = off): */
@@ -76,7 +81,9 @@ typedef struct iris_cache {
   uint32_t table;    /* first texel of this cache's tables in iris_guiding.pdf/.alias */
   uint32_t photons;  /* photons splatted */
   float radiance;    /* irradiance / pi from its k photons (mean of RGB, W m^-2 sr^-1): the
-                        radiance a diffuse white surface here reflects (Russian roulette) */
+                        radiance a diffuse white surface here reflects (Russian roulette);
+                        refined by training */
+  float alpha;       /* learned cache-sampling probability (< 0: not learned, alpha_max) */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
 } iris_cache;
