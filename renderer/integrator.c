@@ -239,8 +239,9 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / ls.pdf);
 }
 
-iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
-                                   iris_path_stats *stats) {
+static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                            iris_path_stats *stats, iris_path_record *rec) {
+  iris_path_vertex *last = NULL; /* the recorded vertex the current ray left from */
   const bool nee = iris_method_uses_nee(it->method) && it->lights->count > 0;
   const bool mis = nee && method_uses_mis(it->method);
   iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
@@ -261,6 +262,7 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
         if (!prev_delta && nee)
           w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, ray.d)) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+        if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }
       break;
     }
@@ -277,7 +279,9 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
       if (!prev_delta && nee)
         w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_triangle(it->lights, prev_p, &si)) : 0.0f;
       L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+      if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
     }
+    last = NULL;
     if (bounce > it->max_depth) break;
 
     iris_shading_point sp;
@@ -296,6 +300,18 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
       break;
     }
     if (iris_max3(beta) <= 0.0f) break;
+    if (rec && !ds.delta && rec->count < IRIS_PATH_RECORD_MAX) {
+      last = &rec->v[rec->count++];
+      last->guide = sp.guide;
+      last->wi = ds.wi;
+      last->f = ds.f;
+      last->cos = cos_i;
+      last->pdf = ds.pdf;
+      last->pdf_bsdf = iris_integrator_bsdf_pdf(&sp, ds.wi);
+      last->L = L;
+      last->miss = iris_v3(0, 0, 0);
+      last->beta = beta; /* replaced after Russian roulette; a killed path brings 0 */
+    }
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;
     prev_p = sp.si.p;
@@ -321,10 +337,23 @@ iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris
       if (iris_sampler_slot(rng, IRIS_SLOT_RR) >= q) break;
       beta = iris_scale(beta, 1.0f / q);
     }
+    if (last) last->beta = beta;
   }
   if (!iris_isfinite3(L)) {
     stats->nan_count++;
+    if (rec) rec->count = 0;
     return iris_v3(0, 0, 0);
   }
   return L;
+}
+
+iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                                   iris_path_stats *stats) {
+  return trace_path(it, ray, rng, stats, NULL);
+}
+
+iris_vec3 iris_integrator_radiance_record(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                                          iris_path_stats *stats, iris_path_record *rec) {
+  rec->count = 0;
+  return trace_path(it, ray, rng, stats, rec);
 }

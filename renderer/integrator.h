@@ -186,6 +186,35 @@ float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shadin
 iris_vec3 iris_integrator_radiance(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
                                    iris_path_stats *stats);
 
+/* One non-delta vertex of a recorded path (guide training, docs/guiding.md
+ * "Training"): what the direction sampler chose there and what the rest of
+ * the path brought back along it. The incident radiance along wi, per unit
+ * throughput, is (L_end - L + miss) / beta per channel, where L_end is the
+ * path's final estimate: `L` is the estimate after this vertex's light sample,
+ * `beta` the throughput after scattering here (and after Russian roulette's
+ * 1/q), `miss` the part of the emission found at the next vertex that MIS
+ * gave to light sampling ((1 - w) beta Le; 0 without light sampling). */
+typedef struct iris_path_vertex {
+  iris_guide_vertex guide; /* the direction sampler's per-vertex state */
+  iris_vec3 wi;            /* world, unit */
+  iris_vec3 f;             /* BSDF value */
+  float cos;               /* |cos| with the shading normal */
+  float pdf;               /* density of the whole direction sampler */
+  float pdf_bsdf;          /* density of BSDF sampling alone */
+  iris_vec3 beta, L, miss;
+} iris_path_vertex;
+
+#define IRIS_PATH_RECORD_MAX 16
+typedef struct iris_path_record {
+  int count; /* vertices recorded (the first IRIS_PATH_RECORD_MAX non-delta ones) */
+  iris_path_vertex v[IRIS_PATH_RECORD_MAX];
+} iris_path_record;
+
+/* iris_integrator_radiance that also records the path's non-delta vertices
+ * (same samples, same estimate; `rec` is reset first). */
+iris_vec3 iris_integrator_radiance_record(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
+                                          iris_path_stats *stats, iris_path_record *rec);
+
 #ifdef __cplusplus
 }
 #endif

@@ -12,6 +12,8 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "renderer/guiding/photons.h"
+#include "renderer/guiding/train.h"
+#include "renderer/guiding/vertex.h"
 
 #define CAMERA_SAMPLE_INDEX 0x63616d6361636865ULL /* streams apart from pixels and photons */
 #define MAX_SPECULAR_CHAIN 8
@@ -32,6 +34,8 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.adjoint_rr = true;
   p.train_spp = -1;
   p.learn_alpha = true;
+  p.train_prior = 200.0f; /* a path sample weighs as much as a photon (k = 200); docs/guiding.md */
+  p.train_all_light = false;
   return p;
 }
 
@@ -297,6 +301,12 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     if (!used || !iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + cache->table,
                                           g->alias + cache->table))
       cache->photons = 0;
+    if (g->photon_hist && cache->photons) { /* kept for training: normalised */
+      double sum = 0.0;
+      for (uint32_t t = 0; t < map->texel_count; ++t) sum += hist[t];
+      for (uint32_t t = 0; t < map->texel_count; ++t)
+        g->photon_hist[cache->table + t] = (float)(hist[t] / sum);
+    }
   }
 }
 
@@ -476,6 +486,10 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   }
   g->pdf = malloc(sizeof(float) * (floats ? floats : 1));
   g->alias = malloc(sizeof(iris_cache_alias) * (floats ? floats : 1));
+  if (p->train_spp != 0 && g->pdf && g->alias) {
+    g->photon_hist = malloc(sizeof(float) * (floats ? floats : 1));
+    if (!g->photon_hist) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
+  }
   iris_kdtree ptree;
   memset(&ptree, 0, sizeof ptree);
   if (!g->pdf || !g->alias || floats > UINT32_MAX)
@@ -581,6 +595,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
                           "guiding budget too large (photons <= 2^32, caches <= 2^26, k <= 100000)");
   }
   int stride = 1;
+  g->alpha_cap = g->params.alpha_max >= 0.0f ? g->params.alpha_max : 0.95f;
   choose_budget(&g->params, setup, &stride);
   g->stats.cache_res = g->params.cache_res;
   g->stats.cache_k = g->params.cache_k;
@@ -592,6 +607,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
     if (setup->lights->count == 0 && !g->params.force) skip(g, "the scene has no lights");
     else st = build_caches(g, setup, stride, err);
   }
+  if (st == IRIS_OK && !g->stats.skipped && g->cache_count > 0) st = iris_guiding_train(g, setup, err);
   if (st != IRIS_OK) {
     iris_guiding_destroy(g);
     return st;
@@ -610,6 +626,7 @@ void iris_guiding_destroy(iris_guiding *g) {
   free(g->caches);
   free(g->pdf);
   free(g->alias);
+  free(g->photon_hist);
   free(g);
 }
 
@@ -651,30 +668,25 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
   return fminf(r, g->params.alpha_max);
 }
 
-/* Per-vertex state (in iris_shading_point.guide): alpha and the tied caches
- * of Algorithm 1, picked once per bounce by guided_prepare. Caches with the
- * same frame and map layout (coplanar caches: the usual tie) map a direction
- * to the same texel, so pdf evaluation computes that texel once per group. */
-typedef struct guide_vertex {
-  float alpha;                          /* cache-sampling probability; 0: BSDF only */
-  float radiance;                       /* tied caches' mean radiance estimate; < 0 none */
-  int32_t m;                            /* tied caches */
-  uint32_t ids[IRIS_GUIDING_PICK_K];
-  uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
-} guide_vertex;
-_Static_assert(sizeof(guide_vertex) <= IRIS_GUIDE_VERTEX_BYTES, "guide_vertex too large");
-
 static void guided_prepare(void *ctx, iris_shading_point *sp) {
   const iris_guiding *g = ctx;
-  guide_vertex *v = (guide_vertex *)sp->guide.bytes;
+  iris_guide_vertex_state *v = (iris_guide_vertex_state *)sp->guide.bytes;
   v->alpha = iris_guiding_alpha(g, sp);
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
   if (v->m == 0) v->alpha = 0.0f;
   v->radiance = -1.0f;
   if (v->m > 0) {
-    float r = 0.0f;
-    for (int i = 0; i < v->m; ++i) r += g->caches[v->ids[i]].radiance;
+    /* Learned selection probabilities (training, docs/guiding.md): the tied
+     * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
+    float r = 0.0f, a = 0.0f;
+    int learned = 0;
+    for (int i = 0; i < v->m; ++i) {
+      const iris_cache *c = &g->caches[v->ids[i]];
+      r += c->radiance;
+      if (c->alpha >= 0.0f) a += c->alpha, learned++;
+    }
     v->radiance = r / (float)v->m;
+    if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
   }
   /* The tables of the tied caches are needed after this vertex's shadow ray
    * (the light sample's mixture pdf, then sampling): start loading them now so
@@ -699,28 +711,10 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   }
 }
 
-/* Cache-sampling density of the vertex's tied caches (their average). */
-static float vertex_cache_pdf(const iris_guiding *g, const guide_vertex *v, iris_vec3 wi) {
-  int32_t texel[IRIS_GUIDING_PICK_K] = {-1, -1, -1, -1, -1};
-  float jac[IRIS_GUIDING_PICK_K];
-  float sum = 0.0f;
-  for (int i = 0; i < v->m; ++i) {
-    const iris_cache *c = &g->caches[v->ids[i]];
-    if (v->same_as[i] == i) {
-      texel[i] = iris_cache_texel(g->hemi.res, c->sphere, iris_frame_to_local(&c->frame, wi), &jac[i]);
-    } else {
-      texel[i] = texel[v->same_as[i]];
-      jac[i] = jac[v->same_as[i]];
-    }
-    if (texel[i] >= 0) sum += g->pdf[c->table + (uint32_t)texel[i]] * jac[i];
-  }
-  return v->m > 0 ? sum / (float)v->m : 0.0f;
-}
-
 static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
                           iris_direction_sample *out) {
   const iris_guiding *g = ctx;
-  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   const float alpha = v->alpha;
   /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
   if (!(alpha > 0.0f)) return iris_integrator_sample_bsdf(sp, rng, out);
@@ -731,7 +725,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
       out->pdf *= 1.0f - alpha;
       return true;
     }
-    out->pdf = (1.0f - alpha) * out->pdf + alpha * vertex_cache_pdf(g, v, out->wi);
+    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_cache_pdf(g, v, out->wi);
     return out->pdf > 0.0f;
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
@@ -749,7 +743,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   out->wi = wi;
   out->f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wi_local);
   out->pdf = (1.0f - alpha) * iris_bsdf_pdf(&sp->bsdf, sp->wo_local, wi_local) +
-             alpha * vertex_cache_pdf(g, v, wi);
+             alpha * iris_guide_vertex_cache_pdf(g, v, wi);
   out->delta = false;
   bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
   out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
@@ -759,10 +753,10 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
 
 static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
   const iris_guiding *g = ctx;
-  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   float pb = iris_integrator_bsdf_pdf(sp, wi);
   if (!(v->alpha > 0.0f)) return pb;
-  return (1.0f - v->alpha) * pb + v->alpha * vertex_cache_pdf(g, v, wi);
+  return (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_cache_pdf(g, v, wi);
 }
 
 /* Radiance still to come at a prepared vertex, per unit throughput: the tied
@@ -771,7 +765,7 @@ static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
  * roulette. */
 static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
   (void)ctx;
-  const guide_vertex *v = (const guide_vertex *)sp->guide.bytes;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   return v->radiance;
 }
 
@@ -796,13 +790,13 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, alpha <= %g; "
-           "preprocessing %.2f s (photons %.2f s); cache memory %.1f MiB",
+           "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s); cache memory %.1f MiB",
            (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
            s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
            (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
            (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, s->cache_k,
            (double)s->pdf_floor, (double)g->params.alpha_max, s->total_seconds, s->photon_seconds,
-           (double)s->memory_bytes / (1024.0 * 1024.0));
+           s->train_spp, s->train_iterations, s->train_seconds, (double)s->memory_bytes / (1024.0 * 1024.0));
 }
 
 /* ---- iris_render provider ---------------------------------------------------- */

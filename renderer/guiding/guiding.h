@@ -57,6 +57,10 @@ typedef struct iris_guiding_params {
                            0 photons only (docs/guiding.md, "Training") */
   bool learn_alpha;     /* learn each cache's selection probability from the training samples
                            (default on; off: alpha = min(roughness, alpha_max)) */
+  float train_prior;    /* photon-equivalent weight of a cache's photon histogram against its
+                           n path samples: mixed with weight n / (n + prior) (--train-prior) */
+  bool train_all_light; /* train towards all incident light, not only what light sampling's MIS
+                           leaves to the sampled direction (--train-all-light) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* Inspection (outputs of the build, NULL = off): */
@@ -94,6 +98,9 @@ typedef struct iris_guiding_stats {
   int cache_res, cache_k, camera_stride;
   float pdf_floor;
   double photon_seconds, cache_seconds, total_seconds;
+  int train_spp, train_iterations; /* training passes run (docs/guiding.md, "Training") */
+  uint64_t train_samples;          /* path vertices recorded into caches */
+  double train_seconds;
   size_t memory_bytes; /* caches + tables + kd-tree */
   bool skipped;        /* guiding off: sampler falls back to the BSDF */
   char reason[160];
@@ -109,6 +116,8 @@ typedef struct iris_guiding {
   iris_kdtree tree;    /* over caches[i].p */
   float pick_radius2;  /* Algorithm 1 ignores caches farther than this (squared) */
   iris_pick_grid grid; /* candidate caches per cell: Algorithm 1's search without the tree */
+  float alpha_cap;     /* cap on learned selection probabilities: --alpha-max when given, else 0.95 */
+  float *photon_hist;  /* during training only: each cache's photon histogram, normalised (pdf layout) */
   iris_guiding_stats stats;
 } iris_guiding;
 

@@ -4,9 +4,11 @@
  * tests/render/test_unbiased.c). Threshold: two-sided normal quantile,
  * Bonferroni-corrected for a family-wise level of 0.1% over this run's tests,
  * never below 3 sigma. Guiding runs at its defaults (the scene-driven budget)
- * (forced on where the budget would skip it) and also with alpha_max 0.9 and
+ * (forced on where the budget would skip it; training passes and learned
+ * selection probabilities on) and also with alpha_max 0.9 and
  * nearest splatting and the plain throughput Russian roulette (the defaults use
- * the adjoint-driven one), so the unbiasedness does not rest on one parameter set. */
+ * the adjoint-driven one), and with 31 training spp towards all incident
+ * light, so the unbiasedness does not rest on one parameter set. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,12 +29,16 @@ static double z_for_alpha(double alpha) {
   return 0.5 * (lo + hi);
 }
 
+#define NV 5 /* variants: mis and four guided ones */
+
 typedef struct variant {
   iris_method method;
   float alpha_max;        /* <= 0: default */
   iris_splat_mode splat;
   const char *label;
   bool plain_rr;          /* throughput Russian roulette instead of the adjoint-driven one */
+  int train_spp;          /* 0: default (training passes from the render's spp); > 0 explicit */
+  bool all_light;         /* train towards all incident light */
 } variant;
 
 static bool render(const iris_scene *s, const variant *v, int w, int h, int spp, uint64_t seed,
@@ -42,6 +48,8 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   if (v->alpha_max > 0.0f) gp.alpha_max = v->alpha_max;
   gp.splat = v->splat;
   gp.adjoint_rr = !v->plain_rr;
+  if (v->train_spp > 0) gp.train_spp = v->train_spp;
+  gp.train_all_light = v->all_light;
   gp.force = true; /* exercise the guide even where the budget would skip it (Veach) */
   p.width = w;
   p.height = h;
@@ -81,25 +89,28 @@ int main(int argc, char **argv) {
   int w = 32, h = 24, spp = 128;
   if (!strcmp(scene, "cornell-box")) w = 24, h = 24;
   if (!strcmp(scene, "veach-mis")) w = 32, h = 16, spp = 256;
-  static const variant variants[4] = {
-      {IRIS_METHOD_MIS, 0.0f, IRIS_SPLAT_BILINEAR, "mis", false},
-      {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided", false},
-      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee", false},
-      {IRIS_METHOD_GUIDED_NEE, 0.9f, IRIS_SPLAT_NEAREST, "guided-nee alpha 0.9 nearest plain RR", true}};
+  /* The defaults train the guide (8% of the spp in doubling passes) and learn
+   * the selection probabilities; one variant trains longer towards all light. */
+  static const variant variants[NV] = {
+      {IRIS_METHOD_MIS, 0.0f, IRIS_SPLAT_BILINEAR, "mis", false, 0, false},
+      {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided", false, 0, false},
+      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee", false, 0, false},
+      {IRIS_METHOD_GUIDED_NEE, 0.9f, IRIS_SPLAT_NEAREST, "guided-nee alpha 0.9 nearest plain RR", true, 0, false},
+      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee 31 training spp, all light", false, 31, true}};
   int bx = w / 8, by = h / 8;
-  int n_tests = 3 * 3 * (1 + bx * by);
+  int n_tests = (NV - 1) * 3 * (1 + bx * by);
   double z_max = fmax(3.0, z_for_alpha(1e-3 / n_tests));
   printf("%s %dx%d %d spp: %d tests, |z| < %.2f\n", scene, w, h, spp, n_tests, z_max);
   iris_scene *s = NULL;
   iris_error err;
   if (!CHECK(iris_builtin_create(scene, &s, &err) == IRIS_OK)) return iris_check_summary("guiding.unbiased");
-  iris_render_result r[4];
-  bool ok[4];
-  for (int m = 0; m < 4; m++) {
+  iris_render_result r[NV];
+  bool ok[NV];
+  for (int m = 0; m < NV; m++) {
     /* mis gets more samples: it is the yardstick, and cheaper per sample. */
     ok[m] = CHECK(render(s, &variants[m], w, h, m == 0 ? 2 * spp : spp, 200 + (uint64_t)m, &r[m]));
   }
-  for (int b = 1; b < 4; b++) {
+  for (int b = 1; b < NV; b++) {
     if (!ok[0] || !ok[b]) continue;
     double worst = 0.0;
     for (int blk = -1; blk < bx * by; blk++) {
@@ -122,7 +133,7 @@ int main(int argc, char **argv) {
     }
     printf("%s: mis vs %s: worst |z| = %.2f\n", scene, variants[b].label, worst);
   }
-  for (int m = 0; m < 4; m++) {
+  for (int m = 0; m < NV; m++) {
     if (!ok[m]) continue;
     CHECK_EQ_INT(r[m].stats.nan_count, 0);
     iris_render_result_destroy(&r[m]);

@@ -1,0 +1,303 @@
+/* Training passes from camera paths; train.h and docs/guiding.md ("Training"). */
+#include "renderer/guiding/train.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "renderer/guiding/vertex.h"
+
+#define TRAIN_SEED 0x747261696e696e67ULL /* "training": streams apart from the render's */
+#define TRAIN_TILE 8
+#define TRAIN_BATCH_TILES 256 /* tiles traced between two merges: bounds the sample buffers */
+/* Samples a cache needs before its learned selection probability is used. */
+#define ALPHA_MIN_SAMPLES 64
+/* Share of the render's samples spent on training when train_spp is automatic. */
+#define TRAIN_SHARE 0.08
+
+/* ---- selection probability --------------------------------------------------- */
+
+void iris_alpha_learner_add(iris_alpha_learner *l, float h, float q, float pb, float pc) {
+  l->n++;
+  if (!(h != 0.0f) || !(q > 0.0f) || !isfinite(h) || !isfinite(pc) || !isfinite(pb)) return;
+  double h2 = (double)h * (double)h / (double)q;
+  for (int j = 0; j < IRIS_ALPHA_GRID; ++j) {
+    double a = iris_alpha_grid_value(j);
+    double qa = (1.0 - a) * (double)pb + a * (double)pc;
+    /* qa = 0 where h != 0 cannot happen for a > 0 and BSDF-covered h (pb > 0);
+     * guard anyway: such an alpha would be infinitely bad. */
+    l->m[j] += qa > 0.0 ? h2 / qa : INFINITY;
+  }
+}
+
+float iris_alpha_learner_best(const iris_alpha_learner *l, float fallback, uint32_t min_samples) {
+  if (l->n < min_samples) return fallback;
+  int best = -1;
+  for (int j = 0; j < IRIS_ALPHA_GRID; ++j)
+    if (l->m[j] > 0.0 && isfinite(l->m[j]) && (best < 0 || l->m[j] < l->m[best])) best = j;
+  return best < 0 ? fallback : iris_alpha_grid_value(best);
+}
+
+/* ---- schedule ------------------------------------------------------------------ */
+
+int iris_guiding_train_budget(int spp) {
+  if (spp <= 0) return 0;
+  return (int)floor(TRAIN_SHARE * (double)spp);
+}
+
+int iris_guiding_train_iteration_spp(int iteration, int done, int total) {
+  int n = iteration < 20 ? 1 << iteration : 1 << 20;
+  return n < total - done ? n : total - done;
+}
+
+/* ---- one training pass --------------------------------------------------------- */
+
+/* What a merge needs of one recorded vertex. */
+typedef struct train_sample {
+  uint32_t ids[IRIS_GUIDING_PICK_K];
+  uint8_t m;
+  iris_vec3 wi;
+  float li;  /* incident radiance along wi per unit throughput, mean of RGB */
+  float h;   /* mean over RGB of f * cos * Li: the integrand of the one-sample MIS estimator */
+  float q;   /* density the direction was sampled with */
+  float pb;  /* BSDF density */
+  float pc;  /* the tied caches' density (tables of this pass) */
+} train_sample;
+
+typedef struct sample_buffer {
+  train_sample *s;
+  size_t count, cap;
+  bool failed; /* could not grow */
+} sample_buffer;
+
+typedef struct pass_ctx {
+  const iris_guiding *g;
+  const iris_integrator *it;
+  const iris_pinhole *cam;
+  iris_sampler_kind sampler;
+  uint64_t seed;
+  uint64_t s0, s1;       /* training sample indices of this pass */
+  int tiles_x;
+  uint64_t tile0;        /* first tile of the batch */
+  sample_buffer *buf;    /* per tile of the batch */
+  bool all_light;        /* record emission MIS gave to light sampling too */
+} pass_ctx;
+
+static bool buffer_push(sample_buffer *b, const train_sample *t) {
+  if (b->count == b->cap) {
+    size_t cap = b->cap ? 2 * b->cap : 256;
+    train_sample *s = realloc(b->s, cap * sizeof *s);
+    if (!s) return false;
+    b->s = s;
+    b->cap = cap;
+  }
+  b->s[b->count++] = *t;
+  return true;
+}
+
+/* Turns a recorded path into samples: incident radiance per unit throughput
+ * along each served vertex's direction, Li_c = (L_end - L + miss) / beta. */
+static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_end, sample_buffer *out) {
+  for (int k = 0; k < rec->count; ++k) {
+    const iris_path_vertex *pv = &rec->v[k];
+    const iris_guide_vertex_state *v = iris_guide_vertex_get(&pv->guide);
+    if (v->m <= 0) continue;
+    iris_vec3 d = iris_sub(L_end, pv->L);
+    if (c->all_light) d = iris_add(d, pv->miss);
+    float li[3], dl[3] = {d.x, d.y, d.z}, b[3] = {pv->beta.x, pv->beta.y, pv->beta.z},
+                 f[3] = {pv->f.x, pv->f.y, pv->f.z};
+    float li_sum = 0.0f, h = 0.0f;
+    for (int ch = 0; ch < 3; ++ch) {
+      li[ch] = b[ch] > 0.0f ? fmaxf(dl[ch], 0.0f) / b[ch] : 0.0f;
+      li_sum += li[ch];
+      h += f[ch] * pv->cos * li[ch];
+    }
+    train_sample t;
+    memcpy(t.ids, v->ids, sizeof t.ids);
+    t.m = (uint8_t)v->m;
+    t.wi = pv->wi;
+    t.li = li_sum / 3.0f;
+    t.h = h / 3.0f;
+    t.q = pv->pdf;
+    t.pb = pv->pdf_bsdf;
+    t.pc = iris_guide_vertex_cache_pdf(c->g, v, pv->wi);
+    if (!isfinite(t.li) || !isfinite(t.h) || !(t.q > 0.0f)) continue;
+    if (!buffer_push(out, &t)) return false;
+  }
+  return true;
+}
+
+static void train_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  (void)thread;
+  pass_ctx *c = vctx;
+  iris_path_stats stats = {0};
+  iris_path_record rec;
+  const int w = c->cam->width, hgt = c->cam->height;
+  for (uint64_t t = begin; t < end; ++t) {
+    uint64_t tile = c->tile0 + t;
+    sample_buffer *out = &c->buf[t];
+    out->count = 0;
+    out->failed = false;
+    int tx = (int)(tile % (uint64_t)c->tiles_x) * TRAIN_TILE, ty = (int)(tile / (uint64_t)c->tiles_x) * TRAIN_TILE;
+    for (int y = ty; y < ty + TRAIN_TILE && y < hgt; ++y)
+      for (int x = tx; x < tx + TRAIN_TILE && x < w; ++x) {
+        uint64_t pixel = (uint64_t)y * (uint64_t)w + (uint64_t)x;
+        for (uint64_t s = c->s0; s < c->s1; ++s) {
+          iris_sampler rng = iris_sampler_start_kind(c->sampler, c->seed, pixel, s);
+          float ux, uy;
+          iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
+          iris_ray ray = iris_pinhole_ray(c->cam, (float)x + ux, (float)y + uy);
+          iris_vec3 L = iris_integrator_radiance_record(c->it, ray, &rng, &stats, &rec);
+          if (!record_path(c, &rec, L, out)) out->failed = true;
+        }
+      }
+  }
+}
+
+/* ---- accumulation and rebuild -------------------------------------------------- */
+
+typedef struct train_state {
+  float *acc;                  /* per texel (pdf layout): sum of Li cos / q */
+  uint32_t *n;                 /* per cache: samples at vertices it served */
+  double *irr;                 /* per cache: sum of Li cos / q over all directions */
+  iris_alpha_learner *learner; /* per cache, this pass's samples */
+} train_state;
+
+static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer *b) {
+  for (size_t i = 0; i < b->count; ++i) {
+    const train_sample *t = &b->s[i];
+    for (int j = 0; j < t->m; ++j) {
+      uint32_t id = t->ids[j];
+      iris_cache *c = &g->caches[id];
+      const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+      iris_vec3 wl = iris_frame_to_local(&c->frame, t->wi);
+      float cosc = fabsf(wl.z);
+      ts->n[id]++;
+      iris_alpha_learner_add(&ts->learner[id], t->h, t->q, t->pb, t->pc);
+      if (!(t->li > 0.0f)) continue;
+      /* Li cos / q estimates the integral of Li cos over the sphere; splatted
+       * at wi it estimates each texel's share (the photons' histogram is
+       * incident power, also Li cos: the two are the same quantity). */
+      float v = t->li * cosc / t->q;
+      if (iris_cache_splat(map, ts->acc + c->table, wl, v, g->params.splat)) ts->irr[id] += v;
+    }
+  }
+}
+
+/* New tables for every cache: the photon histogram (normalised) and the path
+ * samples' histogram (normalised) mixed with weight n / (n + prior). */
+static void rebuild(iris_guiding *g, const train_state *ts, bool learn, float alpha_fallback, float alpha_cap,
+                    float *hist) {
+  const double prior = g->params.train_prior;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    iris_cache *c = &g->caches[i];
+    const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+    const uint32_t n = map->texel_count;
+    const float *ph = g->photon_hist + c->table, *acc = ts->acc + c->table;
+    double sum = 0.0;
+    for (uint32_t t = 0; t < n; ++t) sum += acc[t];
+    if (ts->n[i] > 0 && sum > 0.0 && isfinite(sum)) {
+      double lambda = (double)ts->n[i] / ((double)ts->n[i] + prior);
+      for (uint32_t t = 0; t < n; ++t) hist[t] = (float)((1.0 - lambda) * ph[t] + lambda * acc[t] / sum);
+      iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + c->table, g->alias + c->table);
+      /* The radiance still to come (Russian roulette): irradiance / pi from
+       * the paths, mixed with the photons' estimate the same way. */
+      double r = ts->irr[i] / (double)ts->n[i] / 3.14159265358979;
+      c->radiance = (float)((1.0 - lambda) * c->radiance + lambda * r);
+    }
+    if (learn) {
+      float a = iris_alpha_learner_best(&ts->learner[i], c->alpha >= 0.0f ? c->alpha : alpha_fallback,
+                                        ALPHA_MIN_SAMPLES);
+      c->alpha = fminf(a, alpha_cap);
+    }
+  }
+}
+
+iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_error *err) {
+  double t0 = iris_time_now();
+  const iris_guiding_params *p = &g->params;
+  int total = p->train_spp;
+  const bool timed = total < 0 && !(s->spp > 0) && s->time_budget > 0.0;
+  if (total < 0) total = timed ? 1 : iris_guiding_train_budget(s->spp);
+  if (total <= 0 || g->cache_count == 0 || !g->photon_hist) {
+    free(g->photon_hist);
+    g->photon_hist = NULL;
+    return IRIS_OK;
+  }
+  const size_t caches = g->cache_count;
+  size_t floats = 0;
+  for (size_t i = 0; i < caches; ++i) {
+    size_t end = g->caches[i].table + (g->caches[i].sphere ? g->sphere.texel_count : g->hemi.texel_count);
+    floats = end > floats ? end : floats;
+  }
+  train_state ts = {calloc(floats ? floats : 1, sizeof(float)), calloc(caches, sizeof(uint32_t)),
+                    calloc(caches, sizeof(double)), calloc(caches, sizeof(iris_alpha_learner))};
+  float *hist = malloc(sizeof(float) * g->sphere.texel_count);
+  sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
+  iris_status st = IRIS_OK;
+  if (!ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf)
+    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
+
+  iris_integrator it = *s->integrator;
+  it.guide = iris_guiding_sampler(g);
+  pass_ctx c;
+  memset(&c, 0, sizeof c);
+  c.g = g;
+  c.it = &it;
+  c.cam = s->camera;
+  c.sampler = s->sampler;
+  c.seed = iris_hash4(s->seed, TRAIN_SEED, 0, 0);
+  c.tiles_x = (s->camera->width + TRAIN_TILE - 1) / TRAIN_TILE;
+  c.buf = buf;
+  c.all_light = p->train_all_light;
+  const uint64_t tiles = (uint64_t)c.tiles_x * (uint64_t)((s->camera->height + TRAIN_TILE - 1) / TRAIN_TILE);
+  const float alpha_fallback = p->alpha_max, alpha_cap = g->alpha_cap;
+  int done = 0, iteration = 0;
+  uint64_t samples = 0;
+  while (st == IRIS_OK && done < total) {
+    int n = iris_guiding_train_iteration_spp(iteration, done, total);
+    double tp = iris_time_now();
+    c.s0 = (uint64_t)done;
+    c.s1 = c.s0 + (uint64_t)n;
+    memset(ts.learner, 0, caches * sizeof *ts.learner); /* learn alpha for this pass's tables */
+    for (uint64_t t0b = 0; t0b < tiles && st == IRIS_OK; t0b += TRAIN_BATCH_TILES) {
+      uint64_t count = tiles - t0b < TRAIN_BATCH_TILES ? tiles - t0b : TRAIN_BATCH_TILES;
+      c.tile0 = t0b;
+      iris_parallel_for(count, 1, s->threads, train_tiles, &c);
+      for (uint64_t t = 0; t < count; ++t)
+        if (buf[t].failed) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for training samples");
+      for (uint64_t t = 0; t < count && st == IRIS_OK; ++t) { /* tile order: the same guide for any thread count */
+        merge_samples(g, &ts, &buf[t]);
+        samples += buf[t].count;
+      }
+    }
+    if (st != IRIS_OK) break;
+    rebuild(g, &ts, p->learn_alpha, alpha_fallback, alpha_cap, hist);
+    done += n;
+    iteration++;
+    if (timed && iteration == 1) {
+      /* One training spp costs about one render spp: spend TRAIN_SHARE of
+       * the samples the rest of the budget is expected to hold. */
+      double per_spp = iris_time_now() - tp, left = s->time_budget - (iris_time_now() - t0);
+      int expected = per_spp > 0.0 ? (int)fmin(left / per_spp, 1e6) : 0;
+      total = iris_guiding_train_budget(expected);
+      if (total < done) total = done;
+    }
+  }
+  for (int t = 0; t < TRAIN_BATCH_TILES && buf; ++t) free(buf[t].s);
+  free(buf);
+  free(hist);
+  free(ts.acc);
+  free(ts.n);
+  free(ts.irr);
+  free(ts.learner);
+  free(g->photon_hist);
+  g->photon_hist = NULL;
+  g->stats.train_spp = done;
+  g->stats.train_iterations = iteration;
+  g->stats.train_samples = samples;
+  g->stats.train_seconds = iris_time_now() - t0;
+  return st;
+}

@@ -1,0 +1,184 @@
+/* Training passes (renderer/guiding/train.h):
+ * - the selection-probability learner finds the known optimum of synthetic
+ *   two-strategy integrands (zero-variance mixtures at 0.15 and 0.65, an
+ *   integrand the cache strategy alone serves best, one BSDF sampling serves
+ *   best), from samples drawn with another mixture;
+ * - the schedule doubles and stops at the budget;
+ * - a guide trained on a scene has learned selection probabilities, changed
+ *   tables that still sum to one, and the training does not depend on the
+ *   thread count (bit-identical tables and alphas for 1 and 2 threads). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "core/rng.h"
+#include "renderer/guiding/train.h"
+#include "renderer/lights.h"
+#include "renderer/texture.h"
+#include "scenes/builtin.h"
+
+/* 1D domain [0,1]: p_b = 1, p_c = 2x; samples from (1 - a0) p_b + a0 p_c. */
+static float learn(double (*h)(double), float a0, int n, uint64_t seed) {
+  iris_alpha_learner l;
+  memset(&l, 0, sizeof l);
+  for (int i = 0; i < n; ++i) {
+    double u = iris_u64_to_unit(iris_hash4(seed, (uint64_t)i, 0, 1)),
+           v = iris_u64_to_unit(iris_hash4(seed, (uint64_t)i, 1, 1));
+    double x = u < a0 ? sqrt(v) : v; /* inverse CDF of 2x is sqrt */
+    double pb = 1.0, pc = 2.0 * x, q = (1.0 - a0) * pb + a0 * pc;
+    iris_alpha_learner_add(&l, (float)h(x), (float)q, (float)pb, (float)pc);
+  }
+  return iris_alpha_learner_best(&l, -1.0f, 64);
+}
+
+/* The exact second moment's argmin over the grid (midpoint quadrature). */
+static float exact_best(double (*h)(double)) {
+  int best = 0;
+  double bm = INFINITY;
+  for (int j = 0; j < IRIS_ALPHA_GRID; ++j) {
+    double a = iris_alpha_grid_value(j), m = 0.0;
+    const int N = 200000;
+    for (int i = 0; i < N; ++i) {
+      double x = (i + 0.5) / N, hv = h(x);
+      m += hv * hv / ((1.0 - a) + a * 2.0 * x) / N;
+    }
+    if (m < bm) bm = m, best = j;
+  }
+  return iris_alpha_grid_value(best);
+}
+
+static double h_mix15(double x) { return 3.0 * (0.85 + 0.15 * 2.0 * x); }
+static double h_mix65(double x) { return 0.5 * (0.35 + 0.65 * 2.0 * x); }
+static double h_peak(double x) { return x * x * x * 8.0; }           /* cache-like, sharper than p_c */
+static double h_flat_low(double x) { return x < 0.5 ? 1.0 : 0.2; }  /* where p_c is small */
+
+static void test_learner(void) {
+  struct {
+    double (*h)(double);
+    const char *name;
+  } cases[] = {{h_mix15, "mixture 0.15"}, {h_mix65, "mixture 0.65"}, {h_peak, "x^3"}, {h_flat_low, "step"}};
+  for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+    float want = exact_best(cases[i].h);
+    for (int a0i = 0; a0i < 2; ++a0i) {
+      float a0 = a0i ? 0.7f : 0.3f;
+      float got = learn(cases[i].h, a0, 40000, 7 + (uint64_t)i);
+      iris_check_record(fabsf(got - want) < 1e-4f, __FILE__, __LINE__,
+                        "learner on %s from a0 %.1f: %.2f, exact optimum %.2f", cases[i].name, (double)a0,
+                        (double)got, (double)want);
+    }
+  }
+  /* Zero-variance mixtures are known without quadrature. */
+  CHECK(fabsf(exact_best(h_mix15) - 0.15f) < 1e-4f);
+  CHECK(fabsf(exact_best(h_mix65) - 0.65f) < 1e-4f);
+  /* Too few samples, or nothing but zeros: the fallback. */
+  CHECK(learn(h_mix65, 0.5f, 10, 3) == -1.0f);
+  iris_alpha_learner l;
+  memset(&l, 0, sizeof l);
+  for (int i = 0; i < 100; ++i) iris_alpha_learner_add(&l, 0.0f, 1.0f, 1.0f, 1.0f);
+  CHECK(iris_alpha_learner_best(&l, 0.42f, 64) == 0.42f);
+}
+
+static void test_schedule(void) {
+  CHECK_EQ_INT(iris_guiding_train_budget(64), 5);
+  CHECK_EQ_INT(iris_guiding_train_budget(8), 0);
+  CHECK_EQ_INT(iris_guiding_train_budget(1024), 81);
+  int done = 0, it = 0, sizes[8];
+  while (done < 10) {
+    sizes[it] = iris_guiding_train_iteration_spp(it, done, 10);
+    done += sizes[it++];
+  }
+  CHECK_EQ_INT(it, 4); /* 1 + 2 + 4 + 3 */
+  CHECK_EQ_INT(sizes[0], 1);
+  CHECK_EQ_INT(sizes[2], 4);
+  CHECK_EQ_INT(sizes[3], 3);
+}
+
+static iris_guiding *build(const iris_scene *s, int threads, int train_spp) {
+  iris_error err;
+  iris_error_clear(&err);
+  iris_pinhole cam;
+  iris_accel *acc = NULL;
+  iris_textures tx;
+  iris_lights lights;
+  memset(&tx, 0, sizeof tx);
+  memset(&lights, 0, sizeof lights);
+  iris_guiding *g = NULL;
+  if (iris_pinhole_setup(s, NULL, 48, 36, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
+      iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK) {
+    iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
+    it.method = IRIS_METHOD_GUIDED_NEE;
+    iris_guiding_params gp = iris_guiding_params_default();
+    gp.use_nee = true;
+    gp.photons = 60000;
+    gp.train_spp = train_spp;
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 5, threads, NULL, 256, 0.0, IRIS_SAMPLER_SOBOL};
+    if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
+  }
+  iris_lights_destroy(&lights);
+  iris_textures_destroy(&tx);
+  iris_accel_destroy(acc);
+  return g;
+}
+
+static void test_trained_guide(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("door-shielded", &s, &err) == IRIS_OK)) return;
+  iris_guiding *photons_only = build(s, 2, 0), *t1 = build(s, 1, 15), *t2 = build(s, 2, 15);
+  if (CHECK(photons_only && t1 && t2) && CHECK(!t1->stats.skipped) &&
+      CHECK(t1->cache_count == photons_only->cache_count)) {
+    CHECK_EQ_INT(t1->stats.train_spp, 15);
+    CHECK_EQ_INT(t1->stats.train_iterations, 4);
+    CHECK(t1->stats.train_samples > 10 * t1->cache_count);
+    CHECK_EQ_INT(photons_only->stats.train_spp, 0);
+    size_t learned = 0, changed = 0, lo = 0, hi = 0;
+    for (size_t i = 0; i < t1->cache_count; ++i) {
+      const iris_cache *c = &t1->caches[i];
+      CHECK(photons_only->caches[i].alpha < 0.0f);
+      if (c->alpha >= 0.0f) {
+        learned++;
+        lo += c->alpha < 0.5f;
+        hi += c->alpha > 0.5f;
+      }
+      const iris_octmap *map = c->sphere ? &t1->sphere : &t1->hemi;
+      double sum = 0.0;
+      bool diff = false;
+      for (uint32_t t = 0; t < map->texel_count; ++t) {
+        /* P = pdf * 2 / res^2 */
+        sum += (double)t1->pdf[c->table + t] * 2.0 / ((double)map->res * map->res);
+        diff |= t1->pdf[c->table + t] != photons_only->pdf[c->table + t];
+      }
+      changed += diff;
+      if (!iris_check_record(fabs(sum - 1.0) < 1e-4, __FILE__, __LINE__, "cache %zu: texel P sum %.6f", i, sum))
+        break;
+    }
+    printf("door-shielded: %zu caches, %zu learned alpha (%zu < 0.5, %zu > 0.5), %zu tables changed, %llu samples\n",
+           t1->cache_count, learned, lo, hi, changed, (unsigned long long)t1->stats.train_samples);
+    CHECK(learned > t1->cache_count / 2);
+    CHECK(changed > t1->cache_count / 2);
+    CHECK(t1->photon_hist == NULL); /* freed after training */
+    /* Same guide for 1 and 2 threads. */
+    size_t floats = 0;
+    for (size_t i = 0; i < t1->cache_count; ++i) {
+      const iris_cache *c = &t1->caches[i];
+      size_t end = c->table + (c->sphere ? t1->sphere.texel_count : t1->hemi.texel_count);
+      floats = end > floats ? end : floats;
+      CHECK(memcmp(&t1->caches[i], &t2->caches[i], sizeof *c) == 0);
+    }
+    CHECK(memcmp(t1->pdf, t2->pdf, floats * sizeof(float)) == 0);
+    CHECK(memcmp(t1->alias, t2->alias, floats * sizeof(iris_cache_alias)) == 0);
+  }
+  iris_guiding_destroy(photons_only);
+  iris_guiding_destroy(t1);
+  iris_guiding_destroy(t2);
+  iris_scene_destroy(s);
+}
+
+int main(void) {
+  test_learner();
+  test_schedule();
+  test_trained_guide();
+  return iris_check_summary("guiding.train");
+}
