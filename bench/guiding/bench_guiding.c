@@ -1,6 +1,7 @@
 /* bench_guiding SCENE METHOD (--time S | --spp N) [--ref REF.exr] [-o OUT.exr]
  *               [--photons N] [--caches N] [--cache-res R] [--cache-k K]
  *               [--pdf-floor F] [--alpha-max A] [--cos-min C] [--bilinear | --nearest]
+ *               [--train-spp N] [--train-prior W] [--train-all-light] [--no-learn-alpha]
  *               [--width W --height H] [--threads T] [--seed S]
  * Renders a built-in scene (or `door`) with iris_render and the guiding
  * provider, prints one line: scene method spp seconds setup relMSE. relMSE is
@@ -90,6 +91,10 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--photon-lights-area")) gp.photon_lights = IRIS_EMIT_BY_AREA;
     else if (!strcmp(a, "--force")) gp.force = true;
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
+    else if (!strcmp(a, "--train-spp")) gp.train_spp = atoi(v), ++i;
+    else if (!strcmp(a, "--train-prior")) gp.train_prior = (float)atof(v), ++i;
+    else if (!strcmp(a, "--train-all-light")) gp.train_all_light = true;
+    else if (!strcmp(a, "--no-learn-alpha")) gp.learn_alpha = false;
     else if (!strcmp(a, "--width")) p.width = atoi(v), ++i;
     else if (!strcmp(a, "--height")) p.height = atoi(v), ++i;
     else if (!strcmp(a, "--threads")) p.threads = atoi(v), ++i;
