@@ -36,7 +36,9 @@ static uint64_t hash_bytes(uint64_t h, const unsigned char *p, size_t n) {
   return iris_mix64(h ^ (uint64_t)n);
 }
 
-static uint64_t file_checksum(const unsigned char *data, size_t size) {
+uint64_t iris_guide_file_checksum(const void *bytes, size_t size) {
+  const unsigned char *data = bytes;
+  if (size < HEADER_BYTES) return 0;
   uint64_t h = hash_bytes(0x67756964652d6631ULL, data, CHECKSUM_AT);
   return hash_bytes(h, data + HEADER_BYTES, size - HEADER_BYTES);
 }
@@ -160,7 +162,7 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
    * passed the grid's cell-count cap), n and lo are stored to check it. */
   const bool grid = !skipped && g->grid.n[0] > 0;
   put_u32(&w, (uint32_t)g->params.cache_res);
-  put_f32(&w, skipped ? INFINITY : g->pick_radius2);
+  put_f32(&w, g->pick_radius2); /* 0 in a skipped guide */
   put_f32(&w, grid ? 2.0f * g->grid.cell : 0.0f);
   for (int a = 0; a < 3; ++a) put_i32(&w, grid ? g->grid.n[a] : 0);
   for (int a = 0; a < 3; ++a) put_f32(&w, grid ? g->grid.lo[a] : 0.0f);
@@ -200,7 +202,7 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
   }
   uint64_t payload = (uint64_t)(w.size - HEADER_BYTES);
   for (int i = 0; i < 8; ++i) w.data[32 + i] = (unsigned char)(payload >> (8 * i));
-  uint64_t sum = file_checksum(w.data, w.size);
+  uint64_t sum = iris_guide_file_checksum(w.data, w.size);
   for (int i = 0; i < 8; ++i) w.data[CHECKSUM_AT + i] = (unsigned char)(sum >> (8 * i));
   iris_status st = iris_file_write_atomic(path, w.data, w.size, err);
   free(w.data);
@@ -338,7 +340,8 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
   if (r->short_read) return refuse(err, path, "guide file is truncated");
   if (res != (uint32_t)g->params.cache_res)
     return refuse(err, path, "guide file's map size differs from its cache resolution (corrupted)");
-  if (isnan(g->pick_radius2) || !(g->pick_radius2 > 0.0f) || !isfinite(*spacing) || *spacing < 0.0f)
+  if (isnan(g->pick_radius2) || !(g->pick_radius2 > 0.0f || (g->stats.skipped && g->pick_radius2 == 0.0f)) ||
+      !isfinite(*spacing) || *spacing < 0.0f)
     return refuse(err, path, "guide file has an invalid cache search radius (corrupted)");
   for (int a = 0; a < 3; ++a)
     if (grid_n[a] < 0 || !isfinite(grid_lo[a]))
@@ -443,7 +446,7 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
                           payload > size - HEADER_BYTES ? "truncated" : "longer than written", size,
                           (unsigned long long)payload + HEADER_BYTES);
   }
-  if (file_checksum(d, size) != sum) {
+  if (iris_guide_file_checksum(d, size) != sum) {
     free(data);
     return refuse(err, path, "guide file is corrupted (checksum mismatch)");
   }
