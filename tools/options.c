@@ -99,8 +99,8 @@ static const iris_option GUIDING_ROWS[] = {
         "write the built guide to FILE (without -o/--png: build\n"
         "and write the guide only, render nothing)"),
     OPT("guide-in", 0, IRIS_OPT_STRING, "FILE", 0, 0, iris_guiding_params, guide_in,
-        "read the guide from FILE (written by --guide-out for the same\n"
-        "scene and settings) instead of building it"),
+        "read the guide from FILE (from --guide-out, same scene\n"
+        "and settings) instead of building it"),
     OPT("dump-caches", 0, IRIS_OPT_STRING, "DIR", 0, 0, iris_guiding_params, dump_dir,
         "write pdf and photon-count PNGs of the caches that\n"
         "serve a 4x3 grid of pixels (DIR/caches.txt lists them)"),

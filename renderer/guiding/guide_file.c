@@ -135,7 +135,8 @@ static void put_stats(writer *w, const iris_guiding_stats *s) {
   put_f64(w, s->cache_seconds);
   put_f64(w, s->total_seconds);
   put_u8(w, s->skipped);
-  size_t n = strnlen(s->reason, REASON_MAX);
+  size_t n = 0;
+  while (n < REASON_MAX && s->reason[n]) ++n;
   put_u32(w, (uint32_t)n);
   put_bytes(w, s->reason, n);
 }
