@@ -243,7 +243,11 @@ int iris_cmd_render(int argc, char **argv) {
   if (erc != IRIS_EXIT_OK) return erc;
   /* Everything that can be checked is checked before any work starts. */
   if (!input) return iris_cli_usage_error(CMD, "no input scene given");
-  if (!out_exr && !out_png) return iris_cli_usage_error(CMD, "no output: give -o OUT.exr and/or --png OUT.png");
+  /* --guide-out without an image output: build and write the guide only (the
+   * Slurm driver's training job). */
+  const bool guide_only = !out_exr && !out_png && gp.guide_out;
+  if (!out_exr && !out_png && !guide_only)
+    return iris_cli_usage_error(CMD, "no output: give -o OUT.exr and/or --png OUT.png");
   if (have_spp && p.time_budget > 0.0)
     return iris_cli_usage_error(CMD, "--spp and --time exclude each other");
   if (out_exr && !ends_with(out_exr, ".exr"))
@@ -256,6 +260,20 @@ int iris_cmd_render(int argc, char **argv) {
   if ((aov_caches || gp.dump_dir) && !iris_method_uses_guiding(p.method))
     return iris_cli_usage_error(CMD, "%s needs --method guided or guided-nee",
                                 aov_caches ? "--aov caches" : "--dump-caches");
+  if ((gp.guide_in || gp.guide_out) && !iris_method_uses_guiding(p.method))
+    return iris_cli_usage_error(CMD, "%s needs --method guided or guided-nee",
+                                gp.guide_in ? "--guide-in" : "--guide-out");
+  if (gp.guide_in && gp.guide_out)
+    return iris_cli_usage_error(CMD, "--guide-in and --guide-out exclude each other (copy the file instead)");
+  if (gp.guide_in && (aov_caches || gp.dump_dir))
+    return iris_cli_usage_error(CMD, "%s needs the photons of a built guide; it does not work with --guide-in",
+                                aov_caches ? "--aov caches" : "--dump-caches");
+  if (gp.guide_out && !output_dir_ok(gp.guide_out))
+    return iris_cli_usage_error(CMD, "the folder of the --guide-out file does not exist");
+  if (gp.guide_in && !iris_path_exists(gp.guide_in)) {
+    fprintf(stderr, "iris: %s: cannot open: no such guide file\n", gp.guide_in);
+    return IRIS_EXIT_USAGE;
+  }
   if (gp.dump_dir && !iris_path_exists(gp.dump_dir))
     return iris_cli_usage_error(CMD, "the --dump-caches folder '%s' does not exist", gp.dump_dir);
   if (aov_caches) gp.marks = &marks;
@@ -282,7 +300,10 @@ int iris_cmd_render(int argc, char **argv) {
   p.camera_name = camera;
 
   progress_state ps = {!quiet && !json && iris_log_progress_enabled(), 0};
-  p.cancel = &g_stop;
+  /* Guide only: the guide is built (and written by the provider) before the
+   * first pass, and the passes see a stop request that is already set. */
+  static volatile sig_atomic_t stop_before_passes = 1;
+  p.cancel = guide_only ? &stop_before_passes : &g_stop;
   p.progress = draw_progress;
   p.progress_ctx = &ps;
   {
@@ -313,6 +334,10 @@ int iris_cmd_render(int argc, char **argv) {
     return iris_cli_report(&err);
   }
   rc = IRIS_EXIT_OK;
+  if (guide_only) {
+    res.interrupted = false; /* stopped on purpose before the passes */
+    if (!quiet && !json) iris_infof("render: %s: guide written to %s (no image)", input, gp.guide_out);
+  }
   if (out_exr) st = iris_render_write_exr(&res, out_exr, input, variance, &err);
   if (st == IRIS_OK && out_png) st = iris_render_write_png(&res, out_png, (float)exposure, &err);
   if (st == IRIS_OK && aov_caches) st = write_cache_marks(&res, &marks, out_png ? out_png : out_exr, (float)exposure, &err);

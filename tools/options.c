@@ -95,6 +95,12 @@ static const iris_option GUIDING_ROWS[] = {
            "or, as the thesis, emitters by area"),
     OPT("force-guiding", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, force,
         "build caches even where guiding would be skipped"),
+    OPT("guide-out", 0, IRIS_OPT_STRING, "FILE", 0, 0, iris_guiding_params, guide_out,
+        "write the built guide to FILE (without -o/--png: build\n"
+        "and write the guide only, render nothing)"),
+    OPT("guide-in", 0, IRIS_OPT_STRING, "FILE", 0, 0, iris_guiding_params, guide_in,
+        "read the guide from FILE (from --guide-out, same scene\n"
+        "and settings) instead of building it"),
     OPT("dump-caches", 0, IRIS_OPT_STRING, "DIR", 0, 0, iris_guiding_params, dump_dir,
         "write pdf and photon-count PNGs of the caches that\n"
         "serve a 4x3 grid of pixels (DIR/caches.txt lists them)"),

@@ -11,9 +11,11 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/guiding/guide_file.h"
 #include "renderer/guiding/photons.h"
 #include "renderer/guiding/train.h"
 #include "renderer/guiding/vertex.h"
+#include "renderer/merge.h"
 
 #define CAMERA_SAMPLE_INDEX 0x63616d6361636865ULL /* streams apart from pixels and photons */
 #define MAX_SPECULAR_CHAIN 8
@@ -801,17 +803,37 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
 
 /* ---- iris_render provider ---------------------------------------------------- */
 
+/* The guide from a file (--guide-in) or built, and written (--guide-out):
+ * both keyed by the scene hash and the settings hash (guide_file.h). */
+static iris_status provider_guide(const iris_guide_setup *setup, const iris_guiding_params *p, iris_guiding **g,
+                                  iris_error *err) {
+  uint64_t scene_hash = 0, settings_hash = 0;
+  if (p->guide_in || p->guide_out) {
+    scene_hash = iris_merge_scene_hash(setup->scene);
+    settings_hash = iris_guiding_settings_hash(setup, p);
+  }
+  iris_status st = p->guide_in ? iris_guiding_load(p->guide_in, scene_hash, settings_hash, setup->threads, g, err)
+                               : iris_guiding_build(setup, p, g, err);
+  if (st == IRIS_OK && p->guide_out) st = iris_guiding_save(*g, p->guide_out, scene_hash, settings_hash, err);
+  if (st != IRIS_OK) {
+    iris_guiding_destroy(*g);
+    *g = NULL;
+  }
+  return st;
+}
+
 static iris_status provider_build(const iris_guide_setup *setup, iris_direction_sampler *out,
                                   void **state, iris_error *err) {
   iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
                                          : iris_guiding_params_default();
   p.use_nee = setup->integrator && iris_method_uses_nee(setup->integrator->method);
   iris_guiding *g = NULL;
-  iris_status st = iris_guiding_build(setup, &p, &g, err);
+  iris_status st = provider_guide(setup, &p, &g, err);
   if (st != IRIS_OK) return st;
   char line[512];
   iris_guiding_describe(g, line, sizeof line);
-  iris_infof("%s", line);
+  if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
+  else iris_infof("%s", line);
   *out = iris_guiding_sampler(g);
   *state = g;
   return IRIS_OK;

@@ -63,6 +63,11 @@ typedef struct iris_guiding_params {
                            leaves to the sampled direction (--train-all-light) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
+  /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):
+   * guide_in: read the guide from this file instead of building it (refused
+   * unless it was written for the same scene and settings); guide_out: write
+   * the built guide to this file. */
+  const char *guide_in, *guide_out;
   /* Inspection (outputs of the build, NULL = off): */
   const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
                                  serving a 4 x 3 grid of pixels (docs/guiding.md) */

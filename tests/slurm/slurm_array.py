@@ -1,7 +1,9 @@
 #!/usr/bin/python3
 """slurm.array: a single-node Slurm cluster in this test's own directory runs
 `iris-slurm render` (a 4-task job array of sample partitions + a dependent
-`iris merge` job), and the merged image must equal a single-process render.
+`iris merge` job), and the merged image must equal a single-process render;
+the same for a guided-nee render, whose array waits for the training job that
+writes the guide every task reads (afterok).
 Then `iris-slurm sweep` runs a 6-command array + report job, and a sweep with a
 failing task must end without its report job (afterok).
 
@@ -268,6 +270,33 @@ def main():
         if r.returncode != 0:
             raise RuntimeError("the merged image differs from the single-process render")
         log("merged image equals the single-process render")
+
+        # Guided: training job (writes the guide) -> array (reads it) -> merge.
+        gcommon = ["door", "--width", "40", "--height", "30", "--seed", "7", "--max-depth", "6",
+                   "--method", "guided-nee"]
+        gjob = os.path.join(workdir, "gjob")
+        gmerged = os.path.join(workdir, "gmerged.exr")
+        gsingle = os.path.join(workdir, "gsingle.exr")
+        r = c.run([iris_slurm, "render", "--workdir", gjob, "--iris", iris,
+                   "-o", gmerged, "--spp", "8", "--parts", "4", "--cpus-per-task", "1",
+                   "--width", "40", "--height", "30", "--wait",
+                   "--timeout", str(max(10.0, deadline - time.time() - 60)),
+                   "--", "door", "--seed", "7", "--max-depth", "6", "--method", "guided-nee"],
+                  check=False, timeout=TIMEOUT)
+        print(r.stdout + r.stderr, flush=True)
+        if r.returncode != 0 or "training job" not in r.stdout:
+            raise RuntimeError(f"iris-slurm render (guided) failed ({r.returncode})")
+        glogs = os.listdir(os.path.join(gjob, "logs"))
+        if not os.path.exists(os.path.join(gjob, "guide.bin")) or \
+                len([f for f in glogs if f.startswith("render-train-")]) != 1:
+            raise RuntimeError(f"guided: no guide file or training log ({sorted(glogs)})")
+        c.run([iris, "render"] + gcommon + ["--spp", "8", "--variance", "--quiet", "-o", gsingle],
+              timeout=120)
+        r = c.run([exr_close, gmerged, gsingle], check=False)
+        print(r.stdout + r.stderr, flush=True)
+        if r.returncode != 0:
+            raise RuntimeError("guided: the merged image differs from the single-process render")
+        log("guided: training job + array merged equal the single-process render")
 
         # A generic sweep (the shape of scenes x methods x budgets for iris
         # bench): every task's output and the report job's must appear...
