@@ -56,7 +56,10 @@ static iris_status timed_build(const iris_guide_setup *setup, iris_direction_sam
   return st;
 }
 static void timed_destroy(void *state) { iris_guiding_provider.destroy(state); }
-static const iris_guide_provider timed_provider = {timed_build, timed_destroy};
+static bool timed_decision(const void *state, char *why, size_t size) {
+  return iris_guiding_provider.decision(state, why, size);
+}
+static const iris_guide_provider timed_provider = {timed_build, timed_destroy, timed_decision};
 
 int main(int argc, char **argv) {
   if (argc < 3) {
@@ -89,6 +92,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--no-adjoint-rr")) gp.adjoint_rr = false;
     else if (!strcmp(a, "--photon-lights-area")) gp.photon_lights = IRIS_EMIT_BY_AREA;
     else if (!strcmp(a, "--force")) gp.force = true;
+    else if (!strcmp(a, "--pilot")) gp.pilot_paths = atoll(v), ++i; /* 0: decide on the full pass */
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
     else if (!strcmp(a, "--width")) p.width = atoi(v), ++i;
     else if (!strcmp(a, "--height")) p.height = atoi(v), ++i;

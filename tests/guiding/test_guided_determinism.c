@@ -31,7 +31,7 @@ static iris_guiding *build(const iris_scene *s, int threads, uint64_t seed) {
     iris_guiding_params gp = iris_guiding_params_default();
     gp.use_nee = true;
     gp.photons = 60000;
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL};
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, 64, 0.0, IRIS_SAMPLER_SOBOL};
     if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   }
   iris_lights_destroy(&lights);
