@@ -53,6 +53,12 @@ static iris_status timed_build(const iris_guide_setup *setup, iris_direction_sam
   double t0 = cpu_seconds();
   iris_status st = iris_guiding_provider.build(setup, out, state, err);
   g_guide_cpu = cpu_seconds() - t0;
+  if (st == IRIS_OK && *state) { /* the skip decision's inputs (docs/guiding.md, "--method auto") */
+    const iris_guiding_stats *gs = &((const iris_guiding *)*state)->stats;
+    printf("decision: %s; pilot %llu paths share %.3f (%.3f s); full %llu paths share %.3f\n",
+           gs->skipped ? "skip" : "guide", (unsigned long long)gs->pilot_paths, gs->pilot_share, gs->pilot_seconds,
+           (unsigned long long)gs->photon_paths, gs->indirect_share);
+  }
   return st;
 }
 static void timed_destroy(void *state) { iris_guiding_provider.destroy(state); }

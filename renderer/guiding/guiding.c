@@ -647,7 +647,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   iris_status st = iris_octmap_create(&g->hemi, g->params.cache_res, false, err);
   if (st == IRIS_OK) st = iris_octmap_create(&g->sphere, g->params.cache_res, true, err);
   if (st == IRIS_OK) {
-    if (setup->lights->count == 0 && !g->params.force) skip(g, "the scene has no lights");
+    if (setup->lights->count == 0 && !g->params.force) skip(g, "no lights");
     else st = build_caches(g, setup, stride, err);
   }
   if (st != IRIS_OK) {
