@@ -6,7 +6,7 @@
 #include "renderer/normal_map.h"
 
 static const char *const METHOD_NAMES[IRIS_METHOD_COUNT] = {"bsdf", "nee", "mis", "guided",
-                                                             "guided-nee"};
+                                                             "guided-nee", "auto"};
 
 const char *iris_method_name(iris_method method) {
   return (unsigned)method < IRIS_METHOD_COUNT ? METHOD_NAMES[method] : "unknown";

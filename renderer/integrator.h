@@ -28,13 +28,16 @@ typedef enum iris_method {
   IRIS_METHOD_BSDF = 0,   /* BSDF sampling only; emitters count when hit */
   IRIS_METHOD_NEE,        /* light sampling for direct light; hits count only from the
                              camera and after delta bounces */
-  IRIS_METHOD_MIS,        /* both, power heuristic (default) */
+  IRIS_METHOD_MIS,        /* both, power heuristic */
   IRIS_METHOD_GUIDED,     /* guided direction sampling, emitters count when hit */
   IRIS_METHOD_GUIDED_NEE, /* guided direction sampling + light sampling with MIS */
-  IRIS_METHOD_COUNT
+  IRIS_METHOD_AUTO,       /* guided-nee or mis, chosen per scene by iris_render before any
+                             path is traced (docs/guiding.md, "--method auto"); the default.
+                             The integrator never sees it. */
+  IRIS_METHOD_COUNT       /* iris_render_params: unset */
 } iris_method;
 
-/* "bsdf", "nee", "mis", "guided", "guided-nee". */
+/* "bsdf", "nee", "mis", "guided", "guided-nee", "auto". */
 const char *iris_method_name(iris_method method);
 /* False when `name` is not a method name. */
 bool iris_method_parse(const char *name, iris_method *out);

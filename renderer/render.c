@@ -32,7 +32,7 @@ void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scen
   if (p->max_depth < 0) p->max_depth = rs->max_depth >= 0 ? rs->max_depth : IRIS_DEFAULT_MAX_DEPTH;
   if (p->method == IRIS_METHOD_COUNT) {
     iris_method m;
-    p->method = rs->method[0] && iris_method_parse(rs->method, &m) ? m : IRIS_METHOD_MIS;
+    p->method = rs->method[0] && iris_method_parse(rs->method, &m) ? m : IRIS_METHOD_AUTO;
   }
 }
 
@@ -84,6 +84,12 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   iris_render_params p = *params_in;
   iris_render_params_from_scene(&p, scene);
   if (p.threads <= 0) p.threads = iris_parallel_default_threads();
+  res->method_requested = p.method;
+  if (p.method == IRIS_METHOD_AUTO && (!p.guide || !p.guide->build || !p.guide->decision)) {
+    /* nothing to decide with: mis, at no cost */
+    p.method = IRIS_METHOD_MIS;
+    snprintf(res->method_reason, sizeof res->method_reason, "auto: mis (the guiding module is not linked in)");
+  }
   if (iris_method_uses_guiding(p.method) && (!p.guide || !p.guide->build))
     return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
                           "method '%s' needs the guiding module, which is not linked in",
@@ -138,11 +144,28 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     it.max_depth = p.max_depth;
     it.rr_depth = p.rr_depth;
   }
-  if (st == IRIS_OK && iris_method_uses_guiding(p.method)) {
+  const bool resolve = p.method == IRIS_METHOD_AUTO;
+  if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
+  if (st == IRIS_OK && (resolve || iris_method_uses_guiding(p.method))) {
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
                            p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
                            p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
+  }
+  if (st == IRIS_OK && resolve) {
+    /* --method auto: guided-nee where the guide says it is of use, else mis
+     * without keeping any of the guide (docs/guiding.md, "--method auto"). */
+    char why[IRIS_METHOD_REASON_SIZE - 32];
+    why[0] = 0;
+    bool use = p.guide->decision(guide_state, why, sizeof why);
+    p.method = use ? IRIS_METHOD_GUIDED_NEE : IRIS_METHOD_MIS;
+    it.method = p.method;
+    snprintf(res->method_reason, sizeof res->method_reason, "auto: %s (%s)", iris_method_name(p.method), why);
+    if (!use) {
+      memset(&it.guide, 0, sizeof it.guide);
+      if (guide_state && p.guide->destroy) p.guide->destroy(guide_state);
+      guide_state = NULL;
+    }
   }
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
   if (st == IRIS_OK) {
@@ -257,6 +280,8 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("version", "%s", IRIS_VERSION_STRING);
   META("scene", "%s", scene_name ? scene_name : "");
   META("method", "%s", iris_method_name(r->method));
+  META("method_requested", "%s", iris_method_name(r->method_requested));
+  if (r->method_reason[0]) META("method_reason", "%s", r->method_reason);
   META("sampler", "%s", iris_sampler_kind_name(r->sampler));
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
   META("spp", "%d", r->spp);

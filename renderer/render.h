@@ -7,6 +7,7 @@
 
 #include <signal.h>
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/error.h"
@@ -43,6 +44,11 @@ typedef struct iris_guide_provider {
   iris_status (*build)(const iris_guide_setup *setup, iris_direction_sampler *out,
                        void **state, iris_error *err);
   void (*destroy)(void *state);
+  /* After build: whether the guide is in use (false: it skipped the scene and
+   * the sampler is BSDF sampling), and in `why` a short phrase saying why,
+   * e.g. "75% of the photons indirect" or "the scene has no lights".
+   * `--method auto` resolves to guided-nee when true, to mis when false. */
+  bool (*decision)(const void *state, char *why, size_t size);
 } iris_guide_provider;
 
 /* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
@@ -56,7 +62,7 @@ typedef struct iris_render_params {
   double time_budget;       /* > 0: whole passes until this many seconds */
   uint64_t seed;
   int threads;              /* <= 0: all cores */
-  iris_method method;       /* IRIS_METHOD_COUNT: the scene's, else mis */
+  iris_method method;       /* IRIS_METHOD_COUNT: the scene's, else auto */
   iris_sampler_kind sampler; /* default sobol (docs/rendering.md, "Samplers") */
   iris_triangle_sampling light_sampling; /* emitter triangles: default solid angle where it helps */
   int max_depth;            /* Cycles' bounce count; < 0: the scene's, else 64 */
@@ -81,17 +87,22 @@ typedef struct iris_render_params {
   bool budget_includes_setup;
 } iris_render_params;
 
-/* Defaults: everything unset (taken from the scene, else 64 spp, mis, max
+/* Defaults: everything unset (taken from the scene, else 64 spp, auto, max
  * depth 64), seed 0, all cores, Russian roulette from bounce 3. */
 iris_render_params iris_render_params_default(void);
 /* Fills unset params (spp, max depth, method, seed) from the scene's render
  * settings and then from the defaults. */
 void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scene);
 
+#define IRIS_METHOD_REASON_SIZE 200
+
 typedef struct iris_render_result {
   iris_film film;
   iris_pinhole camera;
-  iris_method method;
+  iris_method method;           /* the method the paths used (auto resolved) */
+  iris_method method_requested; /* the one asked for (flag, scene or default): may be auto */
+  char method_reason[IRIS_METHOD_REASON_SIZE]; /* auto: "auto: guided-nee (75% of the photons
+                                                  indirect)"; otherwise "" */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
   int spp;               /* samples per pixel completed */
@@ -113,7 +124,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
 void iris_render_result_destroy(iris_render_result *result);
 
 /* EXR with R, G, B (+ var.R/G/B when `variance`) and iris:version, scene,
- * method, spp, seed, render_seconds, interrupted, ... metadata, and what
+ * method (the resolved one), method_requested, method_reason (auto), spp, seed, render_seconds, interrupted, ... metadata, and what
  * iris merge needs: sample_offset, window, full_size, scene_hash, config_hash. */
 iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
                                   const char *scene_name, bool variance, iris_error *err);

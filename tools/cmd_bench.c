@@ -17,7 +17,7 @@ static const char *CMD = "bench";
 
 static void print_help(void) {
   printf(
-      "Usage: iris bench INPUT... --methods LIST --times LIST --reference REF.exr|auto\n"
+      "Usage: iris bench INPUT... [--methods LIST] --times LIST --reference REF.exr|auto\n"
       "                  --out DIR [options]\n"
       "\n"
       "Speed against accuracy: renders every INPUT (iris scene, OBJ/PLY/glTF file or\n"
@@ -26,7 +26,8 @@ static void print_help(void) {
       "top 0.1%% of pixels dropped), MAPE and the mean-energy ratio against a reference.\n"
       "\n"
       "Runs:\n"
-      "      --methods LIST   comma-separated: bsdf,nee,mis,guided,guided-nee; a method may\n"
+      "      --methods LIST   comma-separated: auto,bsdf,nee,mis,guided,guided-nee (default\n"
+      "                       auto: guided-nee or mis per scene); a method may\n"
       "                       name its variant: mis@independent, mis@area,\n"
       "                       mis@independent+area (sampler, emitter triangles)\n"
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
@@ -210,7 +211,7 @@ int iris_cmd_bench(int argc, char **argv) {
   p.world.strength = eo.strength;
   p.world.rotation = eo.rotation;
   p.world.color = iris_options_seen(&envb, "env-color") ? eo.color : NULL;
-  if (!methods_buf[0]) return iris_cli_usage_error(CMD, "no --methods given (e.g. mis,guided)");
+  if (!methods_buf[0]) snprintf(methods_buf, sizeof methods_buf, "auto"); /* docs/guiding.md, "--method auto" */
   if (!times_buf[0]) return iris_cli_usage_error(CMD, "no --times given (e.g. 1,2,4)");
   if (!p.out_dir) return iris_cli_usage_error(CMD, "no output folder: give --out DIR");
   if (!ref_auto && ref_count == 0)
@@ -230,7 +231,7 @@ int iris_cmd_bench(int argc, char **argv) {
       iris_sampler_kind smp;
       iris_triangle_sampling ls;
       if (!iris_bench_method_parse(items[k], &m, &smp, &ls))
-        return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee, "
+        return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee, "
                                          "optionally @independent, @area or @independent+area)", items[k]);
       /* --sampler and --light-sampling set what a plain name means */
       if (!strchr(items[k], '@')) {

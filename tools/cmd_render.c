@@ -220,7 +220,7 @@ int iris_cmd_render(int argc, char **argv) {
   if (iris_options_seen(rb, "time")) p.time_budget = ro.time;
   if (have_seed) p.seed = ro.seed;
   if (ro.method && !iris_method_parse(ro.method, &p.method))
-    return iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", ro.method);
+    return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee)", ro.method);
   p.sampler = (iris_sampler_kind)ro.sampler;               /* 0 (sobol) unless given */
   p.light_sampling = (iris_triangle_sampling)ro.light_sampling;
   if (iris_options_seen(rb, "max-depth")) p.max_depth = ro.max_depth;
@@ -278,7 +278,8 @@ int iris_cmd_render(int argc, char **argv) {
     return iris_cli_usage_error(CMD, "the --dump-caches folder '%s' does not exist", gp.dump_dir);
   if (aov_caches) gp.marks = &marks;
   if (gp.marks || gp.dump_dir) gp.inspect = iris_guiding_inspect;
-  if (iris_method_uses_guiding(p.method)) {
+  /* unset (the scene's method, else auto) and auto may need the guide too */
+  if (iris_method_uses_guiding(p.method) || p.method == IRIS_METHOD_AUTO || p.method == IRIS_METHOD_COUNT) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &gp;
     p.config_hash = guiding_params_hash(&gp);
@@ -355,6 +356,8 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_AddNumberToObject(o, "height", res.film.height);
     cJSON_AddStringToObject(o, "camera", res.camera.name);
     cJSON_AddStringToObject(o, "method", iris_method_name(res.method));
+    cJSON_AddStringToObject(o, "method_requested", iris_method_name(res.method_requested));
+    if (res.method_reason[0]) cJSON_AddStringToObject(o, "method_reason", res.method_reason);
     cJSON_AddStringToObject(o, "sampler", iris_sampler_kind_name(res.sampler));
     cJSON_AddStringToObject(o, "light_sampling", iris_triangle_sampling_name(res.light_sampling));
     cJSON_AddNumberToObject(o, "spp", res.spp);
@@ -381,7 +384,8 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_Delete(o);
   } else if (!quiet) {
     iris_infof("render: %s, %dx%d, %d spp (%s), %.2f s, %.2f Msamples/s, %.1f Mrays/s%s",
-               input, res.film.width, res.film.height, res.spp, iris_method_name(res.method),
+               input, res.film.width, res.film.height, res.spp,
+               res.method_reason[0] ? res.method_reason : iris_method_name(res.method),
                res.seconds, res.seconds > 0 ? samples / res.seconds * 1e-6 : 0.0,
                res.seconds > 0 ? rays / res.seconds * 1e-6 : 0.0,
                res.interrupted ? " (interrupted)" : "");

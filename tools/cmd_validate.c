@@ -36,8 +36,9 @@ static void print_help(void) {
       "                            camera and world; reports where the importers disagree\n"
       "      --blender-spp N       Cycles samples per pixel (default %d; --refresh: per scene)\n"
       "Rendering:\n"
-      "      --method M            bsdf | nee | mis | guided | guided-nee; repeat or give a\n"
-      "                            comma list to validate several (default mis)\n"
+      "      --method M            auto | bsdf | nee | mis | guided | guided-nee; repeat or\n"
+      "                            give a comma list to validate several (default: the\n"
+      "                            scene's, else auto: guided-nee or mis per scene)\n"
       "      --spp N               iris samples per pixel (default %d)\n"
       "      --seed N              seed of iris and Cycles (default 0)\n"
       "      --threads N           threads of iris and Cycles (default: all cores)\n"
@@ -86,7 +87,7 @@ static bool add_methods(iris_validate_params *p, const char *list) {
   for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
     iris_method m;
     if (!iris_method_parse(tok, &m)) {
-      iris_cli_usage_error(CMD, "unknown method '%s' (bsdf, nee, mis, guided, guided-nee)", tok);
+      iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee)", tok);
       return false;
     }
     for (int i = 0; i < p->method_count; i++)

@@ -56,7 +56,7 @@ static const iris_option RENDER_ROWS[] = {
     OPT("seed", 0, IRIS_OPT_U64, "N", 0, 0, iris_render_options, seed,
         "random seed (default: the scene's, else 0)"),
     OPT("method", 0, IRIS_OPT_STRING, "M", 0, 0, iris_render_options, method,
-        "bsdf | nee | mis (default) | guided | guided-nee"),
+        "auto | bsdf | nee | mis | guided | guided-nee (default:\nthe scene's, else auto: guided-nee or mis per scene)"),
     CHOICE("sampler", "S", iris_render_options, sampler, SAMPLER_CHOICES,
            "sobol (default: Owen-scrambled Sobol) | independent"),
     CHOICE("light-sampling", "M", iris_render_options, light_sampling, LIGHT_SAMPLING_CHOICES,
@@ -106,7 +106,7 @@ static const iris_option GUIDING_ROWS[] = {
         "serve a 4x3 grid of pixels (DIR/caches.txt lists them)"),
 };
 const iris_option_group IRIS_GUIDING_OPTIONS = {
-    "Guiding (--method guided | guided-nee; docs/guiding.md; unset = from the scene)", GUIDING_ROWS,
+    "Guiding (--method auto | guided | guided-nee; docs/guiding.md; unset = from the scene)", GUIDING_ROWS,
     sizeof GUIDING_ROWS / sizeof GUIDING_ROWS[0]};
 
 /* ---- parser ---------------------------------------------------------------- */

@@ -382,7 +382,7 @@ static iris_render_params render_params(const iris_bench_params *p, const iris_b
   rp.cancel = p->cancel;
   rp.progress = on_render_progress;
   rp.progress_ctx = ctx;
-  if (iris_method_uses_guiding(method)) {
+  if (iris_method_uses_guiding(method) || method == IRIS_METHOD_AUTO) {
     rp.guide = &iris_guiding_provider;
     rp.guide_options = gp;
   }
@@ -719,6 +719,8 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           memset(&row, 0, sizeof row);
           snprintf(row.scene, sizeof row.scene, "%s", sc->name);
           snprintf(row.method, sizeof row.method, "%s", label);
+          snprintf(row.resolved, sizeof row.resolved, "%s", iris_method_name(rr.method));
+          snprintf(row.method_reason, sizeof row.method_reason, "%s", rr.method_reason);
           row.seed = (uint64_t)s;
           row.budget_s = p.times[t];
           /* the whole call: setup, passes and the film's allocation */
@@ -769,12 +771,12 @@ iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res,
   iris_atomic_file f;
   iris_status st = iris_atomic_open(&f, path, err);
   if (st != IRIS_OK) return st;
-  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio\n");
+  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved\n");
   for (size_t i = 0; i < res->row_count; i++) {
     const iris_bench_row *r = &res->rows[i];
-    fprintf(f.fp, "%s,%s,%llu,%g,%.4f,%d,%.6g,%.6g,%.6g\n", r->scene, r->method,
+    fprintf(f.fp, "%s,%s,%llu,%g,%.4f,%d,%.6g,%.6g,%.6g,%s\n", r->scene, r->method,
             (unsigned long long)r->seed, r->budget_s, r->seconds, r->spp, r->relmse, r->mape,
-            r->energy_ratio);
+            r->energy_ratio, r->resolved[0] ? r->resolved : r->method);
   }
   if (ferror(f.fp)) {
     iris_atomic_abort(&f);
@@ -860,6 +862,8 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "scene", r->scene);
     cJSON_AddStringToObject(j, "method", r->method);
+    cJSON_AddStringToObject(j, "resolved", r->resolved[0] ? r->resolved : r->method);
+    if (r->method_reason[0]) cJSON_AddStringToObject(j, "method_reason", r->method_reason);
     cJSON_AddNumberToObject(j, "seed", (double)r->seed);
     cJSON_AddNumberToObject(j, "budget_s", r->budget_s);
     iris_json_add_number(j, "seconds", r->seconds);

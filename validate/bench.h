@@ -86,6 +86,8 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
 typedef struct iris_bench_row {
   char scene[128];
   char method[32];
+  char resolved[32];     /* the method the paths used: auto's choice, else = method */
+  char method_reason[200]; /* auto: "auto: guided-nee (75% of the photons indirect)"; else "" */
   uint64_t seed;
   double budget_s;       /* the budget; Cycles: the budget of the mis run whose spp it used */
   double seconds;        /* wall-clock of setup + passes; Cycles: render time, start-up excluded */
@@ -133,7 +135,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
                            iris_error *err);
 void iris_bench_result_destroy(iris_bench_result *result);
 
-/* DIR/results.csv: header scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio. */
+/* DIR/results.csv: header scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved. */
 iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res, iris_error *err);
 /* DIR/results.json: machine, parameters, scenes (reference, images), rows, tables and charts. */
 iris_status iris_bench_write_json(const char *path, const iris_bench_params *params,

@@ -81,6 +81,32 @@ typedef struct method_curve {
   bool extrapolated;
 } method_curve;
 
+/* The row name of a method in the tables: its label, and for a method that
+ * resolves per scene (auto) what it resolved to, e.g. "auto (guided-nee)";
+ * "auto (mis, guided-nee)" if the runs did not all choose the same. */
+static const char *display_name(const iris_bench_result *res, const char *scene, const char *label, char *buf,
+                                size_t size) {
+  snprintf(buf, size, "%.31s", label);
+  size_t at = strlen(buf);
+  int found = 0;
+  for (size_t i = 0; i < res->row_count; i++) {
+    const iris_bench_row *r = &res->rows[i];
+    if (strcmp(r->scene, scene) != 0 || strcmp(r->method, label) != 0 || !r->resolved[0] ||
+        strcmp(r->resolved, label) == 0 || strncmp(r->resolved, label, strlen(r->resolved)) == 0)
+      continue;
+    bool seen = false; /* already listed */
+    for (size_t j = 0; j < i && !seen; j++) {
+      const iris_bench_row *q = &res->rows[j];
+      seen = strcmp(q->scene, scene) == 0 && strcmp(q->method, label) == 0 && strcmp(q->resolved, r->resolved) == 0;
+    }
+    if (seen) continue;
+    at += (size_t)snprintf(buf + at, at < size ? size - at : 0, "%s%.31s", found++ ? ", " : " (", r->resolved);
+    if (at >= size) break;
+  }
+  if (found && at + 1 < size) snprintf(buf + at, size - at, ")");
+  return buf;
+}
+
 static int collect(const iris_bench_params *p, const iris_bench_result *res, const char *scene,
                    const double *budgets, method_curve *mc) {
   int n = 0;
@@ -223,8 +249,10 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
     for (int t = 0; t < p->time_count + 2; t++) fprintf(m, "---:|");
     fprintf(m, "\n");
     for (int k = 0; k < n; k++) {
-      fprintf(m, "| %s |", mc[k].name);
-      fprintf(h, "<tr><td>%s</td>", mc[k].name);
+      char shown[96];
+      display_name(res, sc->name, mc[k].name, shown, sizeof shown);
+      fprintf(m, "| %s |", shown);
+      fprintf(h, "<tr><td>%s</td>", shown);
       for (int t = 0; t < p->time_count; t++) {
         char c[400];
         cell_relmse(c, sizeof c, &mc[k], base, budgets[t], false);

@@ -122,6 +122,8 @@ iris_status iris_report_write_summary(const char *path, const iris_validate_para
     const iris_validate_method *m = &res->methods[k];
     cJSON *j = cJSON_CreateObject();
     cJSON_AddStringToObject(j, "method", iris_method_name(m->method));
+    cJSON_AddStringToObject(j, "resolved", iris_method_name(m->resolved));
+    if (m->method_reason[0]) cJSON_AddStringToObject(j, "method_reason", m->method_reason);
     cJSON_AddNumberToObject(j, "spp", m->spp);
     iris_json_add_number(j, "seconds", m->seconds);
     cJSON_AddItemToObject(j, "mean", triple(m->mean));

@@ -508,8 +508,8 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
                               iris_error *err) {
   iris_validate_params p = *params;
   memset(res, 0, sizeof *res);
-  if (p.method_count <= 0) {
-    p.methods[0] = IRIS_METHOD_MIS;
+  if (p.method_count <= 0) { /* the scene's method, else auto */
+    p.methods[0] = IRIS_METHOD_COUNT;
     p.method_count = 1;
   }
   if (p.spp <= 0) p.spp = IRIS_VALIDATE_DEFAULT_SPP;
@@ -611,12 +611,13 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     rp.max_depth = res->max_depth;
     rp.camera_name = p.camera_name;
     rp.cancel = p.cancel;
-    if (iris_method_uses_guiding(rp.method)) {
+    if (iris_method_uses_guiding(rp.method) || rp.method == IRIS_METHOD_AUTO || rp.method == IRIS_METHOD_COUNT) {
       rp.guide = &iris_guiding_provider;
       rp.guide_options = &gp;
     }
     if (!p.quiet) iris_infof("validate: rendering %s with %s, %d spp, %dx%d", p.input,
-                             iris_method_name(rp.method), rp.spp, rp.width, rp.height);
+                             rp.method == IRIS_METHOD_COUNT ? "the default method" : iris_method_name(rp.method),
+                             rp.spp, rp.width, rp.height);
     iris_render_result rr;
     st = iris_render(scene, &rp, &rr, err);
     if (st != IRIS_OK) goto done;
@@ -625,7 +626,10 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
       st = iris_error_set(err, IRIS_ERR_INTERRUPTED, NULL, 0, NULL, "interrupted");
       goto done;
     }
-    m->method = rr.method;
+    m->method = rr.method_requested;
+    m->resolved = rr.method;
+    snprintf(m->method_reason, sizeof m->method_reason, "%s", rr.method_reason);
+    if (!p.quiet && rr.method_reason[0]) iris_infof("validate: %s", rr.method_reason);
     m->spp = rr.spp;
     m->seconds = rr.seconds + rr.setup_seconds;
     m->dropped_samples = rr.stats.nan_count;

@@ -54,10 +54,19 @@ static iris_status timed_build(const iris_guide_setup *setup, iris_direction_sam
   double t0 = cpu_seconds();
   iris_status st = iris_guiding_provider.build(setup, out, state, err);
   g_guide_cpu = cpu_seconds() - t0;
+  if (st == IRIS_OK && *state) { /* the skip decision's inputs (docs/guiding.md, "--method auto") */
+    const iris_guiding_stats *gs = &((const iris_guiding *)*state)->stats;
+    printf("decision: %s; pilot %llu paths share %.3f (%.3f s); full %llu paths share %.3f\n",
+           gs->skipped ? "skip" : "guide", (unsigned long long)gs->pilot_paths, gs->pilot_share, gs->pilot_seconds,
+           (unsigned long long)gs->photon_paths, gs->indirect_share);
+  }
   return st;
 }
 static void timed_destroy(void *state) { iris_guiding_provider.destroy(state); }
-static const iris_guide_provider timed_provider = {timed_build, timed_destroy};
+static bool timed_decision(const void *state, char *why, size_t size) {
+  return iris_guiding_provider.decision(state, why, size);
+}
+static const iris_guide_provider timed_provider = {timed_build, timed_destroy, timed_decision};
 
 int main(int argc, char **argv) {
   if (argc < 3) {
@@ -90,6 +99,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--no-adjoint-rr")) gp.adjoint_rr = false;
     else if (!strcmp(a, "--photon-lights-area")) gp.photon_lights = IRIS_EMIT_BY_AREA;
     else if (!strcmp(a, "--force")) gp.force = true;
+    else if (!strcmp(a, "--pilot")) gp.pilot_paths = atoll(v), ++i; /* 0: decide on the full pass */
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
     else if (!strcmp(a, "--train-spp")) gp.train_spp = atoi(v), ++i;
     else if (!strcmp(a, "--train-prior")) gp.train_prior = (float)atof(v), ++i;

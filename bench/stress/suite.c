@@ -30,7 +30,7 @@ static iris_status render_once(const iris_scene *scene, iris_method method,
   p.spp = spp;
   p.time_budget = budget;
   iris_guiding_params gp = iris_guiding_params_default();
-  if (iris_method_uses_guiding(method)) {
+  if (iris_method_uses_guiding(method) || method == IRIS_METHOD_AUTO) {
     gp.use_nee = iris_method_uses_nee(method);
     if (sp->guide_photons > 0) gp.photons = sp->guide_photons;
     p.guide = &iris_guiding_provider;

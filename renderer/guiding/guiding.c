@@ -38,6 +38,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.learn_alpha = true;
   p.train_prior = 200.0f; /* a path sample weighs as much as a photon (k = 200); docs/guiding.md */
   p.train_all_light = false;
+  p.pilot_paths = -1;
   return p;
 }
 
@@ -412,13 +413,65 @@ static void skip(iris_guiding *g, const char *why) {
   snprintf(g->stats.reason, sizeof g->stats.reason, "%s", why);
 }
 
+#define INDIRECT_MIN 0.3 /* the "lit mostly directly" threshold */
+
+uint64_t iris_guiding_pilot_paths(uint64_t photons) {
+  uint64_t n = photons / 16 > 16384 ? photons / 16 : 16384;
+  n = (n + 4095) / 4096 * 4096;
+  return n < photons ? n : photons;
+}
+
+/* Decide before paying (docs/guiding.md, "--method auto"): with light
+ * sampling, a view of nothing but mirrors and glass (the camera pass below,
+ * run alone first) and a scene lit mostly directly (the 30% rule on a pilot,
+ * the first paths of the photon pass) are skipped before the full pass is
+ * traced. `photons` keeps the pilot's photons, which the full pass extends. */
+static iris_status pilot(iris_guiding *g, const iris_guide_setup *s, int stride, iris_photon_map *photons,
+                         iris_error *err) {
+  iris_guiding_params *p = &g->params;
+  memset(photons, 0, sizeof *photons);
+  if (!p->use_nee || p->force || p->pilot_paths == 0) return IRIS_OK;
+  double t0 = iris_time_now();
+  camera_ctx cc = {s, stride, (s->camera->width + stride - 1) / stride, (s->camera->height + stride - 1) / stride, NULL};
+  cc.out = malloc(sizeof(seed_point) * (size_t)cc.cols * (size_t)cc.rows);
+  if (!cc.out) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  iris_parallel_for((uint64_t)cc.rows, 1, s->threads, camera_rows, &cc);
+  size_t ncam = 0;
+  for (size_t i = 0; i < (size_t)cc.cols * (size_t)cc.rows; ++i) ncam += cc.out[i].valid;
+  free(cc.out);
+  if (ncam == 0) {
+    skip(g, "every visible surface is a perfect mirror or glass (or nothing is visible)");
+    return IRIS_OK;
+  }
+  uint64_t n = p->pilot_paths > 0 ? (uint64_t)p->pilot_paths : iris_guiding_pilot_paths((uint64_t)p->photons);
+  iris_status st = iris_photons_trace(s, p->photon_lights, n < (uint64_t)p->photons ? n : (uint64_t)p->photons,
+                                      photons, err);
+  if (st != IRIS_OK) return st;
+  g->stats.pilot_paths = photons->paths;
+  g->stats.pilot_share = indirect_share(s, photons);
+  g->stats.pilot_seconds = iris_time_now() - t0;
+  if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN) {
+    char why[160];
+    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons in a %llu-path pilot",
+             100.0 * g->stats.pilot_share, (unsigned long long)photons->paths);
+    skip(g, why);
+    iris_photons_destroy(photons);
+  }
+  return IRIS_OK;
+}
+
 static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int stride,
                                 iris_error *err) {
   iris_guiding_params *p = &g->params;
   double t0 = iris_time_now();
   iris_photon_map photons;
-  iris_status st = iris_photons_trace(s, p->photon_lights, (uint64_t)p->photons, &photons, err);
-  if (st != IRIS_OK) return st;
+  iris_status st = pilot(g, s, stride, &photons, err);
+  if (st == IRIS_OK && !g->stats.skipped)
+    st = iris_photons_trace_more(s, p->photon_lights, (uint64_t)p->photons, &photons, err);
+  if (st != IRIS_OK || g->stats.skipped) {
+    iris_photons_destroy(&photons);
+    return st;
+  }
   g->stats.photon_paths = photons.paths;
   g->stats.photons_stored = photons.count;
   g->stats.photons_indirect = photons.indirect;
@@ -432,9 +485,13 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   /* Mostly direct light (Veach: 20% of the photons indirect) is light
    * sampling's job; there the guide costs more per sample than it saves
    * (docs/guiding.md, benchmark). Door 75%, Cornell 65%. */
-  if (p->use_nee && !p->force && indirect_share(s, &photons) < 0.3) {
+  g->stats.indirect_share = indirect_share(s, &photons);
+  if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN) {
     iris_photons_destroy(&photons);
-    skip(g, "the scene is lit mostly directly (< 30% indirect photons): light sampling covers it");
+    char why[160];
+    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons",
+             100.0 * g->stats.indirect_share);
+    skip(g, why);
     return IRIS_OK;
   }
   /* Camera caches. */
@@ -603,10 +660,11 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   g->stats.cache_k = g->params.cache_k;
   g->stats.camera_stride = stride;
   g->stats.pdf_floor = g->params.pdf_floor;
+  g->stats.pilot_share = g->stats.indirect_share = -1.0;
   iris_status st = iris_octmap_create(&g->hemi, g->params.cache_res, false, err);
   if (st == IRIS_OK) st = iris_octmap_create(&g->sphere, g->params.cache_res, true, err);
   if (st == IRIS_OK) {
-    if (setup->lights->count == 0 && !g->params.force) skip(g, "the scene has no lights");
+    if (setup->lights->count == 0 && !g->params.force) skip(g, "no lights");
     else st = build_caches(g, setup, stride, err);
   }
   if (st == IRIS_OK && !g->stats.skipped && g->cache_count > 0) st = iris_guiding_train(g, setup, err);
@@ -841,4 +899,21 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
 
 static void provider_destroy(void *state) { iris_guiding_destroy(state); }
 
-const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy};
+static bool provider_decision(const void *state, char *why, size_t size) {
+  const iris_guiding *g = state;
+  if (!g) {
+    snprintf(why, size, "no guide");
+    return false;
+  }
+  if (g->stats.skipped) {
+    snprintf(why, size, "%s", g->stats.reason);
+    return false;
+  }
+  if (g->params.force)
+    snprintf(why, size, "guiding forced");
+  else
+    snprintf(why, size, "%.0f%% of the photons indirect", 100.0 * g->stats.indirect_share);
+  return true;
+}
+
+const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy, provider_decision};

@@ -68,6 +68,10 @@ typedef struct iris_guiding_params {
    * unless it was written for the same scene and settings); guide_out: write
    * the built guide to this file. */
   const char *guide_in, *guide_out;
+  int64_t pilot_paths;  /* with light sampling, the skip rules are decided before the full
+                           photon pass on its first pilot_paths paths; -1 auto
+                           (iris_guiding_pilot_paths), 0 no pilot (docs/guiding.md,
+                           "--method auto") */
   /* Inspection (outputs of the build, NULL = off): */
   const char *dump_dir;       /* --dump-caches DIR: pdf and photon-count PNGs of the caches
                                  serving a 4 x 3 grid of pixels (docs/guiding.md) */
@@ -109,6 +113,10 @@ typedef struct iris_guiding_stats {
   size_t memory_bytes; /* caches + tables + kd-tree */
   bool skipped;        /* guiding off: sampler falls back to the BSDF */
   char reason[160];
+  uint64_t pilot_paths;   /* photon paths of the pilot (0: none ran) */
+  double pilot_share;     /* share of indirect photons the 30% rule saw in the pilot (-1: none) */
+  double indirect_share;  /* ... and in the full pass (-1: the full pass did not run) */
+  double pilot_seconds;
 } iris_guiding_stats;
 
 typedef struct iris_guiding {
@@ -148,6 +156,10 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp);
 /* Builds the guide from `options` (an iris_guiding_params, NULL = defaults)
  * for iris_render; destroy frees it. */
 extern const iris_guide_provider iris_guiding_provider;
+
+/* Photon paths of the pilot for a full pass of `photons` paths: max(16384,
+ * photons / 16) rounded up to whole blocks of 4096, at most `photons`. */
+uint64_t iris_guiding_pilot_paths(uint64_t photons);
 
 /* One-line summaries for `iris render`. */
 void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size);

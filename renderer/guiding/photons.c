@@ -22,7 +22,7 @@ typedef struct photon_block {
 typedef struct trace_ctx {
   const iris_guide_setup *setup;
   const iris_distrib1d *select; /* light choice (lights->select, or the area one) */
-  uint64_t paths;
+  uint64_t first, paths;        /* path indices first .. paths - 1 */
   photon_block *blocks;
   iris_photon *all; /* concatenation target */
 } trace_ctx;
@@ -118,7 +118,7 @@ static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   (void)thread_index;
   trace_ctx *c = ctx;
   for (uint64_t b = begin; b < end; ++b) {
-    uint64_t lo = b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
+    uint64_t lo = c->first + b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
     if (hi > c->paths) hi = c->paths;
     for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->select, i, &c->blocks[b]);
     for (size_t i = 0; i < c->blocks[b].count; ++i) c->blocks[b].indirect += c->blocks[b].items[i].bounce > 0;
@@ -141,8 +141,14 @@ static void copy_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_inde
 iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_selection by,
                                uint64_t paths, iris_photon_map *out, iris_error *err) {
   memset(out, 0, sizeof *out);
-  if (paths == 0 || setup->lights->count == 0) return IRIS_OK;
-  uint64_t nblocks = (paths + BLOCK_PATHS - 1) / BLOCK_PATHS;
+  return iris_photons_trace_more(setup, by, paths, out, err);
+}
+
+iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission_selection by,
+                                    uint64_t paths, iris_photon_map *out, iris_error *err) {
+  if (paths <= out->paths || setup->lights->count == 0) return IRIS_OK;
+  const uint64_t first = out->paths;
+  uint64_t nblocks = (paths - first + BLOCK_PATHS - 1) / BLOCK_PATHS;
   /* By power: the lights' own selection; by area: one built for this pass only. */
   iris_distrib1d area_select;
   memset(&area_select, 0, sizeof area_select);
@@ -155,10 +161,11 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
     iris_distrib1d_destroy(&area_select);
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
   }
-  trace_ctx c = {setup, by == IRIS_EMIT_BY_AREA ? &area_select : &setup->lights->select, paths, blocks, NULL};
+  trace_ctx c = {setup, by == IRIS_EMIT_BY_AREA ? &area_select : &setup->lights->select, first, paths, blocks,
+                 NULL};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
   iris_distrib1d_destroy(&area_select);
-  size_t total = 0;
+  size_t total = out->count; /* the new photons go after the ones already traced */
   uint64_t indirect = 0;
   bool oom = false;
   for (uint64_t b = 0; b < nblocks; ++b) {
@@ -167,8 +174,9 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
     indirect += blocks[b].indirect;
     oom |= blocks[b].oom;
   }
-  iris_photon *all = oom ? NULL : malloc((total ? total : 1) * sizeof *all);
+  iris_photon *all = oom ? NULL : realloc(out->photons, (total ? total : 1) * sizeof *all);
   if (all) {
+    out->photons = all;
     c.all = all;
     iris_parallel_for(nblocks, 1, setup->threads, copy_blocks, &c);
   }
@@ -176,10 +184,9 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
   free(blocks);
   if (!all)
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %zu photons", total);
-  out->photons = all;
   out->count = total;
   out->paths = paths;
-  out->indirect = indirect;
+  out->indirect += indirect;
   return IRIS_OK;
 }
 

@@ -42,6 +42,12 @@ typedef struct iris_photon_map {
 /* Traces `paths` photon paths, choosing lights as `by` says. */
 iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
                                iris_photon_map *out, iris_error *err);
+/* Extends `map` (its first map->paths paths) to `paths` paths: the result is
+ * the map one iris_photons_trace of `paths` gives, bit for bit (path i's
+ * random numbers depend on i alone), so a pilot's photons are not traced
+ * twice. On failure the map keeps what it had. */
+iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
+                                    iris_photon_map *map, iris_error *err);
 void iris_photons_destroy(iris_photon_map *map);
 
 #ifdef __cplusplus

@@ -66,7 +66,7 @@ def main(argv):
     # results.csv
     with open(os.path.join(out, "results.csv"), newline="") as f:
         lines = f.read().splitlines()
-    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio",
+    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved",
           "CSV header: " + lines[0])
     rows = list(csv.DictReader(lines))
     check(len(rows) == 4, f"4 rows (2 methods x 2 budgets x 1 seed), got {len(rows)}")

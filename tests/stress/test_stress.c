@@ -29,7 +29,8 @@
 
 typedef struct budget {
   const char *scene;
-  int spp[IRIS_METHOD_COUNT]; /* bsdf, nee, mis, guided, guided-nee */
+  int spp[IRIS_METHOD_AUTO]; /* bsdf, nee, mis, guided, guided-nee (auto is one of mis and
+                                guided-nee: guiding.auto) */
 } budget;
 
 static const budget BUDGETS[] = {
@@ -118,7 +119,7 @@ int main(int argc, char **argv) {
   /* two gate comparisons (vs reference, vs mis) per checked pair */
   int comparisons = 0;
   for (size_t k = 0; k < n_scenes; k++)
-    for (int m = 0; m < IRIS_METHOD_COUNT; m++)
+    for (int m = 0; m < IRIS_METHOD_AUTO; m++)
       if (!scenes[k].black && !undersampled_why(scenes[k].name, (iris_method)m))
         comparisons += m == IRIS_METHOD_MIS ? 1 : 2;
   const double alpha = ALPHA / comparisons;
@@ -136,10 +137,10 @@ int main(int argc, char **argv) {
     CHECK_OK(st, &err);
     if (st != IRIS_OK) continue;
 
-    iris_stress_render_out r[IRIS_METHOD_COUNT];
+    iris_stress_render_out r[IRIS_METHOD_AUTO];
     memset(r, 0, sizeof r);
-    bool have[IRIS_METHOD_COUNT] = {false};
-    for (int m = 0; m < IRIS_METHOD_COUNT; m++) {
+    bool have[IRIS_METHOD_AUTO] = {false};
+    for (int m = 0; m < IRIS_METHOD_AUTO; m++) {
       have[m] = render(scene, (iris_method)m, b->spp[m], 1, &r[m]);
       if (!have[m]) continue;
       uint64_t nan = 0, inf = 0;
@@ -180,7 +181,7 @@ int main(int argc, char **argv) {
           have_ref = true;
         }
       }
-      for (int m = 0; have_ref && m < IRIS_METHOD_COUNT; m++) {
+      for (int m = 0; have_ref && m < IRIS_METHOD_AUTO; m++) {
         if (!have[m]) continue;
         const char *why = undersampled_why(info->name, (iris_method)m);
         iris_stress_compare c;
@@ -203,7 +204,7 @@ int main(int argc, char **argv) {
       }
       iris_image_destroy(&ref);
     }
-    for (int m = 0; m < IRIS_METHOD_COUNT; m++) iris_stress_render_out_destroy(&r[m]);
+    for (int m = 0; m < IRIS_METHOD_AUTO; m++) iris_stress_render_out_destroy(&r[m]);
     iris_scene_destroy(scene);
   }
   return TEST_SUMMARY();

@@ -1,0 +1,226 @@
+/* --method auto (docs/guiding.md, "--method auto"):
+ *  - it resolves to guided-nee on door and door-shielded and to mis on
+ *    veach-mis, furnace-diffuse, a scene without lights and a view of nothing
+ *    but mirrors, with the reason recorded in the result;
+ *  - the pilot traces fewer photon paths than the full pass and takes the
+ *    decision the full pass takes (the same build with --pilot 0), and where
+ *    guiding goes on the guide is the one built without a pilot (same photon
+ *    count, same caches);
+ *  - `auto` agrees with mis on door per image (3 sigma) and per 8x8 block
+ *    (Bonferroni for 0.1% family-wise, never below 3 sigma), z on the
+ *    variance of the mean (tests/common/film_stats.h).
+ * The summary line, --json and the EXR metadata: guiding.auto_cli. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "film_stats.h"
+#include "renderer/guiding/guiding.h"
+#include "renderer/render.h"
+#include "scenes/builtin.h"
+
+/* The guiding provider, keeping the stats of the last guide it built. */
+static iris_guiding_stats g_stats;
+static size_t g_caches;
+static iris_status keep_build(const iris_guide_setup *setup, iris_direction_sampler *out, void **state,
+                              iris_error *err) {
+  iris_status st = iris_guiding_provider.build(setup, out, state, err);
+  if (st == IRIS_OK && *state) {
+    g_stats = ((const iris_guiding *)*state)->stats;
+    g_caches = ((const iris_guiding *)*state)->cache_count;
+  }
+  return st;
+}
+static void keep_destroy(void *state) { iris_guiding_provider.destroy(state); }
+static bool keep_decision(const void *state, char *why, size_t size) {
+  return iris_guiding_provider.decision(state, why, size);
+}
+static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision};
+
+/* Renders `s` with `method` (spp samples, w x h); pilot: -1 auto, 0 none. */
+static bool render(const iris_scene *s, iris_method method, int w, int h, int spp, uint64_t seed, int64_t pilot,
+                   iris_render_result *r) {
+  iris_render_params p = iris_render_params_default();
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.pilot_paths = pilot;
+  p.width = w;
+  p.height = h;
+  p.spp = spp;
+  p.method = method;
+  p.seed = seed;
+  p.threads = 2;
+  p.guide = &KEEP;
+  p.guide_options = &gp;
+  memset(&g_stats, 0, sizeof g_stats);
+  g_caches = 0;
+  iris_error err;
+  iris_error_clear(&err);
+  if (iris_render(s, &p, r, &err) != IRIS_OK) {
+    fprintf(stderr, "render failed: %s\n", err.message);
+    return false;
+  }
+  return true;
+}
+
+typedef struct expectation {
+  const char *name;     /* built-in scene, or "no-lights" / "mirrors" (cornell-box changed) */
+  iris_method resolved;
+  const char *reason;   /* in the result's reason */
+} expectation;
+
+static iris_scene *make_scene(const char *name) {
+  iris_scene *s = NULL;
+  iris_error err;
+  iris_error_clear(&err);
+  const char *base = !strcmp(name, "no-lights") || !strcmp(name, "mirrors") ? "cornell-box" : name;
+  if (iris_builtin_create(base, &s, &err) != IRIS_OK) return NULL;
+  if (!strcmp(name, "no-lights")) {
+    for (size_t i = 0; i < s->material_count; i++)
+      for (int k = 0; k < 3; k++) s->materials[i].emission[k] = 0.0f;
+    s->light_count = 0; /* the box's lights are its emitting materials; keep none */
+  }
+  if (!strcmp(name, "mirrors")) /* every surface a perfect mirror, the light's too (it still emits) */
+    for (size_t i = 0; i < s->material_count; i++) {
+      iris_material *m = &s->materials[i];
+      m->type = IRIS_MATERIAL_GLOSSY;
+      m->roughness = 0.0f;
+    }
+  return s;
+}
+
+static void test_decisions(void) {
+  static const expectation E[] = {
+      {"door", IRIS_METHOD_GUIDED_NEE, "of the photons indirect"},
+      {"door-shielded", IRIS_METHOD_GUIDED_NEE, "of the photons indirect"},
+      {"veach-mis", IRIS_METHOD_MIS, "lit mostly directly"},
+      {"furnace-diffuse", IRIS_METHOD_MIS, "lit mostly directly"},
+      {"no-lights", IRIS_METHOD_MIS, "no lights"},
+      {"mirrors", IRIS_METHOD_MIS, "perfect mirror or glass"},
+  };
+  for (size_t i = 0; i < sizeof E / sizeof E[0]; i++) {
+    iris_scene *s = make_scene(E[i].name);
+    if (!CHECK(s != NULL)) continue;
+    iris_render_result r, full;
+    if (CHECK(render(s, IRIS_METHOD_AUTO, 32, 24, 1, 1, -1, &r))) {
+      iris_guiding_stats pilot = g_stats;
+      size_t caches = g_caches;
+      printf("%-16s %s | pilot %llu paths, share %.3f | full %llu paths, share %.3f\n", E[i].name, r.method_reason,
+             (unsigned long long)pilot.pilot_paths, pilot.pilot_share, (unsigned long long)pilot.photon_paths,
+             pilot.indirect_share);
+      CHECK_EQ_STR(iris_method_name(r.method), iris_method_name(E[i].resolved));
+      CHECK_EQ_INT(r.method_requested, IRIS_METHOD_AUTO);
+      iris_check_record(strncmp(r.method_reason, "auto: ", 6) == 0 && strstr(r.method_reason, E[i].reason),
+                        __FILE__, __LINE__, "%s: reason '%s' should name '%s'", E[i].name, r.method_reason,
+                        E[i].reason);
+      /* the same build deciding on the full photon pass only */
+      if (CHECK(render(s, IRIS_METHOD_AUTO, 32, 24, 1, 1, 0, &full))) {
+        CHECK_EQ_STR(iris_method_name(full.method), iris_method_name(r.method));
+        CHECK_EQ_INT(g_stats.pilot_paths, 0);
+        if (pilot.pilot_paths > 0) { /* a pilot ran: fewer paths than the full pass */
+          CHECK(pilot.pilot_paths < g_stats.photon_paths);
+          CHECK_EQ_INT(pilot.pilot_paths, iris_guiding_pilot_paths(g_stats.photon_paths));
+          /* the pilot's share lies on the full pass's side of 30% */
+          CHECK((pilot.pilot_share < 0.3) == (g_stats.indirect_share < 0.3));
+        }
+        if (r.method == IRIS_METHOD_GUIDED_NEE) { /* the pilot's photons are the full pass's first */
+          CHECK_EQ_INT(pilot.photon_paths, g_stats.photon_paths);
+          CHECK_EQ_INT(pilot.photons_stored, g_stats.photons_stored);
+          CHECK_EQ_INT(pilot.photons_indirect, g_stats.photons_indirect);
+          CHECK_EQ_INT(caches, g_caches);
+          size_t n = (size_t)r.film.width * (size_t)r.film.height;
+          bool same = true;
+          for (size_t k = 0; k < n && same; k++) {
+            iris_vec3 a, b, va, vb;
+            iris_film_pixel(&r.film, (int)(k % (size_t)r.film.width), (int)(k / (size_t)r.film.width), &a, &va);
+            iris_film_pixel(&full.film, (int)(k % (size_t)full.film.width), (int)(k / (size_t)full.film.width), &b,
+                            &vb);
+            same = a.x == b.x && a.y == b.y && a.z == b.z;
+          }
+          iris_check_record(same, __FILE__, __LINE__, "%s: the image with a pilot differs from the one without",
+                            E[i].name);
+        }
+        if (r.method == IRIS_METHOD_MIS && pilot.pilot_paths > 0) /* skipped before the full pass */
+          CHECK_EQ_INT(pilot.photon_paths, 0);
+        iris_render_result_destroy(&full);
+      }
+      iris_render_result_destroy(&r);
+    }
+    iris_scene_destroy(s);
+  }
+}
+
+/* A scene's own method wins over auto; without a guide provider auto is mis. */
+static void test_defaults(void) {
+  iris_scene *s = make_scene("door");
+  if (!CHECK(s != NULL)) return;
+  iris_render_params p = iris_render_params_default();
+  iris_render_params_from_scene(&p, s);
+  CHECK_EQ_STR(iris_method_name(p.method), "auto");
+  snprintf(s->render.method, sizeof s->render.method, "nee");
+  p = iris_render_params_default();
+  iris_render_params_from_scene(&p, s);
+  CHECK_EQ_STR(iris_method_name(p.method), "nee");
+  s->render.method[0] = 0;
+  p = iris_render_params_default();
+  p.width = 16;
+  p.height = 12;
+  p.spp = 1;
+  iris_render_result r;
+  iris_error err;
+  iris_error_clear(&err);
+  if (CHECK(iris_render(s, &p, &r, &err) == IRIS_OK)) {
+    CHECK_EQ_STR(iris_method_name(r.method), "mis");
+    CHECK(strstr(r.method_reason, "not linked in") != NULL);
+    iris_render_result_destroy(&r);
+  }
+  iris_scene_destroy(s);
+}
+
+/* auto (guided-nee on door) agrees with mis. */
+static void test_unbiased(void) {
+  iris_scene *s = make_scene("door");
+  if (!CHECK(s != NULL)) return;
+  const int w = 32, h = 24, spp = 128;
+  const int bx = w / 8, by = h / 8, n_tests = 3 * bx * by;
+  const double z_block = fmax(3.0, z_for_alpha(1e-3 / n_tests)), z_image = 3.0;
+  iris_render_result a, m;
+  bool ok_a = CHECK(render(s, IRIS_METHOD_AUTO, w, h, spp, 301, -1, &a));
+  bool ok_m = CHECK(render(s, IRIS_METHOD_MIS, w, h, 2 * spp, 302, -1, &m));
+  if (ok_a && ok_m) {
+    CHECK_EQ_STR(iris_method_name(a.method), "guided-nee");
+    double worst = 0.0;
+    for (int blk = -1; blk < bx * by; blk++) {
+      int x0 = 0, y0 = 0, x1 = w, y1 = h;
+      if (blk >= 0) {
+        x0 = (blk % bx) * 8, y0 = (blk / bx) * 8;
+        x1 = x0 + 8, y1 = y0 + 8;
+      }
+      double ma[3], va[3], mb[3], vb[3];
+      region(&m.film, x0, y0, x1, y1, ma, va);
+      region(&a.film, x0, y0, x1, y1, mb, vb);
+      for (int k = 0; k < 3; k++) {
+        double sd = sqrt(va[k] + vb[k]);
+        double z = sd > 0 ? (ma[k] - mb[k]) / sd : (ma[k] == mb[k] ? 0.0 : INFINITY);
+        if (fabs(z) > worst) worst = fabs(z);
+        iris_check_record(fabs(z) <= (blk < 0 ? z_image : z_block), __FILE__, __LINE__,
+                          "door mis vs auto, %s (%d,%d)-(%d,%d) channel %d: %.5f vs %.5f, z = %.2f",
+                          blk < 0 ? "image" : "block", x0, y0, x1, y1, k, ma[k], mb[k], z);
+      }
+    }
+    printf("door: mis vs auto (%s): worst |z| = %.2f (image < %.1f, blocks < %.2f)\n", a.method_reason, worst,
+           z_image, z_block);
+    CHECK_EQ_INT(a.stats.nan_count, 0);
+  }
+  if (ok_a) iris_render_result_destroy(&a);
+  if (ok_m) iris_render_result_destroy(&m);
+  iris_scene_destroy(s);
+}
+
+int main(void) {
+  test_defaults();
+  test_decisions();
+  test_unbiased();
+  return iris_check_summary("guiding.auto");
+}
