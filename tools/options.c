@@ -85,7 +85,8 @@ static const iris_option GUIDING_ROWS[] = {
         "texel probability floor (default 0.0002)"),
     OPT("alpha-max", 0, IRIS_OPT_FLOAT, "A", 0, 1, iris_guiding_params, alpha_max,
         "cap on the cache-sampling probability (default 0.5 for\n"
-        "guided-nee, 0.7 for guided)"),
+        "guided-nee, 0.7 for guided; trained caches learn their\n"
+        "own up to 0.95, or up to A when given)"),
     OPT("cos-min", 0, IRIS_OPT_FLOAT, "C", -1, 1, iris_guiding_params, cos_min,
         "cache normal agreement needed (default 0.9)"),
     CHOICE("splat", "nearest|bilinear", iris_guiding_params, splat, SPLAT_CHOICES,
@@ -93,6 +94,18 @@ static const iris_option GUIDING_ROWS[] = {
     CHOICE("photon-lights", "power|area", iris_guiding_params, photon_lights, PHOTON_LIGHT_CHOICES,
            "photons leave lights in proportion to power (default)\n"
            "or, as the thesis, emitters by area"),
+    OPT("train-spp", 0, IRIS_OPT_INT, "N", 0, 1000000, iris_guiding_params, train_spp,
+        "samples per pixel of training passes from camera paths\n"
+        "(default 8% of --spp, or of what --time holds; 0: photons only)"),
+    OPT("train-prior", 0, IRIS_OPT_FLOAT, "W", 0, 1e9, iris_guiding_params, train_prior,
+        "photon-equivalent weight of a cache's photons against its\n"
+        "n training samples, mixed n / (n + W) (default 200)"),
+    OPT("train-all-light", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, train_all_light,
+        "train towards all incident light, not only the part light\n"
+        "sampling leaves to the sampled direction"),
+    OPT("no-learn-alpha", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, learn_alpha,
+        "keep alpha = min(roughness, --alpha-max) instead of learning\n"
+        "each cache's selection probability in training"),
     OPT("force-guiding", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, force,
         "build caches even where guiding would be skipped"),
     OPT("guide-out", 0, IRIS_OPT_STRING, "FILE", 0, 0, iris_guiding_params, guide_out,
@@ -151,7 +164,7 @@ static bool set_value(const char *cmd, const iris_option *o, const char *val, vo
   long lv;
   double dv;
   switch (o->type) {
-    case IRIS_OPT_FLAG: *(bool *)field = true; return true;
+    case IRIS_OPT_FLAG: *(bool *)field = o->lo >= 0.0; return true; /* lo < 0: a --no-X flag */
     case IRIS_OPT_INT:
       if (!iris_cli_parse_int(cmd, flag, val, (long)o->lo, (long)o->hi, &lv)) return false;
       *(int *)field = (int)lv;

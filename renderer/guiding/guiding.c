@@ -847,16 +847,26 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     snprintf(buf, size, "guiding skipped (BSDF sampling instead): %s", s->reason);
     return;
   }
+  /* learned selection probabilities: their mean over the caches that learned one */
+  double asum = 0.0;
+  size_t learned = 0;
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].alpha >= 0.0f) asum += g->caches[i].alpha, learned++;
+  char alpha[96];
+  if (learned)
+    snprintf(alpha, sizeof alpha, "alpha learned by %zu caches (mean %.2f), else %g", learned,
+             asum / (double)learned, (double)g->params.alpha_max);
+  else
+    snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
-           "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, alpha <= %g; "
+           "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, %s; "
            "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s); cache memory %.1f MiB",
            (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
            s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
            (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
            (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, s->cache_k,
-           (double)s->pdf_floor, (double)g->params.alpha_max, s->total_seconds, s->photon_seconds,
-           s->train_spp, s->train_iterations, s->train_seconds, (double)s->memory_bytes / (1024.0 * 1024.0));
+           (double)s->pdf_floor, alpha, s->total_seconds, s->photon_seconds, s->train_spp, s->train_iterations, s->train_seconds, (double)s->memory_bytes / (1024.0 * 1024.0));
 }
 
 /* ---- iris_render provider ---------------------------------------------------- */

@@ -4,7 +4,8 @@
  *  - a windowed render equals the same window of the full render bit for bit
  *    (film sums), because pixels keep their full-frame sampler index;
  *  - sample partitions (uneven, different thread counts) and tiles merge to
- *    the single render to float rounding, for mis and for the guided method
+ *    the single render to float rounding, for mis, for the guided method and
+ *    for guided-nee with training passes
  *    (same seed -> same caches on every node);
  *  - parts that do not belong together are refused with a clear message;
  *  - the scene hash is stable across a JSON round trip and sees a changed value. */
@@ -484,6 +485,11 @@ int main(void) {
     g_gp.caches = 400;
     g_gp.force = true;
     test_renders(cornell, IRIS_METHOD_GUIDED, 8, "guided");
+    /* with training passes: they trace the whole frame with their own sample
+     * indices, so parts of any window or sample range train the same guide
+     * (an explicit budget: the automatic one follows each part's spp) */
+    g_gp.train_spp = 3;
+    test_renders(cornell, IRIS_METHOD_GUIDED_NEE, 8, "guided-nee trained");
     test_refusals(cornell);
     iris_scene_destroy(cornell);
   }
