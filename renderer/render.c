@@ -149,7 +149,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   if (st == IRIS_OK && (resolve || iris_method_uses_guiding(p.method))) {
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
                            p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
-                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler};
+                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK && resolve) {

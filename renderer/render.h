@@ -36,6 +36,8 @@ typedef struct iris_guide_setup {
   int spp;             /* the render's samples per pixel (0 with a time budget) */
   double time_budget;  /* the render's wall-clock budget in seconds (0: spp decides) */
   iris_sampler_kind sampler; /* the render's sampler (training paths use it too) */
+  bool deciding;       /* --method auto is deciding: the guide may decline the scene on rules
+                          that only auto applies (docs/guiding.md, "--method auto") */
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;

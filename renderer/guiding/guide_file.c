@@ -140,6 +140,8 @@ static void put_stats(writer *w, const iris_guiding_stats *s) {
   put_i32(w, s->train_iterations);
   put_u64(w, s->train_samples);
   put_f64(w, s->train_seconds);
+  put_f64(w, s->indirect_share);
+  put_f64(w, s->seen_indirect_energy);
   put_u8(w, s->skipped);
   size_t n = 0;
   while (n < REASON_MAX && s->reason[n]) ++n;
@@ -323,7 +325,13 @@ static bool get_stats(reader *r, iris_guiding_stats *s) {
   s->train_iterations = get_i32(r);
   s->train_samples = get_u64(r);
   s->train_seconds = get_f64(r);
+  s->indirect_share = get_f64(r);
+  s->seen_indirect_energy = get_f64(r);
+  s->pilot_share = -1.0;
   uint8_t skipped = get_u8(r);
+  if (!(s->indirect_share >= -1.0 && s->indirect_share <= 1.0) ||
+      !(s->seen_indirect_energy >= -1.0 && s->seen_indirect_energy <= 1.0))
+    return false;
   if (s->train_spp < 0 || s->train_iterations < 0) return false;
   uint32_t n = get_u32(r);
   s->skipped = skipped != 0;

@@ -110,6 +110,8 @@ typedef struct iris_guiding_stats {
   int train_spp, train_iterations; /* training passes run (docs/guiding.md, "Training") */
   uint64_t train_samples;          /* path vertices recorded into caches */
   double train_seconds;
+  double seen_indirect_energy; /* --method auto: share of the photon energy on surfaces the camera
+                                  sees that arrived indirectly, from the pilot (-1: not measured) */
   size_t memory_bytes; /* caches + tables + kd-tree */
   bool skipped;        /* guiding off: sampler falls back to the BSDF */
   char reason[160];

@@ -11,6 +11,7 @@
 #ifndef IRIS_RENDERER_GUIDING_TRAIN_H
 #define IRIS_RENDERER_GUIDING_TRAIN_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "core/error.h"

@@ -92,8 +92,10 @@ static iris_scene *make_scene(const char *name) {
 
 static void test_decisions(void) {
   static const expectation E[] = {
-      {"door", IRIS_METHOD_GUIDED_NEE, "of the photons indirect"},
-      {"door-shielded", IRIS_METHOD_GUIDED_NEE, "of the photons indirect"},
+      {"door", IRIS_METHOD_GUIDED_NEE, "of the photon energy on what the camera sees indirect"},
+      {"door-shielded", IRIS_METHOD_GUIDED_NEE, "of the photon energy on what the camera sees indirect"},
+      {"cornell-box", IRIS_METHOD_MIS, "what the camera sees is lit mostly directly"},
+      {"stress-glossy-room", IRIS_METHOD_MIS, "what the camera sees is lit mostly directly"},
       {"veach-mis", IRIS_METHOD_MIS, "lit mostly directly"},
       {"furnace-diffuse", IRIS_METHOD_MIS, "lit mostly directly"},
       {"no-lights", IRIS_METHOD_MIS, "no lights"},

@@ -47,7 +47,7 @@ static iris_guiding *build(const char *name, iris_method method, int64_t photons
     gp.use_nee = iris_method_uses_nee(method);
     gp.photons = photons;
     gp.force = force;
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 3, 2, NULL, 4, 0.0, IRIS_SAMPLER_SOBOL};
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 3, 2, NULL, 4, 0.0, IRIS_SAMPLER_SOBOL, false};
     if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   }
   iris_lights_destroy(&lights);

@@ -32,7 +32,7 @@ static iris_guiding *build(const iris_scene *s, int threads, uint64_t seed) {
     gp.use_nee = true;
     gp.photons = 60000;
     gp.train_spp = 7; /* three training passes (1 + 2 + 4 spp) */
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, 64, 0.0, IRIS_SAMPLER_SOBOL};
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, 64, 0.0, IRIS_SAMPLER_SOBOL, false};
     if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   }
   iris_lights_destroy(&lights);

@@ -113,7 +113,7 @@ static iris_guiding *build(const iris_scene *s, int threads, int train_spp) {
     gp.use_nee = true;
     gp.photons = 60000;
     gp.train_spp = train_spp;
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 5, threads, NULL, 256, 0.0, IRIS_SAMPLER_SOBOL};
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 5, threads, NULL, 256, 0.0, IRIS_SAMPLER_SOBOL, false};
     if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   }
   iris_lights_destroy(&lights);
