@@ -15,7 +15,7 @@
 /* Samples a cache needs before its learned selection probability is used. */
 #define ALPHA_MIN_SAMPLES 64
 /* Share of the render's samples spent on training when train_spp is automatic. */
-#define TRAIN_SHARE 0.08
+#define TRAIN_SHARE 0.05
 
 /* ---- selection probability --------------------------------------------------- */
 
@@ -165,11 +165,14 @@ typedef struct train_state {
   iris_alpha_learner *learner; /* per cache, this pass's samples */
 } train_state;
 
-static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer *b) {
+/* Adds a tile's samples to the caches whose id is `lane` modulo `lanes`:
+ * every cache receives its samples in tile order, whatever the lanes. */
+static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer *b, uint32_t lane, uint32_t lanes) {
   for (size_t i = 0; i < b->count; ++i) {
     const train_sample *t = &b->s[i];
     for (int j = 0; j < t->m; ++j) {
       uint32_t id = t->ids[j];
+      if (id % lanes != lane) continue;
       iris_cache *c = &g->caches[id];
       const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
       iris_vec3 wl = iris_frame_to_local(&c->frame, t->wi);
@@ -184,6 +187,21 @@ static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer 
       if (iris_cache_splat(map, ts->acc + c->table, wl, v, g->params.splat)) ts->irr[id] += v;
     }
   }
+}
+
+typedef struct merge_ctx {
+  iris_guiding *g;
+  train_state *ts;
+  const sample_buffer *buf;
+  uint64_t tiles;
+  uint32_t lanes;
+} merge_ctx;
+
+static void merge_lanes(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  (void)thread;
+  merge_ctx *c = vctx;
+  for (uint64_t lane = begin; lane < end; ++lane)
+    for (uint64_t t = 0; t < c->tiles; ++t) merge_samples(c->g, c->ts, &c->buf[t], (uint32_t)lane, c->lanes);
 }
 
 /* New tables for every cache: the photon histogram (normalised) and the path
@@ -268,10 +286,11 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
       iris_parallel_for(count, 1, s->threads, train_tiles, &c);
       for (uint64_t t = 0; t < count; ++t)
         if (buf[t].failed) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for training samples");
-      for (uint64_t t = 0; t < count && st == IRIS_OK; ++t) { /* tile order: the same guide for any thread count */
-        merge_samples(g, &ts, &buf[t]);
-        samples += buf[t].count;
-      }
+      if (st != IRIS_OK) break;
+      /* Caches split into lanes, each fed in tile order: the same guide for any thread count. */
+      merge_ctx mc = {g, &ts, buf, count, (uint32_t)(s->threads > 0 ? s->threads : iris_parallel_default_threads())};
+      iris_parallel_for(mc.lanes, 1, s->threads, merge_lanes, &mc);
+      for (uint64_t t = 0; t < count; ++t) samples += buf[t].count;
     }
     if (st != IRIS_OK) break;
     rebuild(g, &ts, p->learn_alpha, alpha_fallback, alpha_cap, hist);

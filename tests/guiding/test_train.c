@@ -81,9 +81,10 @@ static void test_learner(void) {
 }
 
 static void test_schedule(void) {
-  CHECK_EQ_INT(iris_guiding_train_budget(64), 5);
+  CHECK_EQ_INT(iris_guiding_train_budget(64), 3);
   CHECK_EQ_INT(iris_guiding_train_budget(8), 0);
-  CHECK_EQ_INT(iris_guiding_train_budget(1024), 81);
+  CHECK_EQ_INT(iris_guiding_train_budget(20), 1);
+  CHECK_EQ_INT(iris_guiding_train_budget(1024), 51);
   int done = 0, it = 0, sizes[8];
   while (done < 10) {
     sizes[it] = iris_guiding_train_iteration_spp(it, done, 10);
