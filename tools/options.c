@@ -96,7 +96,7 @@ static const iris_option GUIDING_ROWS[] = {
            "or, as the thesis, emitters by area"),
     OPT("train-spp", 0, IRIS_OPT_INT, "N", 0, 1000000, iris_guiding_params, train_spp,
         "samples per pixel of training passes from camera paths\n"
-        "(default 8% of --spp, or of what --time holds; 0: photons only)"),
+        "(default 5% of --spp, or of what --time holds; 0: photons only)"),
     OPT("train-prior", 0, IRIS_OPT_FLOAT, "W", 0, 1e9, iris_guiding_params, train_prior,
         "photon-equivalent weight of a cache's photons against its\n"
         "n training samples, mixed n / (n + W) (default 200)"),

@@ -89,7 +89,7 @@ int main(int argc, char **argv) {
   int w = 32, h = 24, spp = 128;
   if (!strcmp(scene, "cornell-box")) w = 24, h = 24;
   if (!strcmp(scene, "veach-mis")) w = 32, h = 16, spp = 256;
-  /* The defaults train the guide (8% of the spp in doubling passes) and learn
+  /* The defaults train the guide (5% of the spp in doubling passes) and learn
    * the selection probabilities; one variant trains longer towards all light. */
   static const variant variants[NV] = {
       {IRIS_METHOD_MIS, 0.0f, IRIS_SPLAT_BILINEAR, "mis", false, 0, false},
