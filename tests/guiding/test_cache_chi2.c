@@ -1,6 +1,7 @@
 /* Chi-square of cache sampling (Algorithm 2, uniform in solid angle inside the
  * texel) against the cache pdf, with the shared harness: hemisphere and
- * sphere maps, several fill patterns, nearest and bilinear splatting. */
+ * sphere maps, several fill patterns, nearest and bilinear splatting, and a
+ * map filled as the training passes fill it (Li cos / q: radiance x cosine). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -37,7 +38,7 @@ static iris_vec3 uniform_sphere(float u0, float u1) {
   return iris_v3(r * cosf(phi), r * sinf(phi), z);
 }
 
-#define N_TESTS 7
+#define N_TESTS 8
 
 static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
   cache_ctx c;
@@ -53,6 +54,8 @@ static void run(int res, bool sphere, int pattern, iris_splat_mode mode) {
     if (pattern == 0) e = powf(fmaxf(0.0f, iris_dot(d, lobe)), 30.0f); /* narrow lobe */
     if (pattern == 1) e = 0.2f + fabsf(d.z);                          /* smooth */
     if (pattern == 2) e = (d.x > 0.0f) ? 1.0f : 0.0f;                   /* half dark: floor only */
+    if (pattern == 3) /* as training splats: Li cos / q, Li a lobe on a constant (q uniform) */
+      e = (1.0f + 8.0f * powf(fmaxf(0.0f, iris_dot(d, lobe)), 4.0f)) * fabsf(d.z) * 4.0f * IRIS_PI;
     iris_cache_splat(&c.map, hist, d, e, mode);
   }
   CHECK(iris_cache_build_tables(&c.map, hist, 2e-4f, c.pdf, c.alias));
@@ -79,5 +82,6 @@ int main(void) {
   run(16, false, 2, IRIS_SPLAT_BILINEAR);
   run(5, false, 0, IRIS_SPLAT_BILINEAR); /* odd resolution: texel split by both diagonals */
   run(3, true, 1, IRIS_SPLAT_NEAREST);
+  run(8, false, 3, IRIS_SPLAT_BILINEAR); /* a trained cache: incident radiance x cosine */
   return TEST_SUMMARY();
 }

@@ -4,6 +4,8 @@
  *   integrand the cache strategy alone serves best, one BSDF sampling serves
  *   best), from samples drawn with another mixture;
  * - the schedule doubles and stops at the budget;
+ * - a cache filled as training fills it samples incident radiance x cosine:
+ *   its texel probabilities match the integrals of Li cos over the texels;
  * - a guide trained on a scene has learned selection probabilities, changed
  *   tables that still sum to one, and the training does not depend on the
  *   thread count (bit-identical tables and alphas for 1 and 2 threads). */
@@ -14,6 +16,7 @@
 
 #include "check.h"
 #include "core/rng.h"
+#include "renderer/guiding/cache.h"
 #include "renderer/guiding/train.h"
 #include "renderer/lights.h"
 #include "renderer/texture.h"
@@ -78,6 +81,67 @@ static void test_learner(void) {
   memset(&l, 0, sizeof l);
   for (int i = 0; i < 100; ++i) iris_alpha_learner_add(&l, 0.0f, 1.0f, 1.0f, 1.0f);
   CHECK(iris_alpha_learner_best(&l, 0.42f, 64) == 0.42f);
+}
+
+/* The product with the cosine: a cache filled as the training passes fill it
+ * (Li cos / q for directions drawn with density q, nearest splat) converges to
+ * texel probabilities proportional to the integral of Li cos over each texel,
+ * computed independently by uniform sampling inside each texel (exact solid
+ * angles). With Li constant that is the cosine alone, which differs from the
+ * solid-angle shares by far more than the tolerance near the horizon. */
+static double li_field(iris_vec3 d) {
+  iris_vec3 lobe = iris_normalize(iris_v3(0.5f, -0.3f, 0.6f));
+  return 0.3 + 6.0 * pow(fmax(0.0, (double)iris_dot(d, lobe)), 6.0);
+}
+
+static void check_cos_product(bool constant) {
+  iris_octmap map;
+  if (!CHECK(iris_octmap_create(&map, 8, false, NULL) == IRIS_OK)) return;
+  const uint32_t n = map.texel_count;
+  float *hist = calloc(n, sizeof(float));
+  double *want = calloc(n, sizeof(double)), wsum = 0.0, osum = 0.0;
+  const int N = 400000;
+  for (int i = 0; i < N; ++i) { /* q: uniform hemisphere, 1 / (2 pi) */
+    float u0 = iris_u64_to_unit(iris_hash4(9, (uint64_t)i, 0, 2)), u1 = iris_u64_to_unit(iris_hash4(9, (uint64_t)i, 1, 2));
+    float z = u0, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.0f * IRIS_PI * u1;
+    iris_vec3 d = iris_v3(r * cosf(phi), r * sinf(phi), z);
+    double li = constant ? 1.0 : li_field(d);
+    iris_cache_splat(&map, hist, d, (float)(li * d.z * 2.0 * IRIS_PI), IRIS_SPLAT_NEAREST);
+  }
+  for (uint32_t t = 0; t < n; ++t) {
+    double m = 0.0;
+    const int M = 4000;
+    for (int k = 0; k < M; ++k) {
+      iris_vec3 d = iris_octmap_sample_in_texel(&map, t, iris_u64_to_unit(iris_hash4(t, (uint64_t)k, 0, 3)),
+                                                iris_u64_to_unit(iris_hash4(t, (uint64_t)k, 1, 3)),
+                                                iris_u64_to_unit(iris_hash4(t, (uint64_t)k, 2, 3)));
+      m += (constant ? 1.0 : li_field(d)) * fmax(0.0, (double)d.z);
+    }
+    want[t] = m / M * map.solid_angle[t];
+    wsum += want[t];
+    osum += map.solid_angle[t];
+  }
+  float *pdf = calloc(n, sizeof(float));
+  iris_cache_alias *alias = calloc(n, sizeof(iris_cache_alias));
+  if (CHECK(iris_cache_build_tables(&map, hist, 0.0f, pdf, alias))) {
+    double worst = 0.0, cos_vs_omega = 0.0;
+    for (uint32_t t = 0; t < n; ++t) {
+      double p = pdf[t] * 2.0 / 64.0, w = want[t] / wsum;
+      /* binomial-like spread of a texel's share of N samples, weighted */
+      double sd = sqrt(w / N) * (constant ? 2.0 : 6.0) + 0.01 * w; /* + the quadrature's error */
+      worst = fmax(worst, fabs(p - w) / sd);
+      cos_vs_omega = fmax(cos_vs_omega, fabs(w - map.solid_angle[t] / osum) / sd);
+    }
+    printf("cos product (%s Li): worst texel %.2f sd from the integral of Li cos; %.1f sd from solid angle\n",
+           constant ? "constant" : "lobe", worst, cos_vs_omega);
+    iris_check_record(worst < 5.0, __FILE__, __LINE__, "trained texel probabilities vs Li cos integrals: %.2f sd", worst);
+    if (constant) CHECK(cos_vs_omega > 20.0); /* the test can tell the cosine from solid angle */
+  }
+  free(hist);
+  free(want);
+  free(pdf);
+  free(alias);
+  iris_octmap_destroy(&map);
 }
 
 static void test_schedule(void) {
@@ -180,6 +244,8 @@ static void test_trained_guide(void) {
 int main(void) {
   test_learner();
   test_schedule();
+  check_cos_product(true);
+  check_cos_product(false);
   test_trained_guide();
   return iris_check_summary("guiding.train");
 }
