@@ -383,53 +383,54 @@ static float pick_radius2(const iris_guiding *g, float *spacing) {
   return r2 > 0.0f ? r2 : INFINITY;
 }
 
+/* Photons on surfaces the camera sees: up to 4096 at an even stride through
+ * the map, facing the camera's eye and unoccluded from it. Counts them and
+ * their energy, and the part of both that arrived after a bounce. */
+typedef struct seen_photons {
+  size_t count, indirect;
+  double energy, indirect_energy;
+} seen_photons;
+
+static seen_photons count_seen_photons(const iris_guide_setup *s, const iris_photon_map *ph) {
+  seen_photons r = {0, 0, 0.0, 0.0};
+  size_t step = ph->count > 4096 ? ph->count / 4096 : 1;
+  iris_vec3 eye = s->camera->origin;
+  for (size_t i = 0; i < ph->count; i += step) {
+    const iris_photon *q = &ph->photons[i];
+    iris_vec3 to_eye = iris_sub(eye, q->p);
+    if (iris_dot(to_eye, q->n) <= 0.0f) continue;
+    iris_ray ray = iris_spawn_ray_to(q->p, q->n, eye, iris_neg(iris_normalize(to_eye)));
+    ray.tmax = 1.0f; /* the eye is a point, not a surface */
+    if (iris_accel_occluded(s->accel, &ray)) continue;
+    r.count++;
+    r.energy += q->energy;
+    if (q->bounce > 0) r.indirect++, r.indirect_energy += q->energy;
+  }
+  return r;
+}
+
 /* Fraction of indirect photons the skip rule looks at. Over all stored
  * photons, except in scenes lit mostly by the environment: there most
  * photons land directly on outside surfaces the camera never sees (the roof
  * and walls of a room lit through a window), so the fraction is taken over
- * up to 4096 photons (an even stride through the map) on surfaces the
- * camera sees: unoccluded from the camera and facing it. */
+ * the photons on surfaces the camera sees. */
 static double indirect_share(const iris_guide_setup *s, const iris_photon_map *ph) {
   if (ph->count == 0) return 0.0;
   double all = (double)ph->indirect / (double)ph->count;
   if (environment_share(s->lights) < 0.5) return all;
-  size_t step = ph->count > 4096 ? ph->count / 4096 : 1, seen = 0, indirect = 0;
-  iris_vec3 eye = s->camera->origin;
-  for (size_t i = 0; i < ph->count; i += step) {
-    const iris_photon *q = &ph->photons[i];
-    iris_vec3 to_eye = iris_sub(eye, q->p);
-    if (iris_dot(to_eye, q->n) <= 0.0f) continue;
-    iris_ray r = iris_spawn_ray_to(q->p, q->n, eye, iris_neg(iris_normalize(to_eye)));
-    r.tmax = 1.0f; /* the eye is a point, not a surface */
-    if (iris_accel_occluded(s->accel, &r)) continue;
-    seen++;
-    indirect += q->bounce > 0;
-  }
-  return seen > 0 ? (double)indirect / (double)seen : all;
+  seen_photons seen = count_seen_photons(s, ph);
+  return seen.count > 0 ? (double)seen.indirect / (double)seen.count : all;
 }
 
 /* --method auto's rule (docs/guiding.md, "--method auto"): the share of the
- * photon energy on surfaces the camera sees (up to 4096 photons at an even
- * stride, facing the camera's eye and unoccluded from it) that arrived after
- * at least one bounce. Where most of what the camera sees is lit directly,
- * light sampling already finds the light and guided-nee's dearer samples do
- * not pay (cornell-box 48%, stress-glossy-room 51%); where it is mostly
- * indirect they do (door 66%, sky-room 60%, door-shielded 90%). */
+ * photon energy on surfaces the camera sees that arrived after at least one
+ * bounce. Where most of what the camera sees is lit directly, light sampling
+ * already finds the light and guided-nee's dearer samples do not pay
+ * (cornell-box 48%, stress-glossy-room 51%); where it is mostly indirect they
+ * do (door 66%, sky-room 61%, door-shielded 93%). -1 when no photon is seen. */
 static double seen_indirect_energy(const iris_guide_setup *s, const iris_photon_map *ph) {
-  size_t step = ph->count > 4096 ? ph->count / 4096 : 1;
-  double all = 0.0, indirect = 0.0;
-  iris_vec3 eye = s->camera->origin;
-  for (size_t i = 0; i < ph->count; i += step) {
-    const iris_photon *q = &ph->photons[i];
-    iris_vec3 to_eye = iris_sub(eye, q->p);
-    if (iris_dot(to_eye, q->n) <= 0.0f) continue;
-    iris_ray r = iris_spawn_ray_to(q->p, q->n, eye, iris_neg(iris_normalize(to_eye)));
-    r.tmax = 1.0f; /* the eye is a point, not a surface */
-    if (iris_accel_occluded(s->accel, &r)) continue;
-    all += q->energy;
-    if (q->bounce > 0) indirect += q->energy;
-  }
-  return all > 0.0 ? indirect / all : -1.0;
+  seen_photons seen = count_seen_photons(s, ph);
+  return seen.energy > 0.0 ? seen.indirect_energy / seen.energy : -1.0;
 }
 
 #define AUTO_SEEN_INDIRECT_MIN 0.55 /* --method auto: guided-nee from this share on */

@@ -23,6 +23,7 @@
 #include "renderer/render.h"
 #include "renderer/texture.h"
 #include "scenes/builtin.h"
+#include "guide_fixture.h"
 
 #define SCENE_HASH 0x1234567890abcdefULL
 #define SETTINGS_HASH 0xfedcba0987654321ULL
@@ -32,27 +33,10 @@ static iris_guiding *build(const char *name, iris_method method, int64_t photons
   iris_error err;
   iris_error_clear(&err);
   if (iris_builtin_create(name, &s, &err) != IRIS_OK) return NULL;
-  iris_pinhole cam;
-  iris_accel *acc = NULL;
-  iris_textures tx;
-  iris_lights lights;
-  memset(&tx, 0, sizeof tx);
-  memset(&lights, 0, sizeof lights);
-  iris_guiding *g = NULL;
-  if (iris_pinhole_setup(s, NULL, 48, 36, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
-      iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK) {
-    iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
-    it.method = method;
-    iris_guiding_params gp = iris_guiding_params_default();
-    gp.use_nee = iris_method_uses_nee(method);
-    gp.photons = photons;
-    gp.force = force;
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 3, 2, NULL, 4, 0.0, IRIS_SAMPLER_SOBOL, false};
-    if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
-  }
-  iris_lights_destroy(&lights);
-  iris_textures_destroy(&tx);
-  iris_accel_destroy(acc);
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.photons = photons;
+  gp.force = force;
+  iris_guiding *g = test_guide_build(s, method, gp, 3, 2, 4);
   iris_scene_destroy(s);
   return g;
 }

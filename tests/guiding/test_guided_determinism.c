@@ -13,32 +13,13 @@
 #include "renderer/render.h"
 #include "renderer/texture.h"
 #include "scenes/builtin.h"
+#include "guide_fixture.h"
 
 static iris_guiding *build(const iris_scene *s, int threads, uint64_t seed) {
-  iris_error err;
-  iris_error_clear(&err);
-  iris_pinhole cam;
-  iris_accel *acc = NULL;
-  iris_textures tx;
-  iris_lights lights;
-  memset(&tx, 0, sizeof tx);
-  memset(&lights, 0, sizeof lights);
-  iris_guiding *g = NULL;
-  if (iris_pinhole_setup(s, NULL, 48, 36, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
-      iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK) {
-    iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
-    it.method = IRIS_METHOD_GUIDED_NEE;
-    iris_guiding_params gp = iris_guiding_params_default();
-    gp.use_nee = true;
-    gp.photons = 60000;
-    gp.train_spp = 7; /* three training passes (1 + 2 + 4 spp) */
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, 64, 0.0, IRIS_SAMPLER_SOBOL, false};
-    if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
-  }
-  iris_lights_destroy(&lights);
-  iris_textures_destroy(&tx);
-  iris_accel_destroy(acc);
-  return g;
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.photons = 60000;
+  gp.train_spp = 7; /* three training passes (1 + 2 + 4 spp) */
+  return test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, seed, threads, 64);
 }
 
 static size_t table_floats(const iris_guiding *g) {

@@ -21,6 +21,7 @@
 #include "renderer/lights.h"
 #include "renderer/texture.h"
 #include "scenes/builtin.h"
+#include "guide_fixture.h"
 
 /* 1D domain [0,1]: p_b = 1, p_c = 2x; samples from (1 - a0) p_b + a0 p_c. */
 static float learn(double (*h)(double), float a0, int n, uint64_t seed) {
@@ -161,30 +162,10 @@ static void test_schedule(void) {
 }
 
 static iris_guiding *build(const iris_scene *s, int threads, int train_spp) {
-  iris_error err;
-  iris_error_clear(&err);
-  iris_pinhole cam;
-  iris_accel *acc = NULL;
-  iris_textures tx;
-  iris_lights lights;
-  memset(&tx, 0, sizeof tx);
-  memset(&lights, 0, sizeof lights);
-  iris_guiding *g = NULL;
-  if (iris_pinhole_setup(s, NULL, 48, 36, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
-      iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK) {
-    iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
-    it.method = IRIS_METHOD_GUIDED_NEE;
-    iris_guiding_params gp = iris_guiding_params_default();
-    gp.use_nee = true;
-    gp.photons = 60000;
-    gp.train_spp = train_spp;
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, 5, threads, NULL, 256, 0.0, IRIS_SAMPLER_SOBOL, false};
-    if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
-  }
-  iris_lights_destroy(&lights);
-  iris_textures_destroy(&tx);
-  iris_accel_destroy(acc);
-  return g;
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.photons = 60000;
+  gp.train_spp = train_spp;
+  return test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 5, threads, 256);
 }
 
 static void test_trained_guide(void) {
