@@ -261,8 +261,11 @@ int iris_cmd_render(int argc, char **argv) {
   if ((aov_caches || gp.dump_dir) && !iris_method_uses_guiding(p.method))
     return iris_cli_usage_error(CMD, "%s needs --method guided or guided-nee",
                                 aov_caches ? "--aov caches" : "--dump-caches");
-  if ((gp.guide_in || gp.guide_out) && !iris_method_uses_guiding(p.method))
-    return iris_cli_usage_error(CMD, "%s needs --method guided or guided-nee",
+  /* auto's guide is a file too (a declined one records why); an unset method
+   * is checked once the scene says what it resolves to */
+  if ((gp.guide_in || gp.guide_out) && !iris_method_uses_guiding(p.method) && p.method != IRIS_METHOD_AUTO &&
+      p.method != IRIS_METHOD_COUNT)
+    return iris_cli_usage_error(CMD, "%s needs --method auto, guided or guided-nee",
                                 gp.guide_in ? "--guide-in" : "--guide-out");
   if (gp.guide_in && gp.guide_out)
     return iris_cli_usage_error(CMD, "--guide-in and --guide-out exclude each other (copy the file instead)");
@@ -295,6 +298,15 @@ int iris_cmd_render(int argc, char **argv) {
     return rc;
   }
   if (!quiet) iris_warn_if_lightless(scene, input);
+  if ((gp.guide_in || gp.guide_out) && p.method == IRIS_METHOD_COUNT) {
+    iris_render_params q = p;
+    iris_render_params_from_scene(&q, scene);
+    if (!iris_method_uses_guiding(q.method) && q.method != IRIS_METHOD_AUTO) {
+      iris_scene_destroy(scene);
+      return iris_cli_usage_error(CMD, "%s needs --method auto, guided or guided-nee (the scene's is %s)",
+                                  gp.guide_in ? "--guide-in" : "--guide-out", iris_method_name(q.method));
+    }
+  }
   iris_error err;
   iris_error_clear(&err);
   iris_status st;

@@ -545,6 +545,7 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_u64(h, (uint64_t)s->sampler);
   if (s->integrator) {
     h = mix_u64(h, (uint64_t)s->integrator->method);
+    h = mix_u64(h, s->deciding); /* --method auto applies a rule of its own */
     h = mix_u64(h, (uint64_t)(int64_t)s->integrator->max_depth);
     h = mix_u64(h, (uint64_t)(int64_t)s->integrator->rr_depth);
   }

@@ -80,6 +80,30 @@ int main(int argc, char **argv) {
   rc = iris_test_run_cli(dir, bin, BASE " --guide-in G2 -o C.exr --quiet", out, sizeof out, err, sizeof err);
   CHECK(rc == 0);
   CHECK(same_pixels(dir, "A.exr", "C.exr"));
+  /* --method auto: its guide is a file too, a trained one on the door and a
+   * declined one (the choice and its reason) on cornell-box; read back, each
+   * gives the same choice and image, and a guide of guided-nee is not auto's */
+  rc = iris_test_run_cli(dir, bin, "render door --spp 8 --height 48 --train-spp 3 --guide-out GA -o AA.exr --quiet",
+                         out, sizeof out, err, sizeof err);
+  CHECK(rc == 0);
+  rc = iris_test_run_cli(dir, bin, "render door --spp 8 --height 48 --train-spp 3 --guide-in GA -o AB.exr", out,
+                         sizeof out, err, sizeof err);
+  iris_check_record(rc == 0 && strstr(err, "auto: guided-nee") && same_pixels(dir, "AA.exr", "AB.exr"), __FILE__,
+                    __LINE__, "auto on door through a guide file: exit %d: %s", rc, err);
+  rc = iris_test_run_cli(dir, bin, "render cornell-box --spp 4 --height 32 --guide-out GC -o CA.exr --quiet", out,
+                         sizeof out, err, sizeof err);
+  CHECK(rc == 0 && iris_test_file_exists(dir, "GC"));
+  rc = iris_test_run_cli(dir, bin, "render cornell-box --spp 4 --height 32 --guide-in GC -o CB.exr", out, sizeof out,
+                         err, sizeof err);
+  iris_check_record(rc == 0 && strstr(err, "auto: mis (what the camera sees is lit mostly directly") &&
+                        same_pixels(dir, "CA.exr", "CB.exr"),
+                    __FILE__, __LINE__, "auto on cornell-box through a declined guide file: exit %d: %s", rc, err);
+  rc = iris_test_run_cli(dir, bin, "render door --method mis --spp 1 --height 48 --guide-out GM -o X.exr", out,
+                         sizeof out, err, sizeof err);
+  CHECK(rc == 2 && !iris_test_file_exists(dir, "GM") && !iris_test_file_exists(dir, "X.exr"));
+  rc = iris_test_run_cli(dir, bin, "render door --method auto --spp 8 --height 48 --guide-in G -o X.exr", out,
+                         sizeof out, err, sizeof err);
+  CHECK(rc == 2 && lines(err) == 1 && !iris_test_file_exists(dir, "X.exr")); /* guided-nee's guide, auto asks */
   /* a guide of another scene */
   rc = iris_test_run_cli(dir, bin, "render cornell-box --method guided-nee --spp 1 --height 48 --guide-in G -o X.exr",
                          out, sizeof out, err, sizeof err);
@@ -128,7 +152,7 @@ int main(int argc, char **argv) {
   /* usage errors, nothing written */
   rc = iris_test_run_cli(dir, bin, "render door --method mis --spp 1 --height 48 --guide-in G -o X.exr", out,
                          sizeof out, err, sizeof err);
-  CHECK(rc == 2 && strstr(err, "--guide-in needs --method guided") && !iris_test_file_exists(dir, "X.exr"));
+  CHECK(rc == 2 && strstr(err, "--guide-in needs --method auto, guided or guided-nee") && !iris_test_file_exists(dir, "X.exr"));
   rc = iris_test_run_cli(dir, bin, BASE " --guide-in G --guide-out H -o X.exr", out, sizeof out, err, sizeof err);
   CHECK(rc == 2 && !iris_test_file_exists(dir, "X.exr") && !iris_test_file_exists(dir, "H"));
   refused(dir, bin, "--guide-in missing.guide", "missing.guide", "missing file");
