@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "renderer/guiding/vertex.h"
@@ -12,6 +13,7 @@
 #define TRAIN_SEED 0x747261696e696e67ULL /* "training": streams apart from the render's */
 #define TRAIN_TILE 8
 #define TRAIN_BATCH_TILES 256 /* tiles traced between two merges: bounds the sample buffers */
+#define TRAIN_BATCH_SPP 4     /* ... and samples per pixel of each batch */
 /* Samples a cache needs before its learned selection probability is used. */
 #define ALPHA_MIN_SAMPLES 64
 /* Share of the render's samples spent on training when train_spp is automatic. */
@@ -277,12 +279,18 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   while (st == IRIS_OK && done < total) {
     int n = iris_guiding_train_iteration_spp(iteration, done, total);
     double tp = iris_time_now();
-    c.s0 = (uint64_t)done;
-    c.s1 = c.s0 + (uint64_t)n;
     memset(ts.learner, 0, caches * sizeof *ts.learner); /* learn alpha for this pass's tables */
-    for (uint64_t t0b = 0; t0b < tiles && st == IRIS_OK; t0b += TRAIN_BATCH_TILES) {
-      uint64_t count = tiles - t0b < TRAIN_BATCH_TILES ? tiles - t0b : TRAIN_BATCH_TILES;
+    /* Batches of tiles x at most TRAIN_BATCH_SPP samples: the sample buffers
+     * stay bounded however long a pass is. */
+    const uint64_t batches_per_chunk = (tiles + TRAIN_BATCH_TILES - 1) / TRAIN_BATCH_TILES,
+                   chunks = (uint64_t)((n + TRAIN_BATCH_SPP - 1) / TRAIN_BATCH_SPP);
+    for (uint64_t b = 0; b < chunks * batches_per_chunk && st == IRIS_OK; ++b) {
+      const uint64_t chunk = b / batches_per_chunk, t0b = (b % batches_per_chunk) * TRAIN_BATCH_TILES; /* tiles fastest */
+      const uint64_t count = tiles - t0b < TRAIN_BATCH_TILES ? tiles - t0b : TRAIN_BATCH_TILES;
+      const uint64_t end = (uint64_t)done + (uint64_t)n;
       c.tile0 = t0b;
+      c.s0 = (uint64_t)done + chunk * TRAIN_BATCH_SPP;
+      c.s1 = c.s0 + TRAIN_BATCH_SPP < end ? c.s0 + TRAIN_BATCH_SPP : end;
       iris_parallel_for(count, 1, s->threads, train_tiles, &c);
       for (uint64_t t = 0; t < count; ++t)
         if (buf[t].failed) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for training samples");
@@ -296,6 +304,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
     rebuild(g, &ts, p->learn_alpha, alpha_fallback, alpha_cap, hist);
     done += n;
     iteration++;
+    if (iris_time_now() - t0 > 2.0) /* progress on long training */
+      iris_infof("guiding: training pass %d: %d of %d spp, %.1f s", iteration, done, total, iris_time_now() - t0);
     if (timed && iteration == 1) {
       /* One training spp costs about one render spp: spend TRAIN_SHARE of
        * the samples the rest of the budget is expected to hold. */
