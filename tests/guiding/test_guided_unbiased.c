@@ -15,19 +15,10 @@
 #include <string.h>
 
 #include "check.h"
+#include "film_stats.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
-
-static double z_for_alpha(double alpha) {
-  double lo = 0.0, hi = 40.0;
-  for (int i = 0; i < 200; i++) {
-    double mid = 0.5 * (lo + hi);
-    if (erfc(mid / sqrt(2.0)) > alpha) lo = mid;
-    else hi = mid;
-  }
-  return 0.5 * (lo + hi);
-}
 
 #define NV 5 /* variants: mis and four guided ones */
 
@@ -65,23 +56,6 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
     return false;
   }
   return true;
-}
-
-static void region(const iris_film *f, int x0, int y0, int x1, int y1, double mean[3], double var[3]) {
-  int n = 0;
-  for (int k = 0; k < 3; k++) mean[k] = var[k] = 0.0;
-  for (int y = y0; y < y1; y++)
-    for (int x = x0; x < x1; x++) {
-      iris_vec3 m, v;
-      iris_film_pixel(f, x, y, &m, &v);
-      mean[0] += m.x, mean[1] += m.y, mean[2] += m.z;
-      var[0] += v.x, var[1] += v.y, var[2] += v.z;
-      n++;
-    }
-  for (int k = 0; k < 3; k++) {
-    mean[k] /= n;
-    var[k] /= (double)n * n;
-  }
 }
 
 int main(int argc, char **argv) {
