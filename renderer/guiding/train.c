@@ -161,6 +161,7 @@ static void train_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
 /* ---- accumulation and rebuild -------------------------------------------------- */
 
 typedef struct train_state {
+  float *radiance_photons;     /* per cache: the photons' radiance estimate, before training */
   float *acc;                  /* per texel (pdf layout): sum of Li cos / q */
   uint32_t *n;                 /* per cache: samples at vertices it served */
   double *irr;                 /* per cache: sum of Li cos / q over all directions */
@@ -225,7 +226,7 @@ static void rebuild(iris_guiding *g, const train_state *ts, bool learn, float al
       /* The radiance still to come (Russian roulette): irradiance / pi from
        * the paths, mixed with the photons' estimate the same way. */
       double r = ts->irr[i] / (double)ts->n[i] / 3.14159265358979;
-      c->radiance = (float)((1.0 - lambda) * c->radiance + lambda * r);
+      c->radiance = (float)((1.0 - lambda) * ts->radiance_photons[i] + lambda * r);
     }
     if (learn) {
       float a = iris_alpha_learner_best(&ts->learner[i], c->alpha >= 0.0f ? c->alpha : alpha_fallback,
@@ -252,12 +253,15 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
     size_t end = g->caches[i].table + (g->caches[i].sphere ? g->sphere.texel_count : g->hemi.texel_count);
     floats = end > floats ? end : floats;
   }
-  train_state ts = {calloc(floats ? floats : 1, sizeof(float)), calloc(caches, sizeof(uint32_t)),
-                    calloc(caches, sizeof(double)), calloc(caches, sizeof(iris_alpha_learner))};
+  train_state ts = {malloc(caches * sizeof(float)), calloc(floats ? floats : 1, sizeof(float)),
+                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
+                    calloc(caches, sizeof(iris_alpha_learner))};
+  if (ts.radiance_photons)
+    for (size_t i = 0; i < caches; ++i) ts.radiance_photons[i] = g->caches[i].radiance;
   float *hist = malloc(sizeof(float) * g->sphere.texel_count);
   sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
   iris_status st = IRIS_OK;
-  if (!ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf)
+  if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf)
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
 
   iris_integrator it = *s->integrator;
@@ -318,6 +322,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   for (int t = 0; t < TRAIN_BATCH_TILES && buf; ++t) free(buf[t].s);
   free(buf);
   free(hist);
+  free(ts.radiance_photons);
   free(ts.acc);
   free(ts.n);
   free(ts.irr);
