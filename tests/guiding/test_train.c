@@ -4,6 +4,7 @@
  *   integrand the cache strategy alone serves best, one BSDF sampling serves
  *   best), from samples drawn with another mixture;
  * - the schedule doubles and stops at the budget;
+ * - the path recorder gives back the exact incident radiance of the furnace;
  * - a cache filled as training fills it samples incident radiance x cosine:
  *   its texel probabilities match the integrals of Li cos over the texels;
  * - a guide trained on a scene has learned selection probabilities, changed
@@ -145,6 +146,63 @@ static void check_cos_product(bool constant) {
   iris_octmap_destroy(&map);
 }
 
+/* The path recorder's bookkeeping: on the white furnace (a convex sphere of
+ * albedo 1 under a sky of radiance 1) the radiance arriving at a surface point
+ * from any direction above it is exactly 1. Per recorded vertex, (L_end - L +
+ * miss) / beta must be 1 for mis (light sampling took its MIS share of the sky,
+ * `miss` gives it back) and for bsdf (no light sampling, miss 0), and without
+ * `miss` mis must fall short (what the guide learns by default). */
+static void test_recorder(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  iris_error_clear(&err);
+  if (!CHECK(iris_builtin_create("furnace-diffuse", &s, &err) == IRIS_OK)) return;
+  iris_pinhole cam;
+  iris_accel *acc = NULL;
+  iris_textures tx;
+  iris_lights lights;
+  memset(&tx, 0, sizeof tx);
+  memset(&lights, 0, sizeof lights);
+  if (CHECK(iris_pinhole_setup(s, NULL, 32, 32, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
+            iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK)) {
+    for (int m = 0; m < 2; ++m) {
+      iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
+      it.method = m == 0 ? IRIS_METHOD_MIS : IRIS_METHOD_BSDF;
+      double with_miss = 0.0, without = 0.0, worst = 0.0;
+      size_t n = 0;
+      iris_path_record rec;
+      iris_path_stats st = {0};
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+          for (int k = 0; k < 4; ++k) {
+            iris_sampler rng = iris_sampler_start_kind(IRIS_SAMPLER_INDEPENDENT, 3, (uint64_t)(y * 32 + x), (uint64_t)k);
+            float ux, uy;
+            iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
+            iris_vec3 L = iris_integrator_radiance_record(&it, iris_pinhole_ray(&cam, (float)x + ux, (float)y + uy), &rng, &st, &rec);
+            for (int v = 0; v < rec.count; ++v) {
+              const iris_path_vertex *pv = &rec.v[v];
+              if (!(pv->beta.x > 0.0f)) continue; /* ended by Russian roulette: brings 0 */
+              double a = (L.x - pv->L.x + pv->miss.x) / pv->beta.x, b = (L.x - pv->L.x) / pv->beta.x;
+              with_miss += a;
+              without += b;
+              worst = fmax(worst, fabs(a - 1.0));
+              n++;
+            }
+          }
+      printf("recorder, %s: %zu vertices, mean Li %.5f (without miss %.5f), worst |Li - 1| %.2g\n",
+             m == 0 ? "mis" : "bsdf", n, with_miss / (double)n, without / (double)n, worst);
+      CHECK(n > 1000);
+      iris_check_record(worst < 1e-3, __FILE__, __LINE__, "%s: recorded incident radiance off by %g", m == 0 ? "mis" : "bsdf", worst);
+      if (m == 0) CHECK(without / (double)n < 0.95);
+      else CHECK(fabs(without / (double)n - 1.0) < 1e-3);
+    }
+  }
+  iris_lights_destroy(&lights);
+  iris_textures_destroy(&tx);
+  iris_accel_destroy(acc);
+  iris_scene_destroy(s);
+}
+
 static void test_schedule(void) {
   CHECK_EQ_INT(iris_guiding_train_budget(64), 3);
   CHECK_EQ_INT(iris_guiding_train_budget(8), 0);
@@ -225,6 +283,7 @@ static void test_trained_guide(void) {
 int main(void) {
   test_learner();
   test_schedule();
+  test_recorder();
   check_cos_product(true);
   check_cos_product(false);
   test_trained_guide();
