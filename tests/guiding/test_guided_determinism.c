@@ -42,6 +42,7 @@ static bool render(const iris_scene *s, int threads, iris_render_result *r) {
   iris_render_params p = iris_render_params_default();
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
+  gp.train_spp = 3; /* the render trains its guide too */
   p.width = 40;
   p.height = 30; /* not a multiple of the 8-pixel tiles */
   p.spp = 6;
