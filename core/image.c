@@ -634,11 +634,17 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
   }
   /* stb_image grows its buffer to each PNG chunk's declared length before
    * reading it: a 143-byte file declaring a 1.5 GB IDAT made it allocate 2 GB
-   * (found by fuzz_texture). Every chunk must fit in the bytes present. */
+   * (found by fuzz_texture). Every chunk, its CRC included, must fit in the
+   * bytes present — also the last one, whose header alone may end the data
+   * (a 120-byte file ending in a 1.2 GB IDAT's length and type: fuzz_texture
+   * again), and a piece of a header is refused too. */
   const unsigned char *pb = data;
   if (size >= 8 && !memcmp(pb, "\x89PNG\r\n\x1a\n", 8)) { /* PNG signature */
     size_t at = 8;
-    while (at + 12 <= size) {
+    while (at < size) {
+      if (size - at < 12)
+        return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL,
+                              "PNG chunk at offset %zu is cut short (truncated or corrupt)", at);
       const size_t len = (size_t)pb[at] << 24 | (size_t)pb[at + 1] << 16 | (size_t)pb[at + 2] << 8 | pb[at + 3];
       if (len > size - at - 12)
         return iris_error_set(err, IRIS_ERR_PARSE, what, 0, NULL,
