@@ -636,7 +636,7 @@ iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what
    * reading it: a 143-byte file declaring a 1.5 GB IDAT made it allocate 2 GB
    * (found by fuzz_texture). Every chunk, its CRC included, must fit in the
    * bytes present — also the last one, whose header alone may end the data
-   * (a 120-byte file ending in a 1.2 GB IDAT's length and type: fuzz_texture
+   * (a 113-byte file ending in a 1.2 GB IDAT's length and type: fuzz_texture
    * again), and a piece of a header is refused too. */
   const unsigned char *pb = data;
   if (size >= 8 && !memcmp(pb, "\x89PNG\r\n\x1a\n", 8)) { /* PNG signature */
