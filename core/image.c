@@ -685,6 +685,91 @@ iris_status iris_ldr_load_file(const char *path, iris_ldr_image *out, iris_error
   return st;
 }
 
+/* Walks a Radiance RGBE file's pixel data the way stb_image's decoder reads
+ * it and checks that every read stays inside the data, before the decoder
+ * runs. stb_image (Debian's 2022 snapshot) reads a zero byte past the end and
+ * takes a zero run count as a dump of nothing, so a file cut inside its
+ * run-length data (or one holding a zero count) makes it loop for ever
+ * (shared/fuzz-findings/env-truncated.hdr). The walk is linear in the file
+ * size: each step consumes at least one byte or ends. w and h come from
+ * stbi_info; the header is skipped line by line as stb_image reads it (lines
+ * end at '\n'; a line whose first byte is NUL ends the header as an empty one
+ * does). */
+static iris_status hdr_check_stream(const unsigned char *d, size_t size, int w, int h, const char *path,
+                                    iris_error *err) {
+  size_t at = 0;
+  int empty_seen = 0;
+  for (int line = 0;; line++) { /* signature, header lines, blank line, resolution */
+    const size_t start = at;
+    while (at < size && d[at] != '\n') at++;
+    if (at >= size)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                            "HDR header ends without pixel data (truncated at byte %zu)", size);
+    const bool empty = at == start || d[start] == 0;
+    at++; /* past '\n' */
+    if (empty_seen) break; /* that was the resolution line */
+    if (line > 0 && empty) empty_seen = 1;
+  }
+  const uint64_t need_flat = (uint64_t)w * (uint64_t)h * 4u;
+  if (w < 8 || w >= 32768) {
+    if (size - at < need_flat)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                            "HDR pixel data is cut short: %zu bytes of the %llu a %dx%d flat image needs "
+                            "(truncated file)", size - at, (unsigned long long)need_flat, w, h);
+    return IRIS_OK;
+  }
+  for (int y = 0; y < h; y++) {
+    if (size - at < 4)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                            "HDR pixel data ends at scanline %d of %d (truncated file)", y, h);
+    const unsigned c1 = d[at], c2 = d[at + 1], hi = d[at + 2], lo = d[at + 3];
+    if (c1 != 2 || c2 != 2 || (hi & 0x80)) {
+      /* not run-length encoded: stb_image then reads the whole image flat
+       * from here, which only makes sense for the first scanline */
+      if (y > 0)
+        return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                              "HDR scanline %d is not run-length encoded after %d that are "
+                              "(mixed encodings are not supported; corrupt file?)", y, y);
+      if (size - at < need_flat)
+        return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                              "HDR pixel data is cut short: %zu bytes of the %llu a %dx%d flat image needs "
+                              "(truncated file)", size - at, (unsigned long long)need_flat, w, h);
+      return IRIS_OK;
+    }
+    if ((int)(hi << 8 | lo) != w)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                            "HDR scanline %d declares width %u, the image is %d wide (corrupt file)", y,
+                            hi << 8 | lo, w);
+    at += 4;
+    for (int k = 0; k < 4; k++) {
+      int x = 0;
+      while (x < w) {
+        if (at >= size)
+          return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                                "HDR run-length data ends inside scanline %d of %d (truncated file)", y, h);
+        unsigned count = d[at++];
+        size_t bytes;
+        if (count > 128) {
+          count -= 128;
+          bytes = 1;
+        } else {
+          bytes = count;
+        }
+        if (count == 0 || (int)count > w - x)
+          return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                                "HDR scanline %d, channel %d: run of %u at pixel %d overruns the %d-pixel "
+                                "line (corrupt file)", y, k, count, x, w);
+        if (size - at < bytes)
+          return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL,
+                                "HDR run-length data ends inside scanline %d of %d (truncated file)", y, h);
+        at += bytes;
+        x += (int)count;
+      }
+    }
+  }
+  return IRIS_OK;
+}
+
 iris_status iris_hdr_read(const char *path, iris_image *img, iris_error *err) {
   memset(img, 0, sizeof *img);
   char *data = NULL;
@@ -706,6 +791,11 @@ iris_status iris_hdr_read(const char *path, iris_image *img, iris_error *err) {
     free(data);
     return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cannot decode HDR image: %s",
                           w > 0 && h > 0 ? "image size out of range" : stbi_failure_reason());
+  }
+  st = hdr_check_stream((const unsigned char *)data, size, w, h, path, err);
+  if (st != IRIS_OK) {
+    free(data);
+    return st;
   }
   float *px = stbi_loadf_from_memory((const stbi_uc *)data, (int)size, &w, &h, &n, 3);
   free(data);
