@@ -11,6 +11,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "core/cancel.h"
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/meshproc.h"
@@ -809,6 +810,8 @@ static iris_status convert_meshes(gltf_ctx *c) {
     c->prims[mi] = calloc(np, sizeof **c->prims);
     if (!c->prims[mi]) return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
     for (size_t pi = 0; pi < np; pi++) {
+      if (iris_cancel_requested()) /* Ctrl-C: core/cancel.h */
+        return gltf_fail(c, IRIS_ERR_INTERRUPTED, NULL, "interrupted while loading the scene");
       iris_status st = convert_primitive(c, mi, pi, &c->prims[mi][pi]);
       if (st) return st;
     }

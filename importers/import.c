@@ -4,6 +4,7 @@
 
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/fileio.h"
 #include "scene/material_class.h"
 
@@ -41,6 +42,11 @@ iris_status iris_import_file(const char *path, const iris_import_options *opts, 
                           ext[0] ? "." : "", ext[0] ? ext : "no extension");
   iris_status st = fn(path, opts, out, err);
   if (st != IRIS_OK) return st;
+  if (iris_cancel_requested()) { /* Ctrl-C after the last check inside the importer */
+    iris_scene_destroy(*out);
+    *out = NULL;
+    return iris_error_set(err, IRIS_ERR_INTERRUPTED, path, 0, NULL, "interrupted while loading the scene");
+  }
   /* Every importer validates its result; checking again here costs one pass
    * and guarantees the renderer's invariants whatever the importer. */
   if (!(*out)->source_path) (*out)->source_path = iris_strdup(path);

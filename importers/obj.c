@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/import.h"
@@ -234,6 +235,8 @@ static iris_status parse_mtl(obj_ctx *c, const char *data, size_t size, const ch
   while (p < end) {
     const char *e = line_end(p, end);
     line++;
+    if ((line & 0xffff) == 0 && iris_cancel_requested()) /* Ctrl-C: core/cancel.h */
+      return iris_error_set(c->err, IRIS_ERR_INTERRUPTED, c->path, line, NULL, "interrupted while loading the scene");
     const char *le = strip_comment(p, e);
     const char *k = iris_np_skip_space(p, le);
     const char *ke = k;
@@ -454,6 +457,8 @@ static iris_status parse_obj(obj_ctx *c, const char *data, size_t size) {
   while (p < end) {
     const char *e = line_end(p, end);
     line++;
+    if ((line & 0xffff) == 0 && iris_cancel_requested()) /* Ctrl-C: core/cancel.h */
+      return iris_error_set(c->err, IRIS_ERR_INTERRUPTED, c->path, line, NULL, "interrupted while loading the scene");
     const char *le = strip_comment(p, e);
     const char *k = iris_np_skip_space(p, le);
     const char *ke = k;

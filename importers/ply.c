@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/import.h"
@@ -356,6 +357,10 @@ static iris_status read_element(ply_ctx *c, ply_element *el, bool is_vertex, boo
   if (is_face && !grow((void **)&c->corners, &c->corner_cap, 3 * (size_t)el->count, sizeof(uint32_t)))
     return iris_error_set(c->err, IRIS_ERR_NOMEM, c->path, 0, el->name, "out of memory");
   for (uint64_t row = 0; row < el->count; row++) {
+    if ((row & 0xffff) == 0xffff && iris_cancel_requested()) { /* Ctrl-C: core/cancel.h */
+      st = iris_error_set(c->err, IRIS_ERR_INTERRUPTED, c->path, 0, NULL, "interrupted while loading the scene");
+      goto done;
+    }
     float vals[R_INDICES] = {0};
     bool indices_seen = false;
     for (size_t j = 0; j < el->prop_count; j++) {

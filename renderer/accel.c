@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/rng.h"
 #include "renderer/texture.h"
 
@@ -124,6 +125,13 @@ static const char *rtc_error_text(RTCDevice device) {
   }
 }
 
+/* Embree calls this during the build: false cancels it (Ctrl-C, core/cancel.h). */
+static bool build_progress(void *ptr, double fraction) {
+  (void)ptr;
+  (void)fraction;
+  return !iris_cancel_requested();
+}
+
 iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err) {
   *out = NULL;
   iris_accel *a = calloc(1, sizeof *a);
@@ -140,6 +148,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   /* ROBUST: watertight edges (no light leaks along the shared edges of walls). */
   rtcSetSceneFlags(a->rtc, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(a->rtc, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneProgressMonitorFunction(a->rtc, build_progress, NULL);
 
   a->instance_count = scene->instance_count;
   a->instances = calloc(scene->instance_count ? scene->instance_count : 1, sizeof *a->instances);
@@ -154,6 +163,10 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     const iris_instance *inst = &scene->instances[i];
     const iris_mesh *mesh = &scene->meshes[inst->mesh];
     accel_instance *ai = &a->instances[i];
+    if ((i & 255) == 255 && iris_cancel_requested()) {
+      iris_accel_destroy(a);
+      return iris_cancel_error(err);
+    }
     ai->mesh = mesh;
     ai->first_prim = (uint32_t)prims;
     prims += mesh->triangle_count;
@@ -200,6 +213,10 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   }
   a->triangle_count = (uint32_t)prims;
   rtcCommitScene(a->rtc);
+  if (iris_cancel_requested()) { /* the progress monitor cancelled the build */
+    iris_accel_destroy(a);
+    return iris_cancel_error(err);
+  }
   if (rtcGetDeviceError(a->device) != RTC_ERROR_NONE) {
     iris_status st = iris_error_set(err, IRIS_ERR_INTERNAL, NULL, 0, NULL, "Embree: %s",
                                     rtc_error_text(a->device));

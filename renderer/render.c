@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/image.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -78,8 +79,30 @@ static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
   total->nan_count += local.nan_count;
 }
 
+/* Ends the phase before (a stop request there becomes "interrupted while
+ * <that phase>") and enters the next one. */
+static iris_status enter_phase(const iris_render_params *p, iris_status st, const char *key, const char *what,
+                               double t0, iris_error *err) {
+  if (st != IRIS_OK) return st;
+  if (iris_cancel_requested()) return iris_cancel_error(err);
+  iris_phase_begin(key, what);
+  if (p->phase) p->phase(p->phase_ctx, what, iris_time_now() - t0, -1.0);
+  return IRIS_OK;
+}
+
+static iris_status render(const iris_scene *scene, const iris_render_params *params_in,
+                          iris_render_result *res, iris_error *err);
+
 iris_status iris_render(const iris_scene *scene, const iris_render_params *params_in,
                         iris_render_result *res, iris_error *err) {
+  volatile sig_atomic_t *before = params_in->cancel ? iris_cancel_watch(params_in->cancel) : NULL;
+  iris_status st = render(scene, params_in, res, err);
+  if (params_in->cancel) iris_cancel_watch(before);
+  return st;
+}
+
+static iris_status render(const iris_scene *scene, const iris_render_params *params_in,
+                          iris_render_result *res, iris_error *err) {
   memset(res, 0, sizeof *res);
   iris_render_params p = *params_in;
   iris_render_params_from_scene(&p, scene);
@@ -131,9 +154,12 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   memset(&lights, 0, sizeof lights);
   void *guide_state = NULL;
   iris_path_stats *stats = NULL;
-  st = iris_accel_build(scene, &accel, err);
+  st = enter_phase(&p, IRIS_OK, "bvh", "building the BVH", t0, err);
+  if (st == IRIS_OK) st = iris_accel_build(scene, &accel, err);
+  st = enter_phase(&p, st, "textures", "decoding textures", t0, err);
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
   if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
+  st = enter_phase(&p, st, "lights", "building the light tables", t0, err);
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
   if (st == IRIS_OK) iris_lights_set_triangle_sampling(&lights, p.light_sampling);
   iris_integrator it;
@@ -146,10 +172,12 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   }
   const bool resolve = p.method == IRIS_METHOD_AUTO;
   if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
+  if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the light tables */
   if (st == IRIS_OK && (resolve || iris_method_uses_guiding(p.method))) {
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
                            p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
-                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve};
+                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve,
+                           p.phase, p.phase_ctx, t0};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK && resolve) {
@@ -167,6 +195,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
       guide_state = NULL;
     }
   }
+  if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the guide's last phase */
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
   if (st == IRIS_OK) {
     stats = calloc((size_t)p.threads, sizeof *stats);
@@ -180,7 +209,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   double t1 = iris_time_now();
   res->setup_seconds = t1 - t0;
 
-  if (st == IRIS_OK) {
+  if (st == IRIS_OK && !p.no_passes) {
     const uint64_t pixels = (uint64_t)res->film.width * (uint64_t)res->film.height;
     pass_ctx c;
     memset(&c, 0, sizeof c);
@@ -204,8 +233,11 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     const int target = timed ? 0 : p.spp;
     int done = 0;
     double sec_per_spp = 0.0;
+    iris_phase_begin("first-pass", "rendering the first image pass");
+    if (p.phase) p.phase(p.phase_ctx, "rendering the first image pass", iris_time_now() - t0, 0.0);
     for (;;) {
-      if (p.cancel && *p.cancel) {
+      if (iris_cancel_requested()) {
+        if (done == 0) st = iris_cancel_error(err); /* no sample: nothing to write */
         res->interrupted = true;
         break;
       }
@@ -231,6 +263,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
       if (grain > 4) grain = 4;
       iris_parallel_for(tiles, grain, p.threads, render_tiles, &c);
       double dt = iris_time_now() - tp;
+      if (done == 0) iris_phase_begin("image", "rendering image passes");
       done += n;
       sec_per_spp = dt / n;
       double now = iris_time_now() - t1;

@@ -38,6 +38,10 @@ typedef struct iris_guide_setup {
   iris_sampler_kind sampler; /* the render's sampler (training paths use it too) */
   bool deciding;       /* --method auto is deciding: the guide may decline the scene on rules
                           that only auto applies (docs/guiding.md, "--method auto") */
+  /* Reports the phase the build is in (iris_render_params.phase; may be NULL). */
+  void (*phase)(void *ctx, const char *what, double elapsed, double eta_first_image);
+  void *phase_ctx;
+  double t0; /* iris_time_now() when the render started: `elapsed` counts from it */
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;
@@ -70,11 +74,24 @@ typedef struct iris_render_params {
   int max_depth;            /* Cycles' bounce count; < 0: the scene's, else 64 */
   int rr_depth;             /* first bounce with Russian roulette */
   const char *camera_name;  /* NULL: the scene's first camera */
-  /* Set asynchronously (e.g. by a signal handler) to stop after the current pass. */
+  /* Set asynchronously (e.g. by a signal handler) to stop: iris_render watches
+   * it (core/cancel.h) for its whole run, so every phase stops within about a
+   * second. Stopped in the image passes: the passes done are the result, with
+   * `interrupted` set. Stopped before the first pass finished: no result,
+   * IRIS_ERR_INTERRUPTED "interrupted while <phase>". NULL: whatever
+   * iris_cancel_watch already watches. */
   volatile sig_atomic_t *cancel;
-  /* Called after each pass from the calling thread (may be NULL). */
+  /* Called after each image pass from the calling thread (may be NULL). */
   void (*progress)(void *ctx, int spp_done, int spp_total, double elapsed, double eta);
   void *progress_ctx;
+  /* Called when a set-up phase starts and during long ones (the guide's
+   * training passes), from the calling thread (may be NULL): `what` says what
+   * runs ("tracing photons", "training pass 3 of 9, 16 spp"), `elapsed` is
+   * seconds since the render started, `eta_first_image` the estimated seconds
+   * until the first image pass starts (< 0: not known yet). */
+  void (*phase)(void *ctx, const char *what, double elapsed, double eta_first_image);
+  void *phase_ctx;
+  bool no_passes; /* build everything (the guide: --guide-out), run no image pass */
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
   /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..

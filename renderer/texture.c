@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
+
 iris_status iris_textures_load(const iris_scene *scene, iris_textures *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   for (int i = 0; i < 256; i++) out->srgb_table[i] = iris_srgb_to_linear((float)i / 255.0f);
@@ -13,6 +15,10 @@ iris_status iris_textures_load(const iris_scene *scene, iris_textures *out, iris
   out->count = scene->texture_count;
   for (size_t i = 0; i < scene->texture_count; i++) {
     const iris_texture *t = &scene->textures[i];
+    if (iris_cancel_requested()) { /* one texture decodes in well under a second */
+      iris_textures_destroy(out);
+      return iris_cancel_error(err);
+    }
     iris_ldr_image img;
     memset(&img, 0, sizeof img);
     char what[64];

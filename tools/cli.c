@@ -1,6 +1,7 @@
 #include "tools/cli.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <getopt.h>
 #include <math.h>
 #include <stdarg.h>
@@ -9,13 +10,48 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "core/cancel.h"
 #include "core/fileio.h"
 #include "importers/import.h"
 #include "scenes/builtin.h"
 
+static volatile sig_atomic_t g_stop = 0;
+static struct sigaction g_old_int, g_old_term;
+static bool g_catching = false;
+
+static void on_signal(int sig) { g_stop = sig; }
+
+void iris_cli_catch_signals(void) {
+  if (g_catching) return;
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_signal;
+  sa.sa_flags = SA_RESETHAND; /* a second signal stops at once */
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, &g_old_int);
+  sigaction(SIGTERM, &sa, &g_old_term);
+  iris_cancel_watch(&g_stop);
+  g_catching = true;
+}
+
+void iris_cli_release_signals(void) {
+  if (!g_catching) return;
+  sigaction(SIGINT, &g_old_int, NULL);
+  sigaction(SIGTERM, &g_old_term, NULL);
+  g_catching = false;
+}
+
+volatile sig_atomic_t *iris_cli_stop_flag(void) { return &g_stop; }
+
+int iris_cli_interrupt_exit(void) { return g_stop == SIGTERM ? 143 : 130; }
+
 int iris_cli_report(const iris_error *err) {
   char buf[1400];
   iris_error_format(err, buf, sizeof buf);
+  if (err->status == IRIS_ERR_INTERRUPTED) {
+    fprintf(stderr, "iris: %s; nothing was written\n", buf);
+    return iris_cli_interrupt_exit();
+  }
   fprintf(stderr, "iris: %s\n", buf);
   switch (err->status) {
     case IRIS_ERR_USAGE:
@@ -144,6 +180,7 @@ int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_n
   iris_error_clear(&err);
   *out = NULL;
   iris_status st;
+  iris_phase_begin("loading", "loading the scene");
   if (iris_path_exists(input)) {
     iris_import_options opts = iris_import_options_default();
     opts.camera_name = camera_name;

@@ -4,6 +4,7 @@
 #ifndef IRIS_TOOLS_CLI_H
 #define IRIS_TOOLS_CLI_H
 
+#include <signal.h>
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
@@ -15,8 +16,20 @@
 enum { IRIS_EXIT_OK = 0, IRIS_EXIT_FAILURE = 1, IRIS_EXIT_USAGE = 2 };
 
 /* Prints "iris: FILE[:LINE]: [element: ]message" and returns the exit code
- * for the error's status. */
+ * for the error's status. IRIS_ERR_INTERRUPTED (a phase stopped before any
+ * sample existed) adds "; nothing was written" and returns 130 or 143. */
 int iris_cli_report(const iris_error *err);
+
+/* SIGINT and SIGTERM: the first sets the stop flag (watched by
+ * iris_cancel_requested, core/cancel.h) and restores the default action, so
+ * a second signal ends the process at once. Install before any long work
+ * (loading a scene included); release restores the previous handlers. */
+void iris_cli_catch_signals(void);
+void iris_cli_release_signals(void);
+/* The flag the handler sets: 0, or the signal number. */
+volatile sig_atomic_t *iris_cli_stop_flag(void);
+/* 130 after SIGINT, 143 after SIGTERM. */
+int iris_cli_interrupt_exit(void);
 /* Prints "iris: <cmd>: <message>" and a hint to run --help; returns 2. */
 int iris_cli_usage_error(const char *cmd, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -82,8 +82,6 @@ static void print_help(const iris_option_binding *b, size_t n) {
       "143 (SIGTERM) when interrupted: the image of the passes done is still written.\n");
 }
 
-static volatile sig_atomic_t g_stop = 0;
-static void on_signal(int sig) { g_stop = sig; }
 
 typedef struct progress_state {
   bool enabled;
@@ -101,6 +99,17 @@ static void draw_progress(void *ctx, int done, int total, double elapsed, double
   double rate = elapsed > 0 ? (double)done * (double)ps->pixels / elapsed : 0.0;
   fprintf(stderr, "\r[%s] %3d%%  %d/%d spp  %.2f Msamples/s  ETA %.0fs ", b, (int)(frac * 100.0),
           done, total, rate * 1e-6, eta);
+  fflush(stderr);
+}
+
+/* A set-up phase on the progress line: what runs, time so far, and when the
+ * first image pass is expected (the guide's training knows after its first pass). */
+static void draw_phase(void *ctx, const char *what, double elapsed, double eta_first_image) {
+  progress_state *ps = (progress_state *)ctx;
+  if (!ps->enabled) return;
+  char eta[64] = "";
+  if (eta_first_image > 0.0) snprintf(eta, sizeof eta, ", first image pass in ~%.0fs", eta_first_image);
+  fprintf(stderr, "\r%-44s %6.1fs%-34s", what, elapsed, eta);
   fflush(stderr);
 }
 
@@ -290,10 +299,16 @@ int iris_cmd_render(int argc, char **argv) {
   }
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
+  /* From here on Ctrl-C stops the work in whatever phase it is (docs/cli.md). */
+  iris_cli_catch_signals();
   iris_scene *scene = NULL;
   int rc = iris_cli_load_scene(CMD, input, camera, NULL, &scene);
-  if (rc != IRIS_EXIT_OK) return rc;
+  if (rc != IRIS_EXIT_OK) {
+    iris_cli_release_signals();
+    return rc;
+  }
   if ((rc = iris_env_options_apply(CMD, &bind[4], scene)) != IRIS_EXIT_OK) {
+    iris_cli_release_signals();
     iris_scene_destroy(scene);
     return rc;
   }
@@ -302,6 +317,7 @@ int iris_cmd_render(int argc, char **argv) {
     iris_render_params q = p;
     iris_render_params_from_scene(&q, scene);
     if (!iris_method_uses_guiding(q.method) && q.method != IRIS_METHOD_AUTO) {
+      iris_cli_release_signals();
       iris_scene_destroy(scene);
       return iris_cli_usage_error(CMD, "%s needs --method auto, guided or guided-nee (the scene's is %s)",
                                   gp.guide_in ? "--guide-in" : "--guide-out", iris_method_name(q.method));
@@ -314,12 +330,13 @@ int iris_cmd_render(int argc, char **argv) {
   p.camera_name = camera;
 
   progress_state ps = {!quiet && !json && iris_log_progress_enabled(), 0};
-  /* Guide only: the guide is built (and written by the provider) before the
-   * first pass, and the passes see a stop request that is already set. */
-  static volatile sig_atomic_t stop_before_passes = 1;
-  p.cancel = guide_only ? &stop_before_passes : &g_stop;
+  /* Guide only: the guide is built (and written by the provider), no pass runs. */
+  p.no_passes = guide_only;
+  p.cancel = iris_cli_stop_flag();
   p.progress = draw_progress;
   p.progress_ctx = &ps;
+  p.phase = draw_phase;
+  p.phase_ctx = &ps;
   {
     /* the film size is only known inside iris_render; estimate pixels there */
     iris_pinhole cam;
@@ -329,27 +346,21 @@ int iris_cmd_render(int argc, char **argv) {
       ps.pixels = p.bounds.x1 > 0 ? (uint64_t)(p.bounds.x1 - p.bounds.x0) * (uint64_t)(p.bounds.y1 - p.bounds.y0)
                                   : (uint64_t)cam.width * (uint64_t)cam.height;
   }
-  struct sigaction sa, old_int, old_term;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sa.sa_flags = SA_RESETHAND; /* a second signal stops at once */
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-
   iris_render_result res;
   st = iris_render(scene, &p, &res, &err);
-  sigaction(SIGINT, &old_int, NULL);
-  sigaction(SIGTERM, &old_term, NULL);
+  /* signals stay caught while the files are written: a first Ctrl-C there
+   * changes nothing, a second ends at once (the writes go through a temporary
+   * file, so no partial output is left under the output's name) */
   if (ps.enabled) fprintf(stderr, "\n");
   if (st != IRIS_OK) {
     iris_guiding_marks_destroy(&marks);
     iris_scene_destroy(scene);
-    return iris_cli_report(&err);
+    rc = iris_cli_report(&err);
+    iris_cli_release_signals();
+    return rc;
   }
   rc = IRIS_EXIT_OK;
   if (guide_only) {
-    res.interrupted = false; /* stopped on purpose before the passes */
     if (!quiet && !json) iris_infof("render: %s: guide written to %s (no image)", input, gp.guide_out);
   }
   if (out_exr) st = iris_render_write_exr(&res, out_exr, input, variance, &err);
@@ -407,6 +418,7 @@ int iris_cmd_render(int argc, char **argv) {
   }
   iris_render_result_destroy(&res);
   iris_scene_destroy(scene);
-  if (rc == IRIS_EXIT_OK && res.interrupted) rc = g_stop == SIGTERM ? 143 : 130;
+  if (rc == IRIS_EXIT_OK && res.interrupted) rc = iris_cli_interrupt_exit();
+  iris_cli_release_signals();
   return rc;
 }

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -273,6 +274,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
   uint32_t *ids = c->ids[thread_index];
   float *d2 = c->d2[thread_index];
   for (uint64_t i = begin; i < end; ++i) {
+    if (iris_cancel_requested()) return; /* the build notices and stops */
     iris_cache *cache = &g->caches[i];
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
@@ -503,10 +505,17 @@ static iris_status pilot(iris_guiding *g, const iris_guide_setup *s, int stride,
   return IRIS_OK;
 }
 
+/* Enters a phase of the guide's build (core/cancel.h) and reports it. */
+void iris_guiding_phase(const iris_guide_setup *s, const char *key, const char *what, double eta_first_image) {
+  if (key) iris_phase_begin(key, what);
+  if (s->phase) s->phase(s->phase_ctx, what, iris_time_now() - s->t0, eta_first_image);
+}
+
 static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int stride,
                                 iris_error *err) {
   iris_guiding_params *p = &g->params;
   double t0 = iris_time_now();
+  iris_guiding_phase(s, "photons", "tracing photons", -1.0);
   iris_photon_map photons;
   iris_status st = pilot(g, s, stride, &photons, err);
   if (st == IRIS_OK && !g->stats.skipped)
@@ -541,6 +550,11 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     iris_photons_destroy(&photons);
     return IRIS_OK;
   }
+  if (iris_cancel_requested()) {
+    iris_photons_destroy(&photons);
+    return iris_cancel_error(err);
+  }
+  iris_guiding_phase(s, "caches", "building the irradiance caches", -1.0);
   /* Camera caches. */
   camera_ctx cc;
   cc.setup = s;
@@ -553,6 +567,11 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
   }
   iris_parallel_for((uint64_t)cc.rows, 1, s->threads, camera_rows, &cc);
+  if (iris_cancel_requested()) {
+    free(cc.out);
+    iris_photons_destroy(&photons);
+    return iris_cancel_error(err);
+  }
   size_t ncam = 0;
   for (size_t i = 0; i < (size_t)cc.cols * (size_t)cc.rows; ++i) ncam += cc.out[i].valid;
   if (ncam == 0 && !p->force) {
@@ -616,6 +635,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     st = iris_kdtree_build_grouped(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
                                    group, NORMAL_GROUPS, s->threads, err);
   free(group);
+  if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err);
   _Static_assert(offsetof(iris_photon, wi) == offsetof(iris_photon, n) + sizeof(iris_vec3) &&
                      offsetof(iris_photon, energy) == offsetof(iris_photon, wi) + sizeof(iris_vec3) &&
                      sizeof(photon_dirs) == 2 * sizeof(iris_vec3) + sizeof(float),
@@ -640,6 +660,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     if (ok) {
       g->cache_count = total;
       iris_parallel_for(total, 64, threads, fill_caches, &fc);
+      if (iris_cancel_requested()) st = iris_cancel_error(err);
     } else {
       st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
     }

@@ -139,6 +139,9 @@ typedef struct iris_guiding {
 iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
                                iris_guiding **out, iris_error *err);
 void iris_guiding_destroy(iris_guiding *g);
+/* Enters a phase of the build (key: core/cancel.h's hook name, NULL: only
+ * report) and reports `what` through setup->phase. */
+void iris_guiding_phase(const iris_guide_setup *s, const char *key, const char *what, double eta_first_image);
 
 /* The integrator hook; sample == NULL when guiding was skipped. */
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g);

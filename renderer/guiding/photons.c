@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 
@@ -118,6 +119,7 @@ static void trace_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   (void)thread_index;
   trace_ctx *c = ctx;
   for (uint64_t b = begin; b < end; ++b) {
+    if (iris_cancel_requested()) return; /* the caller notices and discards the pass */
     uint64_t lo = c->first + b * BLOCK_PATHS, hi = lo + BLOCK_PATHS;
     if (hi > c->paths) hi = c->paths;
     for (uint64_t i = lo; i < hi; ++i) trace_path(c->setup, c->select, i, &c->blocks[b]);
@@ -165,6 +167,11 @@ iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission
                  NULL};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
   iris_distrib1d_destroy(&area_select);
+  if (iris_cancel_requested()) {
+    for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items);
+    free(blocks);
+    return iris_cancel_error(err);
+  }
   size_t total = out->count; /* the new photons go after the ones already traced */
   uint64_t indirect = 0;
   bool oom = false;

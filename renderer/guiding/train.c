@@ -2,9 +2,11 @@
 #include "renderer/guiding/train.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/cancel.h"
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -142,6 +144,7 @@ static void train_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
     sample_buffer *out = &c->buf[t];
     out->count = 0;
     out->failed = false;
+    if (iris_cancel_requested()) continue; /* the batch is discarded */
     int tx = (int)(tile % (uint64_t)c->tiles_x) * TRAIN_TILE, ty = (int)(tile / (uint64_t)c->tiles_x) * TRAIN_TILE;
     for (int y = ty; y < ty + TRAIN_TILE && y < hgt; ++y)
       for (int x = tx; x < tx + TRAIN_TILE && x < w; ++x) {
@@ -280,9 +283,18 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   const float alpha_fallback = p->alpha_max, alpha_cap = g->alpha_cap;
   int done = 0, iteration = 0;
   uint64_t samples = 0;
+  double sec_per_spp = -1.0; /* measured on the passes so far: the ETA to the first image pass */
   while (st == IRIS_OK && done < total) {
     int n = iris_guiding_train_iteration_spp(iteration, done, total);
     double tp = iris_time_now();
+    {
+      int passes = iteration;
+      for (int d = done; d < total; ++passes) d += iris_guiding_train_iteration_spp(passes, d, total);
+      char what[96];
+      snprintf(what, sizeof what, "training pass %d of %d, %d spp", iteration + 1, passes, n);
+      if (iteration == 0) iris_phase_begin("training", "training the guide");
+      iris_guiding_phase(s, NULL, what, sec_per_spp >= 0.0 ? sec_per_spp * (double)(total - done) : -1.0);
+    }
     memset(ts.learner, 0, caches * sizeof *ts.learner); /* learn alpha for this pass's tables */
     /* Batches of tiles x at most TRAIN_BATCH_SPP samples: the sample buffers
      * stay bounded however long a pass is. */
@@ -296,6 +308,10 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
       c.s0 = (uint64_t)done + chunk * TRAIN_BATCH_SPP;
       c.s1 = c.s0 + TRAIN_BATCH_SPP < end ? c.s0 + TRAIN_BATCH_SPP : end;
       iris_parallel_for(count, 1, s->threads, train_tiles, &c);
+      if (iris_cancel_requested()) {
+        st = iris_cancel_error(err);
+        break;
+      }
       for (uint64_t t = 0; t < count; ++t)
         if (buf[t].failed) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for training samples");
       if (st != IRIS_OK) break;
@@ -308,6 +324,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
     rebuild(g, &ts, p->learn_alpha, alpha_fallback, alpha_cap, hist);
     done += n;
     iteration++;
+    sec_per_spp = (iris_time_now() - t0) / (double)done;
     if (iris_time_now() - t0 > 2.0) /* progress on long training */
       iris_infof("guiding: training pass %d: %d of %d spp, %.1f s", iteration, done, total, iris_time_now() - t0);
     if (timed && iteration == 1) {
