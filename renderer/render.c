@@ -24,6 +24,7 @@ iris_render_params iris_render_params_default(void) {
   p.max_depth = -1;
   p.rr_depth = IRIS_DEFAULT_RR_DEPTH;
   p.threads = 0;
+  p.keep_training = IRIS_KEEP_TRAINING_DEFAULT;
   return p;
 }
 
@@ -173,11 +174,15 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   const bool resolve = p.method == IRIS_METHOD_AUTO;
   if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the light tables */
+  if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
+  /* Training samples go into the image only for the render that owns sample
+   * indices from 0 and trains its guide itself (docs/guiding.md). */
+  const bool keep_training = p.keep_training && p.sample_offset == 0 && !p.no_passes;
   if (st == IRIS_OK && (resolve || iris_method_uses_guiding(p.method))) {
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
                            p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
                            p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve,
-                           p.phase, p.phase_ctx, t0};
+                           p.phase, p.phase_ctx, t0, keep_training ? &res->film : NULL, b};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK && resolve) {
@@ -196,7 +201,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
   }
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the guide's last phase */
-  if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
+  /* every pixel holds the same number of training samples (whole passes) */
+  if (st == IRIS_OK && res->film.count) res->train_spp = (int)res->film.count[0];
   if (st == IRIS_OK) {
     stats = calloc((size_t)p.threads, sizeof *stats);
     if (!stats) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
@@ -318,6 +324,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("sampler", "%s", iris_sampler_kind_name(r->sampler));
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
   META("spp", "%d", r->spp);
+  META("train_spp", "%d", r->train_spp);
   META("seed", "%llu", (unsigned long long)r->seed);
   META("render_seconds", "%.3f", r->seconds);
   META("interrupted", "%s", r->interrupted ? "true" : "false");

@@ -21,6 +21,14 @@ extern "C" {
 #endif
 
 #define IRIS_RENDER_DEFAULT_SPP 64
+/* Whether the guide's training samples go into the image by default
+ * (iris_render_params.keep_training; docs/guiding.md, "Training samples"). */
+#define IRIS_KEEP_TRAINING_DEFAULT false
+
+/* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
+typedef struct iris_pixel_bounds {
+  int x0, y0, x1, y1;
+} iris_pixel_bounds;
 
 /* Everything the guided methods need to build their guide before the passes. */
 typedef struct iris_guide_setup {
@@ -42,6 +50,12 @@ typedef struct iris_guide_setup {
   void (*phase)(void *ctx, const char *what, double elapsed, double eta_first_image);
   void *phase_ctx;
   double t0; /* iris_time_now() when the render started: `elapsed` counts from it */
+  /* Training passes add their camera paths' radiance to this film for the
+   * pixels of `window` (full-frame coordinates; the film covers the window),
+   * when not NULL: each training path is an unbiased sample of its pixel
+   * (docs/guiding.md, "Training samples"). */
+  iris_film *film;
+  iris_pixel_bounds window;
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;
@@ -56,11 +70,6 @@ typedef struct iris_guide_provider {
    * `--method auto` resolves to guided-nee when true, to mis when false. */
   bool (*decision)(const void *state, char *why, size_t size);
 } iris_guide_provider;
-
-/* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
-typedef struct iris_pixel_bounds {
-  int x0, y0, x1, y1;
-} iris_pixel_bounds;
 
 typedef struct iris_render_params {
   int width, height;        /* <= 0: derive (camera.h) */
@@ -92,6 +101,10 @@ typedef struct iris_render_params {
   void (*phase)(void *ctx, const char *what, double elapsed, double eta_first_image);
   void *phase_ctx;
   bool no_passes; /* build everything (the guide: --guide-out), run no image pass */
+  /* Keep the guide's training samples in the image (docs/guiding.md,
+   * "Training samples"): only a render that trains its guide itself and
+   * starts at sample offset 0 has them. */
+  bool keep_training;
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
   /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..
@@ -124,7 +137,8 @@ typedef struct iris_render_result {
                                                   indirect)"; otherwise "" */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
-  int spp;               /* samples per pixel completed */
+  int spp;               /* samples per pixel completed in the image passes */
+  int train_spp;         /* training samples per pixel also in the film (keep_training) */
   uint64_t seed;
   int threads;
   double seconds;        /* path tracing time (the passes) */

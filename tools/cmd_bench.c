@@ -241,6 +241,7 @@ int iris_cmd_bench(int argc, char **argv) {
       p.methods[p.method_count] = m;
       p.samplers[p.method_count] = smp;
       p.light_samplings[p.method_count] = ls;
+      p.keep_training[p.method_count] = iris_bench_method_keeps_training(items[k]);
       char a[64], b[64];
       iris_bench_method_label(&p, p.method_count, a, sizeof a);
       for (int j = 0; j < p.method_count; j++)

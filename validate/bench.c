@@ -46,9 +46,18 @@ extern char **environ;
 const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size) {
   const bool indep = p->samplers[k] == IRIS_SAMPLER_INDEPENDENT;
   const bool area = p->light_samplings[k] == IRIS_TRIANGLE_SAMPLING_AREA;
-  snprintf(buf, size, "%s%s%s%s", iris_method_name(p->methods[k]), indep || area ? "@" : "",
-           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "");
+  const bool train = iris_method_uses_guiding(p->methods[k]) && p->keep_training[k] != IRIS_KEEP_TRAINING_DEFAULT;
+  snprintf(buf, size, "%s%s%s%s%s%s", iris_method_name(p->methods[k]), indep || area || train ? "@" : "",
+           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "", train && (indep || area) ? "+" : "",
+           train ? (p->keep_training[k] ? "keep" : "discard") : "");
   return buf;
+}
+
+bool iris_bench_method_keeps_training(const char *label) {
+  const char *at = strchr(label, '@');
+  if (at && strstr(at, "keep")) return true;
+  if (at && strstr(at, "discard")) return false;
+  return IRIS_KEEP_TRAINING_DEFAULT;
 }
 
 bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
@@ -69,6 +78,8 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
         *light = IRIS_TRIANGLE_SAMPLING_AREA;
       else if (strcmp(tok, "solid-angle") == 0)
         *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+      else if (strcmp(tok, "keep") == 0 || strcmp(tok, "discard") == 0)
+        ; /* iris_bench_method_keeps_training */
       else
         return false;
     }
@@ -79,6 +90,7 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
 iris_bench_params iris_bench_params_default(void) {
   iris_bench_params p;
   memset(&p, 0, sizeof p);
+  for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.keep_training[k] = IRIS_KEEP_TRAINING_DEFAULT;
   p.seeds = 1;
   p.max_depth = -1;
   return p;
@@ -703,6 +715,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           iris_render_params rp = render_params(&p, sc, bs[i].max_depth, m, (uint64_t)s, &gp, &ctx);
           rp.sampler = p.samplers[k];
           rp.light_sampling = p.light_samplings[k];
+          rp.keep_training = p.keep_training[k];
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;

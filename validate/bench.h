@@ -49,6 +49,9 @@ typedef struct iris_bench_params {
   iris_method methods[IRIS_BENCH_MAX_METHODS];
   iris_sampler_kind samplers[IRIS_BENCH_MAX_METHODS];
   iris_triangle_sampling light_samplings[IRIS_BENCH_MAX_METHODS];
+  /* guided methods: the training samples kept in the image or discarded
+   * ("@keep" / "@discard" when not IRIS_KEEP_TRAINING_DEFAULT) */
+  bool keep_training[IRIS_BENCH_MAX_METHODS];
   int method_count;
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
@@ -79,6 +82,9 @@ iris_bench_params iris_bench_params_default(void);
  * does not use the defaults (sobol, solid-angle): "mis", "mis@independent",
  * "mis@area", "mis@independent+area". iris_bench_method_parse reads it back. */
 const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size);
+/* Whether a label asks for the training samples to be kept ("@keep"),
+ * discarded ("@discard"), else IRIS_KEEP_TRAINING_DEFAULT. */
+bool iris_bench_method_keeps_training(const char *label);
 bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
                              iris_triangle_sampling *light);
 

@@ -87,6 +87,8 @@ typedef struct pass_ctx {
   uint64_t tile0;        /* first tile of the batch */
   sample_buffer *buf;    /* per tile of the batch */
   bool all_light;        /* record emission MIS gave to light sampling too */
+  iris_film *film;       /* training samples kept in the image (NULL: discarded) */
+  iris_pixel_bounds win; /* the film's window in the frame */
 } pass_ctx;
 
 static bool buffer_push(sample_buffer *b, const train_sample *t) {
@@ -156,6 +158,9 @@ static void train_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
           iris_ray ray = iris_pinhole_ray(c->cam, (float)x + ux, (float)y + uy);
           iris_vec3 L = iris_integrator_radiance_record(c->it, ray, &rng, &stats, &rec);
           if (!record_path(c, &rec, L, out)) out->failed = true;
+          /* a pixel is in one tile, and its samples come in order: deterministic */
+          if (c->film && x >= c->win.x0 && x < c->win.x1 && y >= c->win.y0 && y < c->win.y1)
+            iris_film_add(c->film, x - c->win.x0, y - c->win.y0, L);
         }
       }
   }
@@ -279,6 +284,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   c.tiles_x = (s->camera->width + TRAIN_TILE - 1) / TRAIN_TILE;
   c.buf = buf;
   c.all_light = p->train_all_light;
+  c.film = s->film;
+  c.win = s->window;
   const uint64_t tiles = (uint64_t)c.tiles_x * (uint64_t)((s->camera->height + TRAIN_TILE - 1) / TRAIN_TILE);
   const float alpha_fallback = p->alpha_max, alpha_cap = g->alpha_cap;
   int done = 0, iteration = 0;

@@ -20,7 +20,7 @@
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 
-#define NV 5 /* variants: mis and four guided ones */
+#define NV 7 /* variants: mis and six guided ones */
 
 typedef struct variant {
   iris_method method;
@@ -30,6 +30,7 @@ typedef struct variant {
   bool plain_rr;          /* throughput Russian roulette instead of the adjoint-driven one */
   int train_spp;          /* 0: default (training passes from the render's spp); > 0 explicit */
   bool all_light;         /* train towards all incident light */
+  int keep;               /* training samples in the image: 1 kept, -1 discarded, 0 default */
 } variant;
 
 static bool render(const iris_scene *s, const variant *v, int w, int h, int spp, uint64_t seed,
@@ -42,6 +43,7 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   if (v->train_spp > 0) gp.train_spp = v->train_spp;
   gp.train_all_light = v->all_light;
   gp.force = true; /* exercise the guide even where the budget would skip it (Veach) */
+  if (v->keep) p.keep_training = v->keep > 0;
   p.width = w;
   p.height = h;
   p.spp = spp;
@@ -66,11 +68,14 @@ int main(int argc, char **argv) {
   /* The defaults train the guide (5% of the spp in doubling passes) and learn
    * the selection probabilities; one variant trains longer towards all light. */
   static const variant variants[NV] = {
-      {IRIS_METHOD_MIS, 0.0f, IRIS_SPLAT_BILINEAR, "mis", false, 0, false},
-      {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided", false, 0, false},
-      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee", false, 0, false},
-      {IRIS_METHOD_GUIDED_NEE, 0.9f, IRIS_SPLAT_NEAREST, "guided-nee alpha 0.9 nearest plain RR", true, 0, false},
-      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee 31 training spp, all light", false, 31, true}};
+      {IRIS_METHOD_MIS, 0.0f, IRIS_SPLAT_BILINEAR, "mis", false, 0, false, 0},
+      {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided", false, 0, false, 0},
+      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee", false, 0, false, 0},
+      {IRIS_METHOD_GUIDED_NEE, 0.9f, IRIS_SPLAT_NEAREST, "guided-nee alpha 0.9 nearest plain RR", true, 0, false, 0},
+      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee 31 training spp, all light", false, 31, true, 0},
+      /* the training passes' paths in the image (31 spp of them: weight enough to show a bias) */
+      {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided, 31 training spp kept", false, 31, false, 1},
+      {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee, 31 training spp kept", false, 31, false, 1}};
   int bx = w / 8, by = h / 8;
   int n_tests = (NV - 1) * 3 * (1 + bx * by);
   double z_max = fmax(3.0, z_for_alpha(1e-3 / n_tests));
