@@ -20,6 +20,7 @@ extern "C" {
 #include "importers/gltf_convert.h"
 #include "importers/import.h"
 }
+#include "importers/gltf_compressed.h"
 
 namespace {
 
@@ -500,6 +501,34 @@ iris_status import_memory(const char *data, size_t size, const char *path,
   std::vector<ImageState> image_states;
   loader.SetImageLoader(&keep_encoded_image, &image_states);
 
+  // Draco and meshopt files need a patched JSON before tinygltf sees them
+  // (gltf_compressed.h); a GLB gets its JSON chunk replaced.
+  std::vector<int> placeholders;
+  std::string patched;
+  std::vector<uint8_t> glb;
+  if (is_glb) {
+    const size_t json_len = (size_t)bytes[12] | (size_t)bytes[13] << 8 | (size_t)bytes[14] << 16 |
+                            (size_t)bytes[15] << 24;  // checked by iris_gltf_check_container
+    if (iris_gltf_patch_compressed_json(data + 20, json_len, &patched, &placeholders)) {
+      while (patched.size() % 4) patched += ' ';
+      if (patched.size() > UINT32_MAX - size)
+        return iris_error_set(err, IRIS_ERR_PARSE, file, 0, nullptr, "GLB too large");
+      const size_t total = size - json_len + patched.size();
+      glb.resize(total);
+      std::memcpy(glb.data(), bytes, 12);
+      const uint32_t t32 = (uint32_t)total, j32 = (uint32_t)patched.size();
+      for (int k = 0; k < 4; k++) glb[8 + k] = (uint8_t)(t32 >> (8 * k)), glb[12 + k] = (uint8_t)(j32 >> (8 * k));
+      std::memcpy(glb.data() + 16, bytes + 16, 4);
+      std::memcpy(glb.data() + 20, patched.data(), patched.size());
+      std::memcpy(glb.data() + 20 + patched.size(), bytes + 20 + json_len, size - 20 - json_len);
+      bytes = glb.data();
+      size = total;
+    }
+  } else if (iris_gltf_patch_compressed_json(data, size, &patched, &placeholders)) {
+    data = patched.data();
+    size = patched.size();
+  }
+
   tinygltf::Model model;
   std::string terr, twarn;
   bool ok;
@@ -522,7 +551,15 @@ iris_status import_memory(const char *data, size_t size, const char *path,
                            : IRIS_ERR_PARSE;
     return iris_error_set(err, code, file, 0, nullptr, "%s", msg.c_str());
   }
+  {
+    std::vector<const char *> req;
+    for (const auto &e : model.extensionsRequired) req.push_back(e.c_str());
+    st = iris_gltf_check_required(req.data(), req.size(), file, err);
+    if (st != IRIS_OK) return st;
+  }
   if (!twarn.empty()) iris_infof("%s: tinygltf: %s", file, one_line(twarn).c_str());
+  st = iris_gltf_decode_compressed(model, placeholders, file, err);
+  if (st != IRIS_OK) return st;
 
   DocStorage storage;
   iris_gltf_doc doc;
