@@ -14,6 +14,7 @@
 
 extern "C" {
 #include "importers/draco.h"
+#include "importers/meshopt.h"
 }
 
 namespace {
@@ -96,6 +97,8 @@ struct Decoder {
 
   iris_status draco_primitive(size_t mi, size_t pi);
   iris_status draco_all();
+  iris_status meshopt_view(size_t vi);
+  iris_status meshopt_all();
 };
 
 struct DracoTarget {
@@ -247,6 +250,70 @@ iris_status Decoder::draco_primitive(size_t mi, size_t pi) {
   return st;
 }
 
+iris_status Decoder::meshopt_view(size_t vi) {
+  tinygltf::BufferView &v = m.bufferViews[vi];
+  auto it = v.extensions.find("EXT_meshopt_compression");
+  if (it == v.extensions.end()) return IRIS_OK;
+  const std::string el = "bufferView " + std::to_string(vi);
+  const std::string ex = "EXT_meshopt_compression: ";
+  const tinygltf::Value &e = it->second;
+  auto uint_member = [&](const char *key, bool required, size_t *out) {
+    if (!e.Has(key)) return !required;
+    const tinygltf::Value &x = e.Get(key);
+    if (!x.IsNumber()) return false;
+    const double d = x.GetNumberAsDouble();
+    if (!(d >= 0 && d <= 9007199254740992.0) || d != (double)(uint64_t)d) return false;
+    *out = (size_t)d;
+    return true;
+  };
+  size_t buffer = 0, offset = 0, length = 0, stride = 0, count = 0;
+  if (!e.IsObject() || !uint_member("buffer", true, &buffer) || !uint_member("byteOffset", false, &offset) ||
+      !uint_member("byteLength", true, &length) || !uint_member("byteStride", true, &stride) ||
+      !uint_member("count", true, &count) || !e.Has("mode") || !e.Get("mode").IsString() ||
+      (e.Has("filter") && !e.Get("filter").IsString()))
+    return fail(IRIS_ERR_INVALID, el, ex + "buffer, byteLength, byteStride, count (non-negative integers) "
+                                           "and mode (a string) are required");
+  iris_meshopt_mode mode;
+  iris_meshopt_filter filter = IRIS_MESHOPT_NONE;
+  if (!iris_meshopt_parse_mode(e.Get("mode").Get<std::string>().c_str(), &mode))
+    return fail(IRIS_ERR_INVALID, el, ex + "unknown mode '" + e.Get("mode").Get<std::string>() + "'");
+  if (e.Has("filter") && !iris_meshopt_parse_filter(e.Get("filter").Get<std::string>().c_str(), &filter))
+    return fail(IRIS_ERR_INVALID, el, ex + "unknown filter '" + e.Get("filter").Get<std::string>() + "'");
+  if (const char *why = iris_meshopt_check(count, stride, mode, filter)) return fail(IRIS_ERR_INVALID, el, ex + why);
+  if (buffer >= m.buffers.size())
+    return fail(IRIS_ERR_INVALID, el, ex + "buffer " + std::to_string(buffer) + " does not exist");
+  const std::vector<unsigned char> &src = m.buffers[buffer].data;
+  if (offset > src.size() || length > src.size() - offset || length == 0)
+    return fail(IRIS_ERR_INVALID, el, ex + "byteOffset " + std::to_string(offset) + " + byteLength " +
+                                          std::to_string(length) + " exceeds buffer " + std::to_string(buffer) +
+                                          "'s " + std::to_string(src.size()) + " bytes");
+  const double bytes = (double)count * (double)stride;
+  if (bytes != (double)v.byteLength)
+    return fail(IRIS_ERR_INVALID, el, ex + "count " + std::to_string(count) + " x byteStride " +
+                                          std::to_string(stride) + " is not the bufferView's byteLength " +
+                                          std::to_string(v.byteLength));
+  if (!charge(bytes))
+    return fail(IRIS_ERR_NOMEM, el, ex + "decoding " + std::to_string((long long)(bytes / 1048576.0)) +
+                                        " MiB is more than the file's size allows");
+  tinygltf::Buffer out;
+  out.data.resize(count * stride);
+  if (!iris_meshopt_decode(src.data() + offset, length, count, stride, mode, filter, out.data.data()))
+    return fail(IRIS_ERR_PARSE, el, ex + "the compressed data is corrupt or truncated");
+  m.buffers.push_back(std::move(out));
+  v.buffer = (int)m.buffers.size() - 1;
+  v.byteOffset = 0;
+  return IRIS_OK;
+}
+
+iris_status Decoder::meshopt_all() {
+  const size_t n = m.bufferViews.size();
+  for (size_t i = 0; i < n; i++) {
+    iris_status st = meshopt_view(i);
+    if (st != IRIS_OK) return st;
+  }
+  return IRIS_OK;
+}
+
 iris_status Decoder::draco_all() {
   accessor_source.assign(m.accessors.size(), -1);
   for (size_t mi = 0; mi < m.meshes.size(); mi++)
@@ -292,10 +359,20 @@ bool iris_gltf_patch_compressed_json(const char *json, size_t size, std::string 
       }
     }
   }
+  // A fallback buffer is dropped when the extension is required (it may hold
+  // nothing) or when it has no uri (tinygltf could not load it). Otherwise it
+  // loads, and the compressed views are still decoded (the extension says the
+  // compressed data is used when the loader supports it).
+  bool meshopt_required = false;
+  auto req = j.find("extensionsRequired");
+  if (req != j.end() && req->is_array())
+    for (const auto &r : *req)
+      if (r.is_string() && r.get<std::string>() == "EXT_meshopt_compression") meshopt_required = true;
   auto buffers = j.find("buffers");
   if (buffers != j.end() && buffers->is_array()) {
     for (auto &b : *buffers) {
       if (!b.is_object() || !b.contains("extensions") || !b["extensions"].is_object()) continue;
+      if (!meshopt_required && b.contains("uri")) continue;
       auto e = b["extensions"].find("EXT_meshopt_compression");
       if (e == b["extensions"].end() || !e->is_object() || !e->contains("fallback") ||
           !(*e)["fallback"].is_boolean() || !(*e)["fallback"].get<bool>())
@@ -319,7 +396,9 @@ iris_status iris_gltf_decode_compressed(tinygltf::Model &m, const std::vector<in
                            : b.data.size() * IRIS_GLTF_DECODE_RATIO;
     d.budget_left = d.budget_left > SIZE_MAX / 2 - add ? SIZE_MAX / 2 : d.budget_left + add;
   }
-  iris_status st = d.draco_all();
+  iris_status st = d.meshopt_all();
+  if (st != IRIS_OK) return st;
+  st = d.draco_all();
   if (st != IRIS_OK) return st;
   for (int a : placeholders)
     if ((size_t)a < d.accessor_source.size() && d.accessor_source[(size_t)a] == -1)

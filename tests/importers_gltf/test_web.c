@@ -1,0 +1,295 @@
+/* glTF as the web delivers it (docs/import-gltf.md, "Compressed geometry and
+ * web textures"): every encoding of tests/importers_gltf/data/web-base.glb
+ * (Draco, meshopt through gltf-transform and gltfpack, WebP lossless and lossy,
+ * KHR_texture_basisu with a fallback) imports to the same scene within the
+ * encoding's quantisation, and lying, truncated or corrupt compressed data is
+ * refused in one line naming the file and the element. The files and the
+ * script that makes them are in tests/importers_gltf/data (make_web.py). */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/image.h"
+#include "core/log.h"
+#include "importers/import.h"
+#include "scene/scene.h"
+#include "tests/common/check.h"
+
+#define EXPECT(cond, ...) iris_check_record(!!(cond), __FILE__, __LINE__, __VA_ARGS__)
+
+static iris_scene *load(const char *name, iris_status *status, char *msg, size_t msg_size) {
+  char path[1024];
+  snprintf(path, sizeof path, "%s/%s", IRIS_GLTF_TEST_DATA, name);
+  iris_import_options o = iris_import_options_default();
+  o.keep_materials = true;
+  iris_error e;
+  iris_error_clear(&e);
+  iris_scene *s = NULL;
+  iris_status st = iris_import_gltf(path, &o, &s, &e);
+  if (status) *status = st;
+  if (msg) iris_error_format(&e, msg, msg_size);
+  return s;
+}
+
+static iris_scene *load_ok(const char *name) {
+  char msg[1400] = "";
+  iris_status st;
+  iris_scene *s = load(name, &st, msg, sizeof msg);
+  EXPECT(st == IRIS_OK && s, "%s: %s", name, msg);
+  return s;
+}
+
+/* One vertex in world space: position, unit normal, the uv the colour texture
+ * reads (its KHR_texture_transform applied: gltfpack moves uv dequantisation there). */
+typedef struct wvert {
+  double p[3], n[3], uv[2];
+} wvert;
+
+static wvert *world_vertices(const iris_scene *s) {
+  const iris_instance *in = &s->instances[0];
+  const iris_mesh *m = &s->meshes[in->mesh];
+  const iris_texture *t = NULL;
+  if (m->material >= 0 && s->materials[m->material].color_texture >= 0)
+    t = &s->textures[s->materials[m->material].color_texture];
+  wvert *v = calloc(m->vertex_count, sizeof *v);
+  for (uint32_t i = 0; i < m->vertex_count; i++) {
+    const float *p = m->positions + 3 * i;
+    double nl = 0;
+    for (int r = 0; r < 3; r++) {
+      v[i].p[r] = in->transform.m[r][3];
+      for (int c = 0; c < 3; c++) {
+        v[i].p[r] += in->transform.m[r][c] * p[c];
+        /* uniform scales only (both encoders' node transforms): the linear part maps normals */
+        if (m->normals) v[i].n[r] += in->transform.m[r][c] * m->normals[3 * i + c];
+      }
+      nl += v[i].n[r] * v[i].n[r];
+    }
+    for (int r = 0; r < 3 && nl > 0; r++) v[i].n[r] /= sqrt(nl);
+    double u = m->uvs ? m->uvs[2 * i] : 0, w = m->uvs ? m->uvs[2 * i + 1] : 0;
+    if (t && t->has_transform) {
+      const double c = cos(t->rotation), sn = sin(t->rotation);
+      v[i].uv[0] = t->offset[0] + c * t->scale[0] * u + sn * t->scale[1] * w;
+      v[i].uv[1] = t->offset[1] - sn * t->scale[0] * u + c * t->scale[1] * w;
+    } else {
+      v[i].uv[0] = u, v[i].uv[1] = w;
+    }
+  }
+  return v;
+}
+
+static int cmp_tri(const void *a, const void *b) {
+  const uint32_t *x = a, *y = b;
+  for (int k = 0; k < 3; k++)
+    if (x[k] != y[k]) return x[k] < y[k] ? -1 : 1;
+  return 0;
+}
+
+/* The same triangle with its smallest index first (orientation kept). */
+static void canonical_tri(const uint32_t in[3], uint32_t out[3]) {
+  int k = in[0] < in[1] ? (in[0] < in[2] ? 0 : 2) : (in[1] < in[2] ? 1 : 2);
+  for (int j = 0; j < 3; j++) out[j] = in[(k + j) % 3];
+}
+
+/* Compares the encoded scene with the plain one: every encoded vertex is a
+ * distinct plain vertex within the tolerances (position per axis, normal per
+ * component, uv per component), and the triangles are the same triangles
+ * with the same orientation (encoders reorder vertices and triangles, so the
+ * comparison goes through that vertex map; indices must then match exactly). */
+static size_t compare_geometry(const char *what, const iris_scene *base, const iris_scene *enc, double tol_p,
+                               double tol_n, double tol_uv) {
+  if (!base || !enc || enc->mesh_count != 1 || enc->instance_count != 1) {
+    printf("%s: not one mesh and one instance\n", what);
+    return SIZE_MAX;
+  }
+  const iris_mesh *mb = &base->meshes[0], *me = &enc->meshes[0];
+  if (me->vertex_count != mb->vertex_count || me->triangle_count != mb->triangle_count || !me->normals != !mb->normals ||
+      !me->uvs != !mb->uvs) {
+    printf("%s: %u vertices %u triangles, plain %u %u, or other attributes\n", what, me->vertex_count,
+           me->triangle_count, mb->vertex_count, mb->triangle_count);
+    return SIZE_MAX;
+  }
+  wvert *vb = world_vertices(base), *ve = world_vertices(enc);
+  uint32_t *map = malloc(me->vertex_count * sizeof *map);
+  char *hit = calloc(mb->vertex_count, 1);
+  size_t bad = 0, dup = 0;
+  double worst[3] = {0, 0, 0};
+  for (uint32_t i = 0; i < me->vertex_count; i++) {
+    double best = INFINITY;
+    uint32_t bi = 0;
+    double bd[3] = {0, 0, 0};
+    for (uint32_t j = 0; j < mb->vertex_count; j++) {
+      double d[3] = {0, 0, 0};
+      for (int k = 0; k < 3; k++) d[0] = fmax(d[0], fabs(ve[i].p[k] - vb[j].p[k]));
+      for (int k = 0; k < 3; k++) d[1] = fmax(d[1], fabs(ve[i].n[k] - vb[j].n[k]));
+      for (int k = 0; k < 2; k++) d[2] = fmax(d[2], fabs(ve[i].uv[k] - vb[j].uv[k]));
+      double score = d[0] / tol_p + d[1] / tol_n + d[2] / tol_uv;
+      if (score < best) best = score, bi = j, memcpy(bd, d, sizeof bd);
+    }
+    map[i] = bi;
+    if (bd[0] > tol_p || bd[1] > tol_n || bd[2] > tol_uv) bad++;
+    for (int k = 0; k < 3; k++) worst[k] = fmax(worst[k], bd[k]);
+    if (hit[bi]++) dup++;
+  }
+  printf("%s: %zu vertices beyond tolerance, %zu mapped twice; worst |dp| %.3g (tol %.3g), |dn| %.3g (tol %.3g), |duv| %.3g (tol %.3g)\n", what, bad, dup, worst[0], tol_p,
+         worst[1], tol_n, worst[2], tol_uv);
+  uint32_t *tb = malloc(3 * mb->triangle_count * sizeof *tb);
+  for (uint32_t t = 0; t < mb->triangle_count; t++) canonical_tri(mb->indices + 3 * t, tb + 3 * t);
+  qsort(tb, mb->triangle_count, 3 * sizeof *tb, cmp_tri);
+  size_t missing = 0;
+  for (uint32_t t = 0; t < me->triangle_count; t++) {
+    uint32_t m3[3] = {map[me->indices[3 * t]], map[me->indices[3 * t + 1]], map[me->indices[3 * t + 2]]}, c[3];
+    canonical_tri(m3, c);
+    if (!bsearch(c, tb, mb->triangle_count, 3 * sizeof *tb, cmp_tri)) missing++;
+  }
+  printf("%s: %zu of %u triangles are not triangles of the plain file\n", what, missing, me->triangle_count);
+  free(tb), free(map), free(hit), free(vb), free(ve);
+  return bad + dup + missing;
+}
+
+/* Tolerances from the encoders' bit depths (make_web.py): a quantity
+ * quantised to b bits over a range r is off by at most r / (2^b - 1) / 2;
+ * one full step is allowed. The sphere spans 1.6 on each axis. Octahedral
+ * normals with b-bit components are off by at most about 2 / (2^b - 1) per
+ * component; two steps are allowed. */
+static double step(double range, int bits) { return range / (double)((1 << bits) - 1); }
+
+static void check_geometry(void) {
+  iris_scene *base = load_ok("web-base.glb");
+  struct {
+    const char *file;
+    int pos_bits, normal_bits, uv_bits;
+  } enc[] = {
+      {"web-draco.glb", 14, 10, 12},        /* gltf-transform draco defaults */
+      {"web-meshopt.glb", 14, 8, 12},       /* gltf-transform meshopt: normals stored as int8 (OCTAHEDRAL) */
+      {"web-gltfpack.glb", 14, 8, 12},      /* gltfpack -cc defaults (-vp 14 -vn 8 -vt 12) */
+      {"web-gltfpack-fallback.glb", 14, 8, 12},
+  };
+  for (size_t i = 0; i < sizeof enc / sizeof *enc; i++) {
+    iris_scene *s = load_ok(enc[i].file);
+    size_t problems = compare_geometry(enc[i].file, base, s, step(1.6, enc[i].pos_bits),
+                                       4.0 * step(1.0, enc[i].normal_bits), step(1.0, enc[i].uv_bits));
+    EXPECT(problems == 0, "%s: %zu vertices/triangles differ from the plain file (above)", enc[i].file, problems);
+    iris_scene_destroy(s);
+  }
+  /* The tolerances are tight enough to see a wrong decode: the plain sphere
+   * compared with itself shifted by one position step fails. */
+  iris_scene *shifted = load_ok("web-base.glb");
+  if (shifted) {
+    shifted->meshes[0].positions[0] += 3.0f * (float)step(1.6, 14);
+    CHECK(compare_geometry("self-check, one vertex moved 3 steps", base, shifted, step(1.6, 14), 1, 1) == 1);
+  }
+  iris_scene_destroy(shifted);
+
+  /* meshopt is lossless on the data it is given: the decoded views equal the
+   * uncompressed fallback buffer bit for bit (same file with the extension removed). */
+  iris_scene *a = load_ok("web-gltfpack-fallback.glb"), *b = load_ok("web-gltfpack-nomeshopt.glb");
+  if (a && b && EXPECT(a->mesh_count == 1 && b->mesh_count == 1, "mesh counts")) {
+    const iris_mesh *ma = &a->meshes[0], *mb = &b->meshes[0];
+    CHECK_EQ_INT(ma->vertex_count, mb->vertex_count);
+    CHECK_EQ_INT(ma->triangle_count, mb->triangle_count);
+    if (ma->vertex_count == mb->vertex_count && ma->triangle_count == mb->triangle_count) {
+      CHECK(!memcmp(ma->positions, mb->positions, 12 * (size_t)ma->vertex_count));
+      CHECK(!memcmp(ma->uvs, mb->uvs, 8 * (size_t)ma->vertex_count));
+      /* Not the normals: gltfpack 0.18 writes the OCTAHEDRAL filter's encoded
+       * input (z = 127) to the fallback buffer, not the filtered values (the
+       * decoded normals match the plain file above). meshopt's index codec may
+       * rotate a triangle's vertices: the same triangles, same orientation. */
+      uint32_t *ta = malloc(12 * (size_t)ma->triangle_count), *tb = malloc(12 * (size_t)ma->triangle_count);
+      for (uint32_t t = 0; t < ma->triangle_count; t++) {
+        canonical_tri(ma->indices + 3 * t, ta + 3 * t);
+        canonical_tri(mb->indices + 3 * t, tb + 3 * t);
+      }
+      qsort(ta, ma->triangle_count, 12, cmp_tri);
+      qsort(tb, ma->triangle_count, 12, cmp_tri);
+      CHECK(!memcmp(ta, tb, 12 * (size_t)ma->triangle_count));
+      free(ta), free(tb);
+    }
+  }
+  iris_scene_destroy(a), iris_scene_destroy(b), iris_scene_destroy(base);
+}
+
+/* ---- refusals ------------------------------------------------------------- */
+
+static void expect_refused(const char *name, const char *element, const char *words) {
+  char msg[1400] = "", path[1024];
+  snprintf(path, sizeof path, "%s/%s", IRIS_GLTF_TEST_DATA, name);
+  iris_status st;
+  iris_scene *s = load(name, &st, msg, sizeof msg);
+  EXPECT(st != IRIS_OK && !s, "%s was accepted", name);
+  EXPECT(strstr(msg, path) == msg && !strchr(msg, '\n') && strstr(msg, element) && strstr(msg, words),
+         "%s: expected one line naming the file, '%s' and '%s': %s", name, element, words, msg);
+  printf("refused: %s\n", msg);
+  iris_scene_destroy(s);
+}
+
+static void check_refusals(void) {
+  expect_refused("bad-draco-count.glb", "mesh 0 primitive 0", "declares 218 elements");
+  expect_refused("bad-draco-truncated.glb", "mesh 0 primitive 0", "Draco decoding failed");
+  expect_refused("bad-draco-header.glb", "mesh 0 primitive 0", "not Draco data");
+  expect_refused("bad-draco-attribute-id.glb", "mesh 0 primitive 0", "Draco id 7");
+  expect_refused("bad-draco-indices.glb", "mesh 0 primitive 0", "1053 indices");
+  expect_refused("bad-draco-type.glb", "mesh 0 primitive 0", "declares VEC3");
+  expect_refused("bad-meshopt-truncated.glb", "bufferView 3", "corrupt or truncated");
+  expect_refused("bad-meshopt-count.glb", "bufferView 2", "count 1059");
+  expect_refused("bad-meshopt-corrupt.glb", "bufferView 2", "corrupt or truncated");
+  expect_refused("bad-meshopt-filter.glb", "bufferView 3", "QUATERNION");
+  expect_refused("bad-meshopt-mode.glb", "bufferView 2", "unknown mode");
+  expect_refused("basisu-required.gltf", "extensionsRequired", "KHR_texture_basisu");
+  /* Every cut of a compressed file is refused in one line or imports (a cut
+   * GLB fails its container check; this covers the decoders' own bounds when
+   * the cut is repaired in the header: the data simply ends early). */
+  const char *files[] = {"web-draco.glb", "web-meshopt.glb"};
+  for (size_t f = 0; f < 2; f++) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", IRIS_GLTF_TEST_DATA, files[f]);
+    FILE *fp = fopen(path, "rb");
+    if (!EXPECT(fp != NULL, "cannot open %s", path)) continue;
+    static char data[1 << 16];
+    size_t n = fread(data, 1, sizeof data, fp);
+    fclose(fp);
+    size_t refused = 0;
+    for (size_t cut = 0; cut < n; cut += 7) {
+      /* Zero the tail of the BIN chunk from `cut` on (the lengths stay valid). */
+      static char copy[1 << 16];
+      memcpy(copy, data, n);
+      uint32_t jl;
+      memcpy(&jl, copy + 12, 4);
+      if (cut < 28 + (size_t)jl) continue;
+      memset(copy + cut, 0, n - cut);
+      iris_import_options o = iris_import_options_default();
+      iris_error e;
+      iris_error_clear(&e);
+      iris_scene *s = NULL;
+      iris_status st = iris_import_gltf_memory(copy, n, "cut.glb", &o, &s, &e);
+      char msg[1400];
+      iris_error_format(&e, msg, sizeof msg);
+      if (st != IRIS_OK) {
+        refused++;
+        EXPECT(!s && !strchr(msg, '\n') && strstr(msg, "cut.glb") == msg, "%s zeroed from %zu: %s", files[f], cut, msg);
+      }
+      iris_scene_destroy(s);
+    }
+    printf("%s: %zu of the zeroed tails refused\n", files[f], refused);
+    CHECK(refused > 0);
+  }
+}
+
+/* ---- textures ------------------------------------------------------------- */
+
+static void check_basisu_fallback(void) {
+  iris_scene *s = load_ok("basisu-fallback.gltf");
+  if (s && EXPECT(s->texture_count == 1, "basisu-fallback: %zu textures", s->texture_count))
+    CHECK_EQ_STR(s->textures[0].mime, "image/png");
+  iris_scene_destroy(s);
+}
+
+int main(int argc, char **argv) {
+  iris_log_set_level(IRIS_LOG_WARN);
+  const char *part = argc > 1 ? argv[1] : "all";
+  if (!strcmp(part, "geometry") || !strcmp(part, "all")) check_geometry();
+  if (!strcmp(part, "refusals") || !strcmp(part, "all")) check_refusals();
+  if (!strcmp(part, "textures") || !strcmp(part, "all")) check_basisu_fallback();
+  return TEST_SUMMARY();
+}
