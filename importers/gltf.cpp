@@ -86,6 +86,8 @@ void sniff_mime(const unsigned char *b, int n, char out[16]) {
     std::snprintf(out, 16, "image/png");
   else if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF)
     std::snprintf(out, 16, "image/jpeg");
+  else if (n >= 12 && std::memcmp(b, "RIFF", 4) == 0 && std::memcmp(b + 8, "WEBP", 4) == 0)
+    std::snprintf(out, 16, "image/webp");
 }
 
 bool keep_encoded_image(tinygltf::Image *image, const int index, std::string *, std::string *,
@@ -405,7 +407,21 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
   }
   s.materials.resize(m.materials.size());
   for (size_t i = 0; i < m.materials.size(); i++) fill_material(m.materials[i], &s.materials[i]);
-  for (const auto &t : m.textures) s.textures.push_back({t.source, t.sampler});
+  for (const auto &t : m.textures) {
+    iris_gltf_texture o = {t.source, t.sampler, -1, -1, nullptr};
+    const char *names[2] = {"EXT_texture_webp", "KHR_texture_basisu"};
+    int *dst[2] = {&o.webp_source, &o.basisu_source};
+    for (int k = 0; k < 2; k++) {
+      auto it = t.extensions.find(names[k]);
+      if (it == t.extensions.end()) continue;
+      const tinygltf::Value &v = it->second;
+      if (v.IsObject() && v.Has("source") && v.Get("source").IsInt())
+        *dst[k] = v.Get("source").GetNumberAsInt();
+      else
+        o.bad_extension = names[k];
+    }
+    s.textures.push_back(o);
+  }
   for (size_t i = 0; i < m.images.size(); i++) {
     const auto &im = m.images[i];
     iris_gltf_image o;

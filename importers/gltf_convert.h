@@ -120,6 +120,8 @@ typedef struct iris_gltf_material {
 
 typedef struct iris_gltf_texture {
   int source, sampler;
+  int webp_source, basisu_source; /* EXT_texture_webp / KHR_texture_basisu source, -1 none */
+  const char *bad_extension;      /* names one whose source is not an integer */
 } iris_gltf_texture;
 
 typedef struct iris_gltf_image {

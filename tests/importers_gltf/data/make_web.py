@@ -18,6 +18,7 @@ every other file is an encoding of it:
   web-gltfpack-nomeshopt.glb  web-gltfpack-fallback.glb without the extension: reads the fallback
   bad-*.glb              lying, truncated and corrupt compressed data (each refused in one line;
                          what each breaks is in BAD below)
+  webp-corrupt-fallback.glb  a WebP that does not decode, with a PNG fallback (the PNG is used)
 Tools: Debian's gltfpack and webp (cwebp) packages, and the npm package
 @gltf-transform/cli 4.5.1 (npm install @gltf-transform/cli@4.5.1; pass its
 bin/gltf-transform with --gltf-transform). Output is deterministic for fixed tool
@@ -110,12 +111,14 @@ def base_doc(images):
     return doc, bytes(blob)
 
 
+# Smooth images (lossy WebP is compared with them by PSNR): gradients, and
+# an alpha ramp so that the WebP is RGBA.
 def rgba(x, y):
-    return (16 * x, 255 - 16 * y, (x * y * 7) % 256, 128 + 8 * ((x + y) % 16))
+    return (8 * x, 255 - 8 * y, 4 * (x + y), 128 + 4 * x)
 
 
 def rgb(x, y):
-    return ((x * 37) % 256, (y * 53) % 256, 200 if (x // 4 + y // 4) % 2 else 40)
+    return (8 * x, 8 * y, 128 + int(100 * math.sin(x / 5.0) * math.cos(y / 7.0)))
 
 
 def cwebp(png_bytes, args, tmp):
@@ -155,7 +158,8 @@ def basisu_doc(required):
         "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0]},
                       {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
         # Not a real KTX2 file: only the fallback is ever read.
-        "images": [{"uri": "data:image/ktx2;base64," + base64.b64encode(b"\xabKTX 20\xbb\r\n\x1a\n").decode(), "mimeType": "image/ktx2"},
+        "images": [{"uri": "data:application/octet-stream;base64," + base64.b64encode(b"\xabKTX 20\xbb\r\n\x1a\n").decode(),
+                    "mimeType": "image/ktx2"},
                    {"uri": "data:image/png;base64," + base64.b64encode(tex).decode(), "mimeType": "image/png"}],
         "textures": [{"extensions": {"KHR_texture_basisu": {"source": 0}}}],
     }
@@ -198,6 +202,15 @@ def zero_range(doc, binary, start, length):
     return binary
 
 
+def image_view(doc, i):
+    return doc["bufferViews"][doc["images"][i]["bufferView"]]
+
+
+def set_bytes(binary, at, data):
+    binary[at:at + len(data)] = data
+    return binary
+
+
 def draco_view(doc):
     return doc["bufferViews"][draco_ext(doc)["bufferView"]]
 
@@ -218,6 +231,11 @@ BAD = {
     "bad-meshopt-corrupt.glb": ("web-meshopt.glb", None, lambda d, b: zero_range(d, b, meshopt_view(d, "TRIANGLES")["byteOffset"], 1)),
     "bad-meshopt-filter.glb": ("web-meshopt.glb", lambda d: meshopt_view(d, "ATTRIBUTES", "OCTAHEDRAL").update(filter="QUATERNION"), None),
     "bad-meshopt-mode.glb": ("web-meshopt.glb", lambda d: meshopt_view(d, "TRIANGLES").update(mode="STRIPS"), None),
+    # WebP: image 0 cut to 40 bytes; image 0's lossless header declaring 16384 x 16384 pixels;
+    # the same cut with a PNG fallback (imports, using the PNG).
+    "bad-webp-truncated.glb": ("web-webp-lossy.glb", lambda d: image_view(d, 0).update(byteLength=40), None),
+    "bad-webp-dims.glb": ("web-webp-lossless.glb", None, lambda d, b: set_bytes(b, image_view(d, 0)["byteOffset"] + 21, b"\xff\xff\xff\x0f")),
+    "webp-corrupt-fallback.glb": ("web-webp-fallback.glb", lambda d: image_view(d, 2).update(byteLength=40), None),
 }
 
 
@@ -226,7 +244,7 @@ def main():
     ap.add_argument("--gltf-transform", default="gltf-transform")
     a = ap.parse_args()
     out = lambda n: os.path.join(HERE, n)
-    pngs = [png(16, 16, 4, rgba), png(16, 16, 3, rgb)]
+    pngs = [png(32, 32, 4, rgba), png(32, 32, 3, rgb)]
     doc, blob = base_doc([("image/png", p) for p in pngs])
     open(out("web-base.glb"), "wb").write(glb(doc, blob))
     gt = a.gltf_transform
