@@ -14,8 +14,11 @@
 #include "core/image.h"
 #include "core/log.h"
 #include "importers/import.h"
+#include "importers/meshopt.h"
 #include "scene/scene.h"
 #include "tests/common/check.h"
+
+#include <meshoptimizer.h>
 
 #define EXPECT(cond, ...) iris_check_record(!!(cond), __FILE__, __LINE__, __VA_ARGS__)
 
@@ -355,11 +358,91 @@ static void check_textures(void) {
   iris_scene_destroy(base);
 }
 
+/* ---- meshopt filters -------------------------------------------------------- */
+
+/* Each filter of importers/meshopt.c against libmeshoptimizer's own encoder:
+ * random unit vectors (OCTAHEDRAL, 8 and 16 bits), random unit quaternions
+ * (QUATERNION, 12 bits) and random floats over six decades (EXPONENTIAL, 15-bit
+ * mantissa) go through encodeFilter + encodeVertexBuffer and back through
+ * iris_meshopt_decode; the error stays within the bit depth. A cut stream fails. */
+static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
+static double rnd(void) {
+  rng_state ^= rng_state << 13, rng_state ^= rng_state >> 7, rng_state ^= rng_state << 17;
+  return (double)(rng_state >> 11) / 9007199254740992.0;
+}
+
+static void check_filters(void) {
+  enum { N = 500 };
+  static float in[4 * N], out_f[4 * N];
+  static uint8_t filtered[8 * N], encoded[16 * 8 * N + 1024], decoded[8 * N];
+  for (int kind = 0; kind < 4; kind++) {
+    const int bits = kind == 0 ? 8 : kind == 1 ? 16 : kind == 2 ? 12 : 15;
+    const size_t stride = kind == 0 ? 4 : 8;
+    const iris_meshopt_filter filter =
+        kind < 2 ? IRIS_MESHOPT_OCTAHEDRAL : kind == 2 ? IRIS_MESHOPT_QUATERNION : IRIS_MESHOPT_EXPONENTIAL;
+    const int comps = kind == 3 ? 2 : 4; /* EXPONENTIAL: two floats per 8-byte element */
+    for (int i = 0; i < N; i++) {
+      double v[4], l = 0;
+      for (int k = 0; k < 4; k++) v[k] = 2 * rnd() - 1, l += v[k] * v[k];
+      if (kind < 2) l -= v[3] * v[3], v[3] = 0;
+      for (int k = 0; k < 4; k++) in[4 * i + k] = (float)(kind == 3 ? v[k] * pow(10.0, 6 * rnd() - 3) : v[k] / sqrt(l));
+      if (kind == 3) in[2 * i] = in[4 * i], in[2 * i + 1] = in[4 * i + 1];
+    }
+    if (kind < 2) meshopt_encodeFilterOct(filtered, N, stride, bits, in);
+    else if (kind == 2) meshopt_encodeFilterQuat(filtered, N, stride, bits, in);
+    else meshopt_encodeFilterExp(filtered, N, stride, bits, in);
+    size_t size = meshopt_encodeVertexBuffer(encoded, sizeof encoded, filtered, N, stride);
+    CHECK(iris_meshopt_check(N, stride, IRIS_MESHOPT_ATTRIBUTES, filter) == NULL);
+    if (!CHECK(size > 0 && iris_meshopt_decode(encoded, size, N, stride, IRIS_MESHOPT_ATTRIBUTES, filter, decoded)))
+      continue;
+    CHECK(!iris_meshopt_decode(encoded, size / 2, N, stride, IRIS_MESHOPT_ATTRIBUTES, filter, decoded));
+    double worst = 0;
+    for (int i = 0; i < N; i++) {
+      double q[4] = {0, 0, 0, 0};
+      for (int k = 0; k < comps; k++) {
+        if (kind == 0) q[k] = ((const int8_t *)decoded)[4 * i + k] / 127.0;
+        else if (kind < 3) q[k] = ((const int16_t *)decoded)[4 * i + k] / 32767.0;
+        else memcpy(&out_f[k], decoded + 8 * (size_t)i + 4 * (size_t)k, 4), q[k] = out_f[k];
+      }
+      /* a quaternion and its negation are the same rotation */
+      double dot = 0;
+      for (int k = 0; k < 4; k++) dot += q[k] * in[4 * i + k];
+      double sign = kind == 2 && dot < 0 ? -1 : 1;
+      for (int k = 0; k < comps; k++) {
+        const double ref = kind == 3 ? in[2 * i + k] : in[4 * i + k];
+        double e = fabs(sign * q[k] - ref);
+        if (kind == 3) { /* relative to the element's larger magnitude (the shared exponent) */
+          double m = fmax(fabs(in[2 * i]), fabs(in[2 * i + 1]));
+          e /= m;
+        }
+        worst = fmax(worst, e);
+      }
+    }
+    /* Octahedral K-bit: a few steps of 2 / (2^(K-1) - 1) after renormalisation (and
+     * the 8/16-bit storage); quaternion K-bit: sqrt(2) / (2^(K-1) - 1) per
+     * component plus 16-bit storage; exponential: 2^-(K-1) of the element's scale. */
+    const double tol = kind < 2 ? 3.0 / ((1 << (bits - 1)) - 1)
+                       : kind == 2 ? 2.0 / ((1 << (bits - 1)) - 1)
+                                   : 2.0 / (double)(1 << (bits - 1));
+    printf("meshopt filter %s, %d bits: largest error %.3g (tolerance %.3g)\n",
+           kind < 2 ? "OCTAHEDRAL" : kind == 2 ? "QUATERNION" : "EXPONENTIAL", bits, worst, tol);
+    EXPECT(worst <= tol, "filter kind %d: error %g > %g", kind, worst, tol);
+  }
+  /* The checks the library would otherwise assert on. */
+  CHECK(iris_meshopt_check(3, 6, IRIS_MESHOPT_ATTRIBUTES, IRIS_MESHOPT_NONE) != NULL);
+  CHECK(iris_meshopt_check(4, 2, IRIS_MESHOPT_TRIANGLES, IRIS_MESHOPT_NONE) != NULL);
+  CHECK(iris_meshopt_check(3, 4, IRIS_MESHOPT_INDICES, IRIS_MESHOPT_OCTAHEDRAL) != NULL);
+  CHECK(iris_meshopt_check(3, 12, IRIS_MESHOPT_ATTRIBUTES, IRIS_MESHOPT_OCTAHEDRAL) != NULL);
+  CHECK(iris_meshopt_check(0, 4, IRIS_MESHOPT_ATTRIBUTES, IRIS_MESHOPT_NONE) != NULL);
+  CHECK(iris_meshopt_check(3, 4, IRIS_MESHOPT_TRIANGLES, IRIS_MESHOPT_NONE) == NULL);
+}
+
 int main(int argc, char **argv) {
   iris_log_set_level(IRIS_LOG_WARN);
   const char *part = argc > 1 ? argv[1] : "all";
   if (!strcmp(part, "geometry") || !strcmp(part, "all")) check_geometry();
   if (!strcmp(part, "refusals") || !strcmp(part, "all")) check_refusals();
   if (!strcmp(part, "textures") || !strcmp(part, "all")) check_textures();
+  if (!strcmp(part, "filters") || !strcmp(part, "all")) check_filters();
   return TEST_SUMMARY();
 }

@@ -289,6 +289,17 @@ static void test_assets(void) {
   snprintf(args, sizeof args, "import '%s/basisu-required.gltf' -o basisu.json", IRIS_GLTF_TEST_DATA);
   EXPECT_RUN(args, 2, "KHR_texture_basisu");
   CHECK(!exists("basisu.json"));
+  /* Compressed data that lies: one line naming the file and the primitive / image, exit 2, nothing written. */
+  snprintf(args, sizeof args, "import '%s/bad-draco-count.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "mesh 0 primitive 0: KHR_draco_mesh_compression");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  snprintf(args, sizeof args, "import '%s/bad-meshopt-corrupt.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "bufferView 2: EXT_meshopt_compression");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  snprintf(args, sizeof args, "import '%s/bad-webp-truncated.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "image 0: WebP decoding failed");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  CHECK(!exists("bad.json") && !exists("bad.meshes"));
   /* Draco (formerly the must-reject example) imports. */
   snprintf(args, sizeof args, "import -q '%s/bad/gltf/Box-Draco-must-reject/Box.gltf' -o draco.json", assets);
   EXPECT_RUN(args, 0, NULL);
