@@ -270,6 +270,7 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
       o->bad_extension = "KHR_materials_transmission";
     o->has_transmission_texture = has_texture(*v, "transmissionTexture");
   }
+  if (ext("KHR_materials_unlit")) o->unlit = true;
   if (const tinygltf::Value *v = ext("KHR_materials_ior")) {
     o->has_ior = true;
     if (!get_number(*v, "ior", &o->ior, nullptr)) o->bad_extension = "KHR_materials_ior";

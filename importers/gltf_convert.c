@@ -28,7 +28,7 @@ static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", "EXT_texture_webp"};
+    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit"};
 
 /* ---- small helpers ------------------------------------------------------ */
 

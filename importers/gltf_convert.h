@@ -116,6 +116,7 @@ typedef struct iris_gltf_material {
   iris_gltf_texture_ref sheen_color_texture, sheen_roughness_texture;
   bool has_volume, has_attenuation_distance;
   double attenuation_distance, attenuation_color[3];
+  bool unlit; /* KHR_materials_unlit */
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {

@@ -449,6 +449,27 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
       }
       if (g->emissive[0] > 0 || g->emissive[1] > 0 || g->emissive[2] > 0) c->warned_alpha_emission = true;
     }
+    if (g->unlit) {
+      /* KHR_materials_unlit: the surface shows base colour x texture x vertex colour
+       * as radiance and scatters nothing; every other property is ignored (the
+       * extension). Stored as a black diffuse emitting the base colour through the
+       * base colour texture; `unlit` multiplies in the vertex colours. The colour
+       * texture stays for its alpha (MASK/BLEND), under a zero colour. */
+      iris_material u = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+      u.name = m->name;
+      u.unlit = true;
+      for (int k = 0; k < 3; k++) u.emission[k] = m->color[k], u.color[k] = 0.0f;
+      u.color_texture = m->color_texture;
+      u.emission_texture = m->color_texture;
+      u.emission_two_sided = m->emission_two_sided;
+      u.double_sided = m->double_sided;
+      u.alpha_mode = m->alpha_mode, u.alpha = m->alpha, u.alpha_cutoff = m->alpha_cutoff;
+      *m = u;
+      gltf_slot color_slot = slots[GLTF_SLOT_COLOR];
+      for (int k = 0; k < GLTF_SLOT_COUNT; k++) slots[k].texture = -1;
+      slots[GLTF_SLOT_COLOR] = slots[GLTF_SLOT_EMISSION] = color_slot;
+      continue;
+    }
     if (g->has_occlusion_texture) c->warned_occlusion = true;
     if (g->has_specular_textures) c->warned_spec_tex = true;
     if (g->has_transmission_texture) c->warned_trans_tex = true;

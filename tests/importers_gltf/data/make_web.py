@@ -15,6 +15,7 @@ every other file is an encoding of it:
   web-webp-fallback.glb  WebP and the PNG both present, the extension used but not required
   basisu-fallback.gltf   KHR_texture_basisu used, not required, with a PNG fallback source
   basisu-required.gltf   KHR_texture_basisu required (refused)
+  unlit-quads.gltf       KHR_materials_unlit quads (plain and vertex-coloured) before a lit wall
   web-gltfpack-nomeshopt.glb  web-gltfpack-fallback.glb without the extension: reads the fallback
   bad-*.glb              lying, truncated and corrupt compressed data (each refused in one line;
                          what each breaks is in BAD below)
@@ -239,6 +240,40 @@ BAD = {
 }
 
 
+def unlit_doc():
+    """Two quads facing +z, KHR_materials_unlit: x in [-1, 0] base colour (0.2, 0.5, 0.8);
+    x in [0, 1] base colour (0.8, 0.6, 0.4) times COLOR_0 (0.5, 1, 0.25) at every vertex;
+    behind them (z = -0.5) a lit white diffuse quad, so the lighting is visible elsewhere."""
+    def quad(x0, x1, z):
+        return struct.pack("<12f", x0, -1, z, x1, -1, z, x1, 1, z, x0, 1, z)
+    buf = quad(-1, 0, 0) + quad(0, 1, 0) + quad(-3, 3, -0.5) + struct.pack("<12f", *([0.5, 1, 0.25] * 4)) + \
+        struct.pack("<6H", 0, 1, 2, 0, 2, 3)
+    views = [{"buffer": 0, "byteOffset": 48 * i, "byteLength": 48} for i in range(4)] + \
+        [{"buffer": 0, "byteOffset": 192, "byteLength": 12}]
+    acc = [{"bufferView": i, "componentType": 5126, "count": 4, "type": "VEC3"} for i in range(4)] + \
+        [{"bufferView": 4, "componentType": 5123, "count": 6, "type": "SCALAR"}]
+    for i, (x0, x1, z) in enumerate([(-1, 0, 0), (0, 1, 0), (-3, 3, -0.5)]):
+        acc[i]["min"], acc[i]["max"] = [x0, -1, z], [x1, 1, z]
+    d = {
+        "asset": {"version": "2.0", "generator": "iris tests/importers_gltf/data/make_web.py"},
+        "extensionsUsed": ["KHR_materials_unlit"],
+        "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"mesh": 0}, {"mesh": 1}, {"mesh": 2}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 4, "material": 0}]},
+                   {"primitives": [{"attributes": {"POSITION": 1, "COLOR_0": 3}, "indices": 4, "material": 1}]},
+                   {"primitives": [{"attributes": {"POSITION": 2}, "indices": 4, "material": 2}]}],
+        "materials": [
+            {"name": "unlit-blue", "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.5, 0.8, 1], "metallicFactor": 0.3},
+             "emissiveFactor": [1, 0, 0], "extensions": {"KHR_materials_unlit": {}}},
+            {"name": "unlit-vertex", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.6, 0.4, 1]},
+             "extensions": {"KHR_materials_unlit": {}}},
+            {"name": "wall", "pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}}],
+        "buffers": [{"byteLength": len(buf), "uri": "data:application/octet-stream;base64," + base64.b64encode(buf).decode()}],
+        "bufferViews": views, "accessors": acc,
+    }
+    return json.dumps(d, indent=1) + "\n"
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--gltf-transform", default="gltf-transform")
@@ -262,6 +297,7 @@ def main():
     open(out("web-webp-lossy.glb"), "wb").write(webp_doc(pngs, lossy, True, False))
     open(out("web-webp-fallback.glb"), "wb").write(webp_doc(pngs, lossy, False, True))
     open(out("basisu-fallback.gltf"), "w").write(basisu_doc(False))
+    open(out("unlit-quads.gltf"), "w").write(unlit_doc())
     edit_glb(out("web-gltfpack-fallback.glb"), out("web-gltfpack-nomeshopt.glb"), strip_meshopt)
     for name, (src, edit_doc, edit_bin) in BAD.items():
         edit_glb(out(src), out(name), edit_doc, edit_bin)

@@ -1,0 +1,120 @@
+/* KHR_materials_unlit (docs/import-gltf.md, docs/format.md "unlit"): the
+ * surface shows base colour x texture x vertex colour as radiance and scatters
+ * nothing. tests/importers_gltf/data/unlit-quads.gltf holds an unlit quad
+ * (base colour 0.2 0.5 0.8, with metallic and an emissive factor the extension
+ * says to ignore), a vertex-coloured unlit quad (0.8 0.6 0.4 x COLOR_0
+ * 0.5 1 0.25) and a lit white wall behind them. Rendered with bsdf, nee and mis
+ * in the dark, under a bright sky, and under the sky plus a point light, every
+ * pixel of each quad is exactly its colour (no noise: nothing scatters), while
+ * the wall's pixels change with the lighting. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/log.h"
+#include "importers/import.h"
+#include "renderer/render.h"
+#include "scene/scene.h"
+#include "tests/common/check.h"
+
+#define EXPECT(cond, ...) iris_check_record(!!(cond), __FILE__, __LINE__, __VA_ARGS__)
+#define W 40
+
+static bool render(const iris_scene *s, iris_method m, iris_vec3 *pix) {
+  iris_render_params p = iris_render_params_default();
+  p.width = p.height = W;
+  p.spp = 16;
+  p.method = m;
+  p.seed = 3;
+  iris_render_result r;
+  iris_error err;
+  iris_error_clear(&err);
+  if (iris_render(s, &p, &r, &err) != IRIS_OK) {
+    fprintf(stderr, "render failed: %s\n", err.message);
+    return false;
+  }
+  for (int y = 0; y < W; y++)
+    for (int x = 0; x < W; x++) {
+      iris_vec3 v;
+      iris_film_pixel(&r.film, x, y, &pix[y * W + x], &v);
+    }
+  iris_render_result_destroy(&r);
+  return true;
+}
+
+int main(void) {
+  iris_log_set_level(IRIS_LOG_WARN);
+  char path[1024];
+  snprintf(path, sizeof path, "%s/unlit-quads.gltf", IRIS_GLTF_TEST_DATA);
+  iris_import_options o = iris_import_options_default();
+  iris_error e;
+  iris_error_clear(&e);
+  iris_scene *s = NULL;
+  CHECK_OK(iris_import_gltf(path, &o, &s, &e), &e);
+  if (!s) return TEST_SUMMARY();
+  /* The stored form: a black diffuse emitting the base colour, marked unlit. */
+  for (int k = 0; k < 2; k++) {
+    const iris_material *m = &s->materials[k];
+    CHECK(m->unlit && m->type == IRIS_MATERIAL_DIFFUSE && m->color[0] == 0 && m->color[1] == 0 && m->color[2] == 0);
+  }
+  CHECK(s->materials[0].emission[0] == 0.2f && s->materials[0].emission[1] == 0.5f &&
+        s->materials[0].emission[2] == 0.8f); /* emissiveFactor (1, 0, 0) ignored */
+  CHECK(!s->materials[2].unlit);
+
+  /* Camera on +z: the plain quad left of x = 0, the vertex-coloured one right of it. */
+  iris_camera cam;
+  memset(&cam, 0, sizeof cam);
+  cam.name = iris_strdup("front");
+  cam.to_world = iris_mat4_identity();
+  cam.to_world.m[2][3] = 4.0f;
+  cam.yfov = 2.0f * atanf(1.25f / 4.0f); /* x, y in [-1.25, 1.25] at z = 0: the wall shows around the quads */
+  cam.aspect = 1.0f;
+  iris_scene_add_camera(s, &cam);
+  const float expect[2][3] = {{0.2f, 0.5f, 0.8f}, {0.8f * 0.5f, 0.6f * 1.0f, 0.4f * 0.25f}};
+
+  /* Lighting: none; a sky of radiance 3; the sky and a point light of 40 W/sr at z = 2. */
+  static iris_vec3 pix[W * W];
+  const iris_method methods[3] = {IRIS_METHOD_BSDF, IRIS_METHOD_NEE, IRIS_METHOD_MIS};
+  double wall_lit[3] = {0, 0, 0};
+  for (int light = 0; light < 3; light++) {
+    if (light == 1) {
+      s->has_environment = true;
+      s->environment[0] = s->environment[1] = s->environment[2] = 3.0f;
+    }
+    if (light == 2) {
+      iris_light l;
+      memset(&l, 0, sizeof l);
+      l.name = iris_strdup("bulb");
+      l.type = IRIS_LIGHT_POINT;
+      l.color[0] = l.color[1] = l.color[2] = 1.0f;
+      l.intensity = 40.0f;
+      l.position[2] = 2.0f;
+      iris_scene_add_light(s, &l);
+    }
+    for (int k = 0; k < 3; k++) {
+      if (!render(s, methods[k], pix)) continue;
+      double worst = 0;
+      for (int y = 0; y < W; y++)
+        for (int x = 0; x < W; x++) {
+          /* pixel centres at least 0.1 inside a quad (the filter may mix across edges) */
+          const float px = -1.25f + 2.5f * ((float)x + 0.5f) / W, py = -1.25f + 2.5f * ((float)y + 0.5f) / W;
+          if (fabsf(py) > 0.9f || fabsf(px) > 0.9f || fabsf(px) < 0.1f) continue;
+          const float *c = expect[x >= W / 2];
+          const iris_vec3 p = pix[y * W + x];
+          worst = fmax(worst, fmax(fabs(p.x - c[0]), fmax(fabs(p.y - c[1]), fabs(p.z - c[2]))));
+        }
+      printf("lighting %d, %s: largest difference from the base colour %.3g\n", light, iris_method_name(methods[k]),
+             worst);
+      EXPECT(worst <= 1e-5, "lighting %d %s: unlit pixels differ from the base colour by %g", light,
+             iris_method_name(methods[k]), worst);
+      if (methods[k] == IRIS_METHOD_MIS) /* the wall, seen left and right of the quads */
+        wall_lit[light] = (pix[(W / 2) * W].y + pix[(W / 2) * W + W - 1].y) / 2;
+    }
+  }
+  printf("wall (edge pixels, luminance): dark %.4f, sky %.4f, sky + bulb %.4f\n", wall_lit[0], wall_lit[1],
+         wall_lit[2]);
+  CHECK(wall_lit[0] == 0.0 && wall_lit[1] > 0.1 && wall_lit[2] > wall_lit[1]);
+  iris_scene_destroy(s);
+  return TEST_SUMMARY();
+}
