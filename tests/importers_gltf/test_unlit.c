@@ -12,7 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/image.h"
 #include "core/log.h"
+#include "exporters/blender.h"
 #include "importers/import.h"
 #include "renderer/render.h"
 #include "scene/scene.h"
@@ -43,8 +45,76 @@ static bool render(const iris_scene *s, iris_method m, iris_vec3 *pix) {
   return true;
 }
 
-int main(void) {
+/* Largest difference between the unlit quads' pixels and their colours. */
+static double unlit_error(const float *const *chan, const float expect[2][3], size_t stride) {
+  double worst = 0;
+  for (int y = 0; y < W; y++)
+    for (int x = 0; x < W; x++) {
+      /* pixel centres at least 0.1 inside a quad (the filter may mix across edges) */
+      const float px = -1.25f + 2.5f * ((float)x + 0.5f) / W, py = -1.25f + 2.5f * ((float)y + 0.5f) / W;
+      if (fabsf(py) > 0.9f || fabsf(px) > 0.9f || fabsf(px) < 0.1f) continue;
+      const float *c = expect[x >= W / 2];
+      for (int k = 0; k < 3; k++) worst = fmax(worst, fabs(chan[k][((size_t)y * W + x) * stride] - c[k]));
+    }
+  return worst;
+}
+
+/* The same lit scene exported to Blender and rendered by Cycles 3.4: the
+ * unlit quads are Emission (strength 1) over a black Diffuse, so Cycles shows
+ * the same colours; SKIP (77) without blender. */
+static int check_blender(iris_scene *s, const float expect[2][3]) {
+  char blender[1024] = "";
+  const char *path_env = getenv("PATH");
+  for (const char *p = path_env; p && *p && !blender[0];) {
+    size_t n = strcspn(p, ":");
+    char cand[1024];
+    snprintf(cand, sizeof cand, "%.*s/blender", (int)n, p);
+    FILE *f = fopen(cand, "rb");
+    if (f) fclose(f), snprintf(blender, sizeof blender, "%s", cand);
+    p += n + (p[n] == ':');
+  }
+  if (!blender[0]) return TEST_SKIP("blender is not installed");
+  char dir[1024], script[1100], exr[1100], cmd[4096], log[1200];
+  if (!CHECK(iris_test_tmpdir(dir, sizeof dir, "unlit-blender") == 0)) return TEST_SUMMARY();
+  snprintf(script, sizeof script, "%s/unlit.py", dir);
+  snprintf(exr, sizeof exr, "%s/unlit.exr", dir);
+  snprintf(log, sizeof log, "%s/blender.log", dir);
+  iris_export_params p = iris_export_params_default();
+  p.width = p.height = W, p.max_depth = 8;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_export_blender(s, script, &p, &err), &err);
+  snprintf(cmd, sizeof cmd,
+           "'%s' -b --factory-startup --python-exit-code 1 -P '%s' -- --output '%s' --spp 4 --threads 2 "
+           "--seed 7 > '%s' 2>&1",
+           blender, script, exr, log);
+  if (CHECK(system(cmd) == 0)) {
+    iris_image img;
+    memset(&img, 0, sizeof img);
+    iris_error_clear(&err);
+    if (iris_exr_read(exr, &img, NULL, NULL, &err) == IRIS_OK && img.width == W && img.height == W) {
+      const char *names[3] = {"R", "G", "B"};
+      const float *chan[3];
+      for (int k = 0; k < 3; k++) {
+        int ch = iris_image_channel(&img, names[k]);
+        chan[k] = ch >= 0 ? img.data + ch : img.data;
+      }
+      double worst = unlit_error(chan, expect, (size_t)img.channel_count);
+      printf("Cycles: largest difference of the unlit pixels from the base colour %.3g\n", worst);
+      /* EXR half floats hold 0.8 to 2^-11 (5e-4) */
+      EXPECT(worst <= 1e-3, "Cycles: unlit pixels differ from the base colour by %g", worst);
+    } else {
+      CHECK_OK(IRIS_ERR_IO, &err);
+    }
+    iris_image_destroy(&img);
+  }
+  iris_test_rmtree(dir);
+  return TEST_SUMMARY();
+}
+
+int main(int argc, char **argv) {
   iris_log_set_level(IRIS_LOG_WARN);
+  const bool blender = argc > 1 && strcmp(argv[1], "blender") == 0;
   char path[1024];
   snprintf(path, sizeof path, "%s/unlit-quads.gltf", IRIS_GLTF_TEST_DATA);
   iris_import_options o = iris_import_options_default();
@@ -72,6 +142,22 @@ int main(void) {
   cam.aspect = 1.0f;
   iris_scene_add_camera(s, &cam);
   const float expect[2][3] = {{0.2f, 0.5f, 0.8f}, {0.8f * 0.5f, 0.6f * 1.0f, 0.4f * 0.25f}};
+
+  if (blender) { /* lit by the sky and a bulb */
+    s->has_environment = true;
+    s->environment[0] = s->environment[1] = s->environment[2] = 3.0f;
+    iris_light l;
+    memset(&l, 0, sizeof l);
+    l.name = iris_strdup("bulb");
+    l.type = IRIS_LIGHT_POINT;
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    l.intensity = 40.0f;
+    l.position[2] = 2.0f;
+    iris_scene_add_light(s, &l);
+    int rc = check_blender(s, expect);
+    iris_scene_destroy(s);
+    return rc;
+  }
 
   /* Lighting: none; a sky of radiance 3; the sky and a point light of 40 W/sr at z = 2. */
   static iris_vec3 pix[W * W];
