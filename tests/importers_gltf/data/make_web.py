@@ -73,8 +73,8 @@ def sphere(rings=12, segments=16):
     return pos, nrm, uv, idx
 
 
-def base_doc(images):
-    pos, nrm, uv, idx = sphere()
+def base_doc(images, rings=12, segments=16):
+    pos, nrm, uv, idx = sphere(rings, segments)
     blob = bytearray()
     views, accessors = [], []
     def add(data, count, type_, ct, extra=None):
@@ -89,7 +89,8 @@ def base_doc(images):
         {"min": [min(p[i] for p in pos) for i in range(3)], "max": [max(p[i] for p in pos) for i in range(3)]})
     add(struct.pack("<%df" % (3 * len(nrm)), *flat(nrm)), len(nrm), "VEC3", 5126)
     add(struct.pack("<%df" % (2 * len(uv)), *flat(uv)), len(uv), "VEC2", 5126)
-    add(struct.pack("<%dH" % len(idx), *idx), len(idx), "SCALAR", 5123)
+    big = len(pos) > 65535
+    add(struct.pack("<%d%s" % (len(idx), "I" if big else "H"), *idx), len(idx), "SCALAR", 5125 if big else 5123)
     image_json = []
     for mime, data in images:
         while len(blob) % 4: blob.append(0)
