@@ -45,7 +45,7 @@ n = sum(len(o.data.polygons) for o in bpy.data.objects if o.type == 'MESH')
 print('IRIS_IMPORT seconds=%.3f triangles=%d' % (time.perf_counter() - t, n))
 " > "$TMP/out" 2> "$TMP/time" || {
       # Debian's Blender 3.4 lacks the add-on's libextern_draco.so
-      printf '%-8s %-13s %9.2f %10s %12s   (fails: %s)\n' blender "$f.glb" "$mb" - - "$(grep -m1 'OSError\|Error' "$TMP/out")"
+      printf '%-8s %-13s %9.2f %10s %12s   (fails: %s)\n' blender "$f.glb" "$mb" - - "$(grep -m1 'OSError' "$TMP/out")"
       continue; }
     s=$(sed -n 's/^IRIS_IMPORT seconds=\([0-9.]*\).*/\1/p' "$TMP/out")
     printf '%-8s %-13s %9.2f %10s %12.1f   (%s)\n' blender "$f.glb" "$mb" "$s" "$(echo "$(rss "$TMP/time")/1024" | bc -l)" \
