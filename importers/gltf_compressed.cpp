@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <vector>
 
 extern "C" {
@@ -329,11 +330,11 @@ iris_status Decoder::draco_all() {
 bool iris_gltf_patch_compressed_json(const char *json, size_t size, std::string *out,
                                      std::vector<int> *placeholders) {
   placeholders->clear();
-  const std::string text(json, size);
-  if (text.find("KHR_draco_mesh_compression") == std::string::npos &&
-      text.find("EXT_meshopt_compression") == std::string::npos)
+  const std::string_view text(json, size);  // searched in place: most files use neither
+  if (text.find("KHR_draco_mesh_compression") == std::string_view::npos &&
+      text.find("EXT_meshopt_compression") == std::string_view::npos)
     return false;
-  nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+  nlohmann::json j = nlohmann::json::parse(json, json + size, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return false;  // tinygltf reports it
   bool changed = false;
   auto accessors = j.find("accessors");
