@@ -132,15 +132,8 @@ int main(int argc, char **argv) {
         s->materials[0].emission[2] == 0.8f); /* emissiveFactor (1, 0, 0) ignored */
   CHECK(!s->materials[2].unlit);
 
-  /* Camera on +z: the plain quad left of x = 0, the vertex-coloured one right of it. */
-  iris_camera cam;
-  memset(&cam, 0, sizeof cam);
-  cam.name = iris_strdup("front");
-  cam.to_world = iris_mat4_identity();
-  cam.to_world.m[2][3] = 4.0f;
-  cam.yfov = 2.0f * atanf(1.25f / 4.0f); /* x, y in [-1.25, 1.25] at z = 0: the wall shows around the quads */
-  cam.aspect = 1.0f;
-  iris_scene_add_camera(s, &cam);
+  /* The file's camera, on +z: the plain quad left of x = 0, the vertex-coloured one right of it. */
+  CHECK(s->camera_count == 1);
   const float expect[2][3] = {{0.2f, 0.5f, 0.8f}, {0.8f * 0.5f, 0.6f * 1.0f, 0.4f * 0.25f}};
 
   if (blender) { /* lit by the sky and a bulb */

@@ -258,8 +258,11 @@ def unlit_doc():
     d = {
         "asset": {"version": "2.0", "generator": "iris tests/importers_gltf/data/make_web.py"},
         "extensionsUsed": ["KHR_materials_unlit"],
-        "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
-        "nodes": [{"mesh": 0}, {"mesh": 1}, {"mesh": 2}],
+        "scene": 0, "scenes": [{"nodes": [0, 1, 2, 3]}],
+        "nodes": [{"mesh": 0}, {"mesh": 1}, {"mesh": 2}, {"camera": 0, "translation": [0, 0, 4], "name": "front"}],
+        # sees x, y in [-1.25, 1.25] at z = 0: the wall shows around the quads
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 2 * math.atan(1.25 / 4), "aspectRatio": 1,
+                                                            "znear": 0.1}}],
         "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 4, "material": 0}]},
                    {"primitives": [{"attributes": {"POSITION": 1, "COLOR_0": 3}, "indices": 4, "material": 1}]},
                    {"primitives": [{"attributes": {"POSITION": 2}, "indices": 4, "material": 2}]}],
