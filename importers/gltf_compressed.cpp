@@ -360,20 +360,13 @@ bool iris_gltf_patch_compressed_json(const char *json, size_t size, std::string 
       }
     }
   }
-  // A fallback buffer is dropped when the extension is required (it may hold
-  // nothing) or when it has no uri (tinygltf could not load it). Otherwise it
-  // loads, and the compressed views are still decoded (the extension says the
-  // compressed data is used when the loader supports it).
-  bool meshopt_required = false;
-  auto req = j.find("extensionsRequired");
-  if (req != j.end() && req->is_array())
-    for (const auto &r : *req)
-      if (r.is_string() && r.get<std::string>() == "EXT_meshopt_compression") meshopt_required = true;
+  // A fallback buffer (EXT_meshopt_compression.fallback) is dropped: iris
+  // decodes every compressed view, and only those may use it, so the file
+  // imports even when the fallback's .bin is absent (and nothing is read twice).
   auto buffers = j.find("buffers");
   if (buffers != j.end() && buffers->is_array()) {
     for (auto &b : *buffers) {
       if (!b.is_object() || !b.contains("extensions") || !b["extensions"].is_object()) continue;
-      if (!meshopt_required && b.contains("uri")) continue;
       auto e = b["extensions"].find("EXT_meshopt_compression");
       if (e == b["extensions"].end() || !e->is_object() || !e->contains("fallback") ||
           !(*e)["fallback"].is_boolean() || !(*e)["fallback"].get<bool>())

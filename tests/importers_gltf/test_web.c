@@ -212,6 +212,21 @@ static void check_geometry(void) {
     }
   }
   iris_scene_destroy(a), iris_scene_destroy(b), iris_scene_destroy(base);
+  /* The fallback buffer is never read: the file imports from memory, where
+   * external files (its fallback .bin) cannot be opened at all. */
+  char path[1024];
+  snprintf(path, sizeof path, "%s/web-gltfpack-fallback.glb", IRIS_GLTF_TEST_DATA);
+  FILE *fp = fopen(path, "rb");
+  static char data[1 << 16];
+  size_t n = fp ? fread(data, 1, sizeof data, fp) : 0;
+  if (fp) fclose(fp);
+  iris_import_options o = iris_import_options_default();
+  iris_error e;
+  iris_error_clear(&e);
+  iris_scene *m = NULL;
+  CHECK_OK(iris_import_gltf_memory(data, n, NULL, &o, &m, &e), &e);
+  CHECK(m && m->meshes[0].triangle_count == 352);
+  iris_scene_destroy(m);
 }
 
 /* ---- refusals ------------------------------------------------------------- */
