@@ -17,7 +17,7 @@ extern "C" {
 
 // Before tinygltf parses: tinygltf 2.7 refuses an indices accessor without a
 // bufferView (as Draco primitives' are) and loads every buffer (an
-// EXT_meshopt_compression fallback buffer has no data). When the JSON uses
+// EXT_meshopt_compression fallback buffer may have no data). When the JSON uses
 // either extension, gives such accessors the Draco bufferView as a placeholder
 // (listed in *placeholders, all of which must then be decoded) and empties
 // fallback buffers. Returns true with the new JSON in *out when it changed.
