@@ -503,7 +503,8 @@ static const char *const PRELUDE[] = {
     "    if max(m[\"emission\"]) > 0.0:",
     "        em = nt.nodes.new(\"ShaderNodeEmission\")",
     "        em.inputs[\"Strength\"].default_value = 1.0",
-    "        set_color(nt, em.inputs[\"Color\"], m[\"emission\"], m[\"emission_tex\"], False)",
+    "        # KHR_materials_unlit (unlit): the emission is base colour x texture x vertex colour",
+    "        set_color(nt, em.inputs[\"Color\"], m[\"emission\"], m[\"emission_tex\"], m[\"unlit\"] and vc)",
     "        emitted = em.outputs[0]",
     "        if not m[\"emission_two_sided\"]:",
     "            # Cycles emits from both faces; a back face gets a Mix Shader whose",
@@ -999,8 +1000,8 @@ static void put_material(FILE *fp, const iris_scene *scene, material_variant v, 
   fprintf(fp, ", principled=%s", principled ? "True" : "False");
   fputs(", emission=", fp);
   iris_blender_put_vec3(fp, m->emission);
-  fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, vertex_colors=%s",
-          (int)m->emission_texture, m->emission_two_sided ? "True" : "False",
+  fprintf(fp, ", emission_tex=%d, emission_two_sided=%s, unlit=%s, vertex_colors=%s",
+          (int)m->emission_texture, m->emission_two_sided ? "True" : "False", m->unlit ? "True" : "False",
           v.vertex_colors ? "True" : "False");
   static const char *const ALPHA[] = {"opaque", "mask", "blend"};
   fprintf(fp, ", normal_tex=%d, normal_scale=", (int)m->normal_texture);

@@ -20,6 +20,7 @@ extern "C" {
 #include "importers/gltf_convert.h"
 #include "importers/import.h"
 }
+#include "importers/gltf_compressed.h"
 
 namespace {
 
@@ -85,6 +86,8 @@ void sniff_mime(const unsigned char *b, int n, char out[16]) {
     std::snprintf(out, 16, "image/png");
   else if (n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF)
     std::snprintf(out, 16, "image/jpeg");
+  else if (n >= 12 && std::memcmp(b, "RIFF", 4) == 0 && std::memcmp(b + 8, "WEBP", 4) == 0)
+    std::snprintf(out, 16, "image/webp");
 }
 
 bool keep_encoded_image(tinygltf::Image *image, const int index, std::string *, std::string *,
@@ -267,6 +270,7 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
       o->bad_extension = "KHR_materials_transmission";
     o->has_transmission_texture = has_texture(*v, "transmissionTexture");
   }
+  if (ext("KHR_materials_unlit")) o->unlit = true;
   if (const tinygltf::Value *v = ext("KHR_materials_ior")) {
     o->has_ior = true;
     if (!get_number(*v, "ior", &o->ior, nullptr)) o->bad_extension = "KHR_materials_ior";
@@ -404,7 +408,21 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
   }
   s.materials.resize(m.materials.size());
   for (size_t i = 0; i < m.materials.size(); i++) fill_material(m.materials[i], &s.materials[i]);
-  for (const auto &t : m.textures) s.textures.push_back({t.source, t.sampler});
+  for (const auto &t : m.textures) {
+    iris_gltf_texture o = {t.source, t.sampler, -1, -1, nullptr};
+    const char *names[2] = {"EXT_texture_webp", "KHR_texture_basisu"};
+    int *dst[2] = {&o.webp_source, &o.basisu_source};
+    for (int k = 0; k < 2; k++) {
+      auto it = t.extensions.find(names[k]);
+      if (it == t.extensions.end()) continue;
+      const tinygltf::Value &v = it->second;
+      if (v.IsObject() && v.Has("source") && v.Get("source").IsInt())
+        *dst[k] = v.Get("source").GetNumberAsInt();
+      else
+        o.bad_extension = names[k];
+    }
+    s.textures.push_back(o);
+  }
   for (size_t i = 0; i < m.images.size(); i++) {
     const auto &im = m.images[i];
     iris_gltf_image o;
@@ -500,6 +518,34 @@ iris_status import_memory(const char *data, size_t size, const char *path,
   std::vector<ImageState> image_states;
   loader.SetImageLoader(&keep_encoded_image, &image_states);
 
+  // Draco and meshopt files need a patched JSON before tinygltf sees them
+  // (gltf_compressed.h); a GLB gets its JSON chunk replaced.
+  std::vector<int> placeholders;
+  std::string patched;
+  std::vector<uint8_t> glb;
+  if (is_glb) {
+    const size_t json_len = (size_t)bytes[12] | (size_t)bytes[13] << 8 | (size_t)bytes[14] << 16 |
+                            (size_t)bytes[15] << 24;  // checked by iris_gltf_check_container
+    if (iris_gltf_patch_compressed_json(data + 20, json_len, &patched, &placeholders)) {
+      while (patched.size() % 4) patched += ' ';
+      if (patched.size() > UINT32_MAX - size)
+        return iris_error_set(err, IRIS_ERR_PARSE, file, 0, nullptr, "GLB too large");
+      const size_t total = size - json_len + patched.size();
+      glb.resize(total);
+      std::memcpy(glb.data(), bytes, 12);
+      const uint32_t t32 = (uint32_t)total, j32 = (uint32_t)patched.size();
+      for (int k = 0; k < 4; k++) glb[8 + k] = (uint8_t)(t32 >> (8 * k)), glb[12 + k] = (uint8_t)(j32 >> (8 * k));
+      std::memcpy(glb.data() + 16, bytes + 16, 4);
+      std::memcpy(glb.data() + 20, patched.data(), patched.size());
+      std::memcpy(glb.data() + 20 + patched.size(), bytes + 20 + json_len, size - 20 - json_len);
+      bytes = glb.data();
+      size = total;
+    }
+  } else if (iris_gltf_patch_compressed_json(data, size, &patched, &placeholders)) {
+    data = patched.data();
+    size = patched.size();
+  }
+
   tinygltf::Model model;
   std::string terr, twarn;
   bool ok;
@@ -522,7 +568,15 @@ iris_status import_memory(const char *data, size_t size, const char *path,
                            : IRIS_ERR_PARSE;
     return iris_error_set(err, code, file, 0, nullptr, "%s", msg.c_str());
   }
+  {
+    std::vector<const char *> req;
+    for (const auto &e : model.extensionsRequired) req.push_back(e.c_str());
+    st = iris_gltf_check_required(req.data(), req.size(), file, err);
+    if (st != IRIS_OK) return st;
+  }
   if (!twarn.empty()) iris_infof("%s: tinygltf: %s", file, one_line(twarn).c_str());
+  st = iris_gltf_decode_compressed(model, placeholders, file, err);
+  if (st != IRIS_OK) return st;
 
   DocStorage storage;
   iris_gltf_doc doc;

@@ -28,7 +28,8 @@
 static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
-    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume"};
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit"};
 
 /* ---- small helpers ------------------------------------------------------ */
 
@@ -1186,7 +1187,9 @@ static iris_status check_asset(gltf_ctx *c) {
   char list[400] = "";
   size_t used = 0;
   for (size_t i = 0; i < d->extensions_used_count; i++) {
-    if (is_supported_extension(d->extensions_used[i])) continue;
+    /* KHR_texture_basisu: its fallback source is used, with its own notice (gltf_material.c). */
+    if (is_supported_extension(d->extensions_used[i]) || strcmp(d->extensions_used[i], "KHR_texture_basisu") == 0)
+      continue;
     int w = snprintf(list + used, sizeof list - used, "%s%s", used ? ", " : "", d->extensions_used[i]);
     if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
   }

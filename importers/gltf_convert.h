@@ -116,10 +116,13 @@ typedef struct iris_gltf_material {
   iris_gltf_texture_ref sheen_color_texture, sheen_roughness_texture;
   bool has_volume, has_attenuation_distance;
   double attenuation_distance, attenuation_color[3];
+  bool unlit; /* KHR_materials_unlit */
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {
   int source, sampler;
+  int webp_source, basisu_source; /* EXT_texture_webp / KHR_texture_basisu source, -1 none */
+  const char *bad_extension;      /* names one whose source is not an integer */
 } iris_gltf_texture;
 
 typedef struct iris_gltf_image {

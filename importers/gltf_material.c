@@ -11,6 +11,7 @@
 #include "core/fileio.h"
 #include "core/log.h"
 #include "importers/gltf_private.h"
+#include "importers/webp.h"
 
 iris_status gltf_validate_textures(gltf_ctx *c) {
   const iris_gltf_doc *d = c->doc;
@@ -37,6 +38,13 @@ iris_status gltf_validate_textures(gltf_ctx *c) {
     if (t->source != -1 && (t->source < 0 || (size_t)t->source >= d->image_count))
       return gltf_fail(c, IRIS_ERR_INVALID, el, "image %d does not exist (%zu images)", t->source,
                   d->image_count);
+    if (t->bad_extension)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: source is not an integer", t->bad_extension);
+    int ext_sources[2] = {t->webp_source, t->basisu_source};
+    for (int k = 0; k < 2; k++)
+      if (ext_sources[k] != -1 && (ext_sources[k] < 0 || (size_t)ext_sources[k] >= d->image_count))
+        return gltf_fail(c, IRIS_ERR_INVALID, el, "%s: image %d does not exist (%zu images)",
+                         k ? "KHR_texture_basisu" : "EXT_texture_webp", ext_sources[k], d->image_count);
     if (t->sampler != -1 && (t->sampler < 0 || (size_t)t->sampler >= d->sampler_count))
       return gltf_fail(c, IRIS_ERR_INVALID, el, "sampler %d does not exist (%zu samplers)", t->sampler,
                   d->sampler_count);
@@ -78,20 +86,126 @@ static bool same_mapping(const gltf_slot *a, const gltf_slot *b) {
                                a->scale[1] == b->scale[1]);
 }
 
+/* Reads glTF image `image` into tex (data or path, and mime). A WebP image
+ * is decoded and stored as PNG (importers/webp.h). *soft is set, and tex left
+ * empty, when the image cannot be used: `webp_failed` tells whether it was a
+ * WebP that did not decode (an error unless a fallback exists) rather than a
+ * format iris does not read (the texture is dropped with a warning). */
+static iris_status load_image(gltf_ctx *c, int image, iris_texture *tex, char *soft, size_t soft_size,
+                              bool *webp_failed) {
+  const iris_gltf_doc *d = c->doc;
+  char el[64];
+  const iris_gltf_image *im = &d->images[image];
+  ELEMENT(el, "image %d", image);
+  soft[0] = '\0';
+  *webp_failed = false;
+  const uint8_t *bytes = NULL;
+  size_t size = 0;
+  char *file_data = NULL;
+  char mime[16] = "";
+  if (im->view >= 0) {
+    const iris_gltf_view *v = &d->views[im->view];
+    bytes = d->buffers[v->buffer].data + v->offset;
+    size = v->length;
+  } else if (im->data) {
+    bytes = im->data;
+    size = im->size;
+  }
+  if (!bytes && im->uri) {
+    if (strstr(im->uri, "://"))
+      return gltf_fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
+    if (!d->base_dir)
+      return gltf_fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
+    char rel[1024], joined[2048], abs_path[4096];
+    uri_decode(im->uri, rel, sizeof rel);
+    iris_path_join(d->base_dir, rel, joined, sizeof joined);
+    if (!im->file_found) return gltf_fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
+    if (strcmp(im->file_mime, "image/webp") == 0) {
+      /* Decoded like an embedded WebP; the scene then holds the PNG. */
+      iris_error fe;
+      iris_error_clear(&fe);
+      if (iris_file_read(joined, (size_t)1 << 30, &file_data, &size, &fe) != IRIS_OK)
+        return gltf_fail(c, IRIS_ERR_IO, el, "cannot read image file '%s'", joined);
+      bytes = (const uint8_t *)file_data;
+    } else {
+      /* Absolute, so the scene stays valid wherever it is written. */
+      char cwd[2048];
+      if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
+        snprintf(abs_path, sizeof abs_path, "%s", joined);
+      else
+        snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
+      if (!im->file_mime[0]) {
+        snprintf(soft, soft_size, "not a PNG, JPEG or WebP file");
+        return IRIS_OK;
+      }
+      tex->path = iris_strdup(abs_path);
+      if (!tex->path) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+      snprintf(tex->mime, sizeof tex->mime, "%s", im->file_mime);
+      return IRIS_OK;
+    }
+  }
+  if (!bytes) return gltf_fail(c, IRIS_ERR_INVALID, el, "has no data");
+  if (iris_webp_sniff(bytes, size)) {
+    uint8_t *png = NULL;
+    size_t png_size = 0;
+    bool ok = iris_webp_to_png(bytes, size, &png, &png_size, soft, soft_size);
+    free(file_data);
+    if (!ok) {
+      *webp_failed = true;
+      return IRIS_OK;
+    }
+    tex->data = png;
+    tex->data_size = png_size;
+    snprintf(tex->mime, sizeof tex->mime, "image/png");
+    return IRIS_OK;
+  }
+  if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
+  else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
+    snprintf(mime, sizeof mime, "image/jpeg");
+  if (!mime[0]) {
+    free(file_data);
+    snprintf(soft, soft_size, "not a PNG, JPEG or WebP image");
+    return IRIS_OK;
+  }
+  tex->data = malloc(size);
+  if (!tex->data) {
+    free(file_data);
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+  }
+  memcpy(tex->data, bytes, size);
+  tex->data_size = size;
+  free(file_data);
+  snprintf(tex->mime, sizeof tex->mime, "%s", mime);
+  return IRIS_OK;
+}
+
 /* Scene texture for a material slot, created on first use: one per (image,
- * sampler, uv set, transform); -2 when dropped with a warning. */
+ * sampler, uv set, transform); -2 when dropped with a warning. The image is
+ * EXT_texture_webp's source when there is one, else (or when that WebP does
+ * not decode) the core source; KHR_texture_basisu's KTX2 image is never
+ * decoded: its fallback source is used with a notice. */
 static iris_status resolve_texture(gltf_ctx *c, const gltf_slot *slot, int32_t *out) {
   const iris_gltf_doc *d = c->doc;
   int ti = slot->texture;
   const iris_gltf_texture *t = &d->textures[ti];
   *out = -2;
-  if (t->source < 0) {
-    iris_warnf("%s: texture %d has no core image source (extension-only image); ignored", c->file, ti);
+  int order[2], n = 0;
+  if (t->webp_source >= 0) order[n++] = t->webp_source;
+  if (t->source >= 0 && t->source != t->webp_source) order[n++] = t->source;
+  if (t->basisu_source >= 0 && !c->noticed_basisu) {
+    c->noticed_basisu = true;
+    if (t->source >= 0)
+      iris_infof("%s: texture %d: KHR_texture_basisu (KTX2) cannot be decoded by iris; using its fallback image %d",
+                 c->file, ti, t->source);
+  }
+  if (n == 0) {
+    iris_warnf("%s: texture %d has no image iris can decode (%s); ignored", c->file, ti,
+               t->basisu_source >= 0 ? "only KHR_texture_basisu's KTX2" : "no source");
     return IRIS_OK;
   }
   for (size_t k = 0; k < c->tex_key_count; k++) {
     const gltf_tex_key *key = &c->tex_keys[k];
-    if (key->source == t->source && key->sampler == t->sampler && same_mapping(&key->map, slot)) {
+    if (key->source == order[0] && key->sampler == t->sampler && same_mapping(&key->map, slot)) {
       *out = key->id;
       return IRIS_OK;
     }
@@ -103,61 +217,29 @@ static iris_status resolve_texture(gltf_ctx *c, const gltf_slot *slot, int32_t *
     c->tex_keys = grown, c->tex_key_cap = cap;
   }
   gltf_tex_key *key = &c->tex_keys[c->tex_key_count++];
-  key->source = t->source, key->sampler = t->sampler, key->map = *slot, key->id = -2;
-  char el[64];
-  const iris_gltf_image *im = &d->images[t->source];
-  ELEMENT(el, "image %d", t->source);
+  key->source = order[0], key->sampler = t->sampler, key->map = *slot, key->id = -2;
   iris_texture tex;
   memset(&tex, 0, sizeof tex);
-  const uint8_t *bytes = NULL;
-  size_t size = 0;
-  char mime[16] = "";
-  if (im->view >= 0) {
-    const iris_gltf_view *v = &d->views[im->view];
-    bytes = d->buffers[v->buffer].data + v->offset;
-    size = v->length;
-  } else if (im->data) {
-    bytes = im->data;
-    size = im->size;
-  }
-  if (bytes) {
-    if (size >= 8 && memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0) snprintf(mime, sizeof mime, "image/png");
-    else if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF)
-      snprintf(mime, sizeof mime, "image/jpeg");
-    if (!mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG image");
+  int used = -1;
+  for (int k = 0; k < n && used < 0; k++) {
+    char soft[256];
+    bool webp_failed;
+    iris_status st = load_image(c, order[k], &tex, soft, sizeof soft, &webp_failed);
+    if (st != IRIS_OK) return st;
+    if (!soft[0]) {
+      used = order[k];
+    } else if (k + 1 < n) {
+      iris_infof("%s: image %d: %s; texture %d uses its fallback image %d", c->file, order[k], soft, ti, order[k + 1]);
+    } else if (webp_failed) {
+      char el[64];
+      ELEMENT(el, "image %d", order[k]);
+      return gltf_fail(c, IRIS_ERR_PARSE, el, "%s", soft);
+    } else {
+      warn_dropped_image(c, (size_t)order[k], soft);
       return IRIS_OK;
     }
-    tex.data = malloc(size);
-    if (!tex.data) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-    memcpy(tex.data, bytes, size);
-    tex.data_size = size;
-  } else if (im->uri) {
-    if (strstr(im->uri, "://"))
-      return gltf_fail(c, IRIS_ERR_UNSUPPORTED, el, "remote image URI '%s'", im->uri);
-    if (!d->base_dir)
-      return gltf_fail(c, IRIS_ERR_IO, el, "external image '%s' needs a file path", im->uri);
-    char rel[1024], joined[2048], abs_path[4096];
-    uri_decode(im->uri, rel, sizeof rel);
-    iris_path_join(d->base_dir, rel, joined, sizeof joined);
-    if (!im->file_found) return gltf_fail(c, IRIS_ERR_IO, el, "cannot open image file '%s'", joined);
-    /* Absolute, so the scene stays valid wherever it is written. */
-    char cwd[2048];
-    if (joined[0] == '/' || !getcwd(cwd, sizeof cwd))
-      snprintf(abs_path, sizeof abs_path, "%s", joined);
-    else
-      snprintf(abs_path, sizeof abs_path, "%s/%s", cwd, joined[0] == '.' && joined[1] == '/' ? joined + 2 : joined);
-    if (!im->file_mime[0]) {
-      warn_dropped_image(c, (size_t)t->source, "not a PNG or JPEG file");
-      return IRIS_OK;
-    }
-    snprintf(mime, sizeof mime, "%s", im->file_mime);
-    tex.path = iris_strdup(abs_path);
-    if (!tex.path) return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
-  } else {
-    return gltf_fail(c, IRIS_ERR_INVALID, el, "has no data");
   }
-  snprintf(tex.mime, sizeof tex.mime, "%s", mime);
+  const iris_gltf_image *im = &d->images[used];
   tex.name = im->name && im->name[0] ? iris_strdup(im->name) : NULL;
   tex.wrap_s = tex.wrap_t = IRIS_WRAP_REPEAT;
   if (t->sampler >= 0) {
@@ -176,7 +258,7 @@ static iris_status resolve_texture(gltf_ctx *c, const gltf_slot *slot, int32_t *
   int32_t id = iris_scene_add_texture(c->scene, &tex);
   if (id < 0) {
     free(tex.name), free(tex.path), free(tex.data);
-    return gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory");
+    return gltf_fail(c, IRIS_ERR_NOMEM, NULL, "out of memory");
   }
   *out = key->id = id;
   return IRIS_OK;
@@ -366,6 +448,27 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
         m->alpha_cutoff = (float)g->alpha_cutoff;
       }
       if (g->emissive[0] > 0 || g->emissive[1] > 0 || g->emissive[2] > 0) c->warned_alpha_emission = true;
+    }
+    if (g->unlit) {
+      /* KHR_materials_unlit: the surface shows base colour x texture x vertex colour
+       * as radiance and scatters nothing; every other property is ignored (the
+       * extension). Stored as a black diffuse emitting the base colour through the
+       * base colour texture; `unlit` multiplies in the vertex colours. The colour
+       * texture stays for its alpha (MASK/BLEND), under a zero colour. */
+      iris_material u = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+      u.name = m->name;
+      u.unlit = true;
+      for (int k = 0; k < 3; k++) u.emission[k] = m->color[k], u.color[k] = 0.0f;
+      u.color_texture = m->color_texture;
+      u.emission_texture = m->color_texture;
+      u.emission_two_sided = m->emission_two_sided;
+      u.double_sided = m->double_sided;
+      u.alpha_mode = m->alpha_mode, u.alpha = m->alpha, u.alpha_cutoff = m->alpha_cutoff;
+      *m = u;
+      gltf_slot color_slot = slots[GLTF_SLOT_COLOR];
+      for (int k = 0; k < GLTF_SLOT_COUNT; k++) slots[k].texture = -1;
+      slots[GLTF_SLOT_COLOR] = slots[GLTF_SLOT_EMISSION] = color_slot;
+      continue;
     }
     if (g->has_occlusion_texture) c->warned_occlusion = true;
     if (g->has_specular_textures) c->warned_spec_tex = true;

@@ -79,6 +79,7 @@ typedef struct gltf_ctx {
   bool warned_texcoord, warned_alpha_emission, warned_occlusion, warned_spec_tex, warned_trans_tex;
   size_t normal_map_no_normal, normal_map_no_uv; /* primitives whose normal map is not applied */
   size_t tangents_generated, tangents_split;
+  bool noticed_basisu;
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
   size_t zero_normals;
   size_t budget_total, budget_left; /* bytes of converted mesh data allowed */

@@ -362,7 +362,7 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     e->e1 = iris_sub(v[1], v[0]);
     e->e2 = iris_sub(v[2], v[0]);
     e->ng = iris_normalize(iris_cross(e->e1, e->e2));
-    e->textured = m->emission_texture >= 0;
+    e->textured = m->emission_texture >= 0 || m->unlit; /* evaluated per point (vertex colours) */
     out->light_of_prim[t] = (uint32_t)n;
     n++;
   }
@@ -496,6 +496,7 @@ static iris_vec3 surface_emission(const iris_lights *lights, const iris_material
     iris_texture_sample(lights->textures, m->emission_texture, si->uv, si->uv1, true, t);
     le = iris_mul(le, iris_v3(t[0], t[1], t[2]));
   }
+  if (m->unlit) le = iris_mul(le, si->color); /* KHR_materials_unlit: base colour x vertex colour */
   return le;
 }
 

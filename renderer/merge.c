@@ -71,7 +71,7 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
     hash_u64(&s, (uint64_t)(int64_t)m->color_texture);
     hash_u64(&s, (uint64_t)(int64_t)m->metallic_roughness_texture);
     hash_u64(&s, (uint64_t)(int64_t)m->emission_texture);
-    hash_u64(&s, (m->emission_two_sided ? 2u : 0u) | (m->double_sided ? 1u : 0u));
+    hash_u64(&s, (m->unlit ? 4u : 0u) | (m->emission_two_sided ? 2u : 0u) | (m->double_sided ? 1u : 0u));
     if (m->alpha_mode != IRIS_ALPHA_OPAQUE || m->alpha != 1.0f) { /* (opaque scenes hash as before) */
       float a[2] = {m->alpha, m->alpha_cutoff};
       hash_u64(&s, (uint64_t)m->alpha_mode);

@@ -76,6 +76,9 @@ typedef struct iris_material {
   float emission[3];       /* emitted radiance = colour x strength; all 0: not emissive */
   int32_t emission_texture;/* multiplies emission (sRGB-decoded); -1 none */
   bool emission_two_sided; /* true: emits from both faces (Cycles' behaviour) */
+  bool unlit;              /* glTF KHR_materials_unlit: the emission is also multiplied by the
+                              mesh's vertex colours (the importer stores an unlit surface as a
+                              black diffuse emitting base colour x texture, docs/format.md) */
   bool double_sided;       /* glTF doubleSided (informational for back-face shading) */
   int32_t normal_texture;  /* tangent-space normal map (linear, glTF convention), -1 none;
                               used on meshes with tangents */

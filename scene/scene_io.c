@@ -211,6 +211,7 @@ static cJSON *write_material(const iris_material *m) {
   if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
   if (m->emission_two_sided != d.emission_two_sided)
     cJSON_AddBoolToObject(o, "emission_two_sided", m->emission_two_sided);
+  if (m->unlit) cJSON_AddBoolToObject(o, "unlit", true);
   if (m->double_sided != d.double_sided) cJSON_AddBoolToObject(o, "double_sided", m->double_sided);
   if (m->normal_texture >= 0) cJSON_AddNumberToObject(o, "normal_texture", m->normal_texture);
   if (m->normal_scale != d.normal_scale) add_float(o, "normal_scale", m->normal_scale);
@@ -657,7 +658,7 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   static const char *const keys[] = {"name", "type", "color", "color_texture", "roughness", "ior",
                                      "metallic", "metallic_roughness_texture", "specular",
                                      "specular_color", "transmission", "emission", "emission_texture",
-                                     "emission_two_sided", "double_sided", "normal_texture",
+                                     "emission_two_sided", "unlit", "double_sided", "normal_texture",
                                      "normal_scale", "alpha_mode", "alpha", "alpha_cutoff", "clearcoat",
                                      "clearcoat_roughness", "clearcoat_texture",
                                      "clearcoat_roughness_texture", "clearcoat_normal_texture",
@@ -699,6 +700,7 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
   TRY(get_floats(c, o, "emission", full.emission, 3));
   TRY(get_i32(c, o, "emission_texture", -1, INT32_MAX, &full.emission_texture));
   TRY(get_bool(c, o, "emission_two_sided", &full.emission_two_sided));
+  TRY(get_bool(c, o, "unlit", &m->unlit));
   TRY(get_bool(c, o, "double_sided", &full.double_sided));
   TRY(get_i32(c, o, "normal_texture", -1, INT32_MAX, &m->normal_texture));
   TRY(get_float(c, o, "normal_scale", &m->normal_scale));

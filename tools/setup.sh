@@ -9,9 +9,10 @@ set -eu
 cd "$(dirname "$0")/.."
 
 build_pkgs="build-essential cmake pkg-config libembree-dev libopenexr-dev libopenmesh-dev
-  libtinygltf-dev nlohmann-json3-dev libstb-dev libcjson-dev libpng-dev zlib1g-dev"
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libcjson-dev libpng-dev zlib1g-dev
+  libdraco-dev libmeshoptimizer-dev libwebp-dev"
 test_pkgs="clang libclang-rt-14-dev blender povray openimageio-tools assimp-utils
-  python3-matplotlib python3-numpy gnuplot-nox chromium slurm-wlm munge"
+  python3-matplotlib python3-numpy gnuplot-nox chromium slurm-wlm munge gltfpack webp"
 
 pkgs=$build_pkgs
 [ "${1:-}" = "--tests" ] && pkgs="$build_pkgs $test_pkgs"

@@ -92,8 +92,8 @@ int main(int argc, char **argv) {
   expect_usage_error("no-such-scene --to blender -o x.py", "no-such-scene");
   expect_usage_error("cornell-box --to blender -o x.py --camera nosuch", "nosuch");
   expect_usage_error("cornell-box --to blender -o x.py --bogus", "--bogus");
-  snprintf(args, sizeof args, "'%s/bad/gltf/Box-Draco-must-reject/Box.gltf' --to blender -o x.py", g_assets);
-  expect_usage_error(args, "Box.gltf");
+  snprintf(args, sizeof args, "'%s/basisu-required.gltf' --to blender -o x.py", IRIS_GLTF_TEST_DATA);
+  expect_usage_error(args, "basisu-required.gltf");
   snprintf(args, sizeof args, "'%s/bad/gltf/assimp/IndexOutOfRange/IndexOutOfRange.gltf' --to pov -o x.pov",
            g_assets);
   expect_usage_error(args, "IndexOutOfRange.gltf");

@@ -285,10 +285,25 @@ static void test_assets(void) {
   CHECK(system(cmd) == 0);
   EXPECT_RUN("info r2/bt.json", 0, "textures     1");
 
-  /* Must-reject asset: Draco compression; nothing written. */
-  snprintf(args, sizeof args, "import '%s/bad/gltf/Box-Draco-must-reject/Box.gltf' -o draco.json", assets);
-  EXPECT_RUN(args, 2, "Box.gltf");
-  CHECK(!exists("draco.json"));
+  /* Must-reject file: a required extension iris cannot decode (KHR_texture_basisu); nothing written. */
+  snprintf(args, sizeof args, "import '%s/basisu-required.gltf' -o basisu.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "KHR_texture_basisu");
+  CHECK(!exists("basisu.json"));
+  /* Compressed data that lies: one line naming the file and the primitive / image, exit 2, nothing written. */
+  snprintf(args, sizeof args, "import '%s/bad-draco-count.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "mesh 0 primitive 0: KHR_draco_mesh_compression");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  snprintf(args, sizeof args, "import '%s/bad-meshopt-corrupt.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "bufferView 2: EXT_meshopt_compression");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  snprintf(args, sizeof args, "import '%s/bad-webp-truncated.glb' -o bad.json", IRIS_GLTF_TEST_DATA);
+  EXPECT_RUN(args, 2, "image 0: WebP decoding failed");
+  CHECK(strchr(err_text, '\n') == strrchr(err_text, '\n')); /* one line */
+  CHECK(!exists("bad.json") && !exists("bad.meshes"));
+  /* Draco (formerly the must-reject example) imports. */
+  snprintf(args, sizeof args, "import -q '%s/bad/gltf/Box-Draco-must-reject/Box.gltf' -o draco.json", assets);
+  EXPECT_RUN(args, 0, NULL);
+  CHECK(exists("draco.json"));
 }
 
 int main(int argc, char **argv) {
