@@ -27,6 +27,11 @@ void iris_infof(const char *fmt, ...)
     ;
 /* True when progress bars should be drawn: info level and stderr is a terminal. */
 bool iris_log_progress_enabled(void);
+/* Says that a progress line ending in '\r'-style redrawing (no newline) is on
+ * screen: the next warning or message starts on a new line below it. */
+void iris_log_progress_drawn(void);
+/* Ends an open progress line with its newline (nothing when none is open). */
+void iris_log_progress_end(void);
 
 #ifdef __cplusplus
 }

@@ -100,6 +100,7 @@ static void draw_progress(void *ctx, int done, int total, double elapsed, double
   fprintf(stderr, "\r[%s] %3d%%  %d/%d spp  %.2f Msamples/s  ETA %.0fs ", b, (int)(frac * 100.0),
           done, total, rate * 1e-6, eta);
   fflush(stderr);
+  iris_log_progress_drawn();
 }
 
 /* A set-up phase on the progress line: what runs, time so far, and when the
@@ -111,6 +112,7 @@ static void draw_phase(void *ctx, const char *what, double elapsed, double eta_f
   if (eta_first_image > 0.0) snprintf(eta, sizeof eta, ", first image pass in ~%.0fs", eta_first_image);
   fprintf(stderr, "\r%-44s %6.1fs%-34s", what, elapsed, eta);
   fflush(stderr);
+  iris_log_progress_drawn();
 }
 
 static bool ends_with(const char *s, const char *suffix) {
@@ -336,7 +338,7 @@ int iris_cmd_render(int argc, char **argv) {
   p.cancel = iris_cli_stop_flag();
   p.progress = draw_progress;
   p.progress_ctx = &ps;
-  p.phase = draw_phase;
+  p.phase = ps.enabled ? draw_phase : NULL; /* else the guide logs its long training passes */
   p.phase_ctx = &ps;
   {
     /* the film size is only known inside iris_render; estimate pixels there */
@@ -352,7 +354,7 @@ int iris_cmd_render(int argc, char **argv) {
   /* signals stay caught while the files are written: a first Ctrl-C there
    * changes nothing, a second ends at once (the writes go through a temporary
    * file, so no partial output is left under the output's name) */
-  if (ps.enabled) fprintf(stderr, "\n");
+  iris_log_progress_end();
   if (st != IRIS_OK) {
     iris_guiding_marks_destroy(&marks);
     iris_scene_destroy(scene);

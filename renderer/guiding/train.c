@@ -332,7 +332,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
     done += n;
     iteration++;
     sec_per_spp = (iris_time_now() - t0) / (double)done;
-    if (iris_time_now() - t0 > 2.0) /* progress on long training */
+    if (!s->phase && iris_time_now() - t0 > 2.0) /* progress on long training, where no progress line shows it */
       iris_infof("guiding: training pass %d: %d of %d spp, %.1f s", iteration, done, total, iris_time_now() - t0);
     if (timed && iteration == 1) {
       /* One training spp costs about one render spp: spend TRAIN_SHARE of
