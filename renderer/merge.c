@@ -217,6 +217,12 @@ iris_status iris_merge_part_info_parse(const iris_image *img, const iris_image_m
   if (!parse_ints(spp, v, 1) || v[0] < 1)
     return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:spp", "'%s' is not a sample count", spp);
   out->spp = v[0];
+  const char *train = meta_get(meta, meta_count, "iris:train_spp");
+  if (train) {
+    if (!parse_ints(train, v, 1))
+      return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:train_spp", "'%s' is not a sample count", train);
+    out->train_spp = v[0];
+  }
   const char *off = meta_get(meta, meta_count, "iris:sample_offset");
   if (off) {
     if (!parse_ints(off, v, 1))
@@ -329,6 +335,21 @@ iris_status iris_merge_add(iris_merge *m, const char *path, const iris_image *im
       return mismatch(err, path, "render configuration (camera, depths, guiding options) hash",
                       fi->config_hash, in->config_hash, f->path);
   }
+  /* Training samples are the guide-training process's own: only a part that
+   * starts at sample 0 can hold them, and every such part the same number. */
+  if (in->train_spp > 0 && in->sample_offset > 0)
+    return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:train_spp",
+                          "%" PRId64 " training samples in a part starting at sample %" PRId64
+                          " (only the part at sample 0 may hold them)", in->train_spp, in->sample_offset);
+  if (in->sample_offset == 0) {
+    bool first0 = true;
+    for (size_t i = 0; i < m->part_count; i++) first0 = first0 && m->parts[i].info.sample_offset != 0;
+    if (first0) m->train_spp = in->train_spp;
+    else if (in->train_spp != m->train_spp)
+      return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:train_spp",
+                            "%" PRId64 " training samples where the other parts at sample 0 hold %" PRId64,
+                            in->train_spp, m->train_spp);
+  }
   if (m->part_count == m->part_capacity) {
     size_t cap = m->part_capacity ? 2 * m->part_capacity : 16;
     iris_merge_part *p = realloc(m->parts, cap * sizeof *p);
@@ -353,7 +374,7 @@ iris_status iris_merge_add(iris_merge *m, const char *path, const iris_image *im
     cm[c] = iris_image_channel(img, names[c]);
     cv[c] = in->has_variance ? iris_image_channel(img, names[3 + c]) : -1;
   }
-  const double nb = (double)in->spp;
+  const double nb = (double)(in->spp + in->train_spp); /* the film's count per pixel */
   const int cc = img->channel_count;
   for (int y = in->y0; y < in->y1; y++)
     for (int x = in->x0; x < in->x1; x++) {
@@ -499,7 +520,7 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
   static const char *const replaced[] = {"iris:spp",          "iris:sample_offset", "iris:window",
                                          "iris:full_size",    "iris:render_seconds",
                                          "iris:nan_count",    "iris:threads",
-                                         "iris:interrupted",  "iris:merged_parts"};
+                                         "iris:interrupted",  "iris:merged_parts", "iris:train_spp"};
   const size_t nrep = sizeof replaced / sizeof replaced[0];
   iris_image_meta *meta = calloc(m->meta_count + nrep, sizeof *meta);
   if (!meta) {
@@ -526,6 +547,7 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
   META("iris:nan_count", "%" PRIu64, m->nan_count);
   META("iris:interrupted", "false");
   META("iris:merged_parts", "%zu", m->part_count);
+  META("iris:train_spp", "%" PRId64, m->train_spp);
 #undef META
   *meta_out = meta;
   *meta_count_out = k;

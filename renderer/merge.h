@@ -38,6 +38,8 @@ typedef struct iris_merge_part_info {
   int x0, y0, x1, y1;   /* iris:window, half-open, in full-frame pixels */
   int64_t sample_offset; /* iris:sample_offset (default 0) */
   int64_t spp;          /* iris:spp: samples of every pixel, indices offset .. offset+spp-1 */
+  int64_t train_spp;    /* iris:train_spp: the guide's training samples also in the image (only
+                           at sample offset 0: docs/distributed.md; default 0) */
   bool has_variance;    /* var.R/G/B present (variance of the mean) */
 } iris_merge_part_info;
 
@@ -65,6 +67,7 @@ typedef struct iris_merge {
   double render_seconds; /* sum over parts */
   uint64_t nan_count;    /* sum over parts */
   bool all_variance;
+  int64_t train_spp;     /* of the parts at sample offset 0 (all equal) */
   int width, height;
   double *n;    /* samples per pixel */
   double *mean; /* 3 per pixel */

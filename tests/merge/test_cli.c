@@ -107,6 +107,23 @@ int main(int argc, char **argv) {
   EXPECT_RUN("merge t3.exr t1.exr t0.exr t2.exr -o tiles.exr --json", 0, "\"windows\":\t4");
   expect_close("tiles.exr", "full.exr");
 
+  /* guided-nee keeping its training samples (3 spp, the same guide in every
+   * part): the part at sample 0 holds them, the later part does not, and the
+   * merge equals the single render that kept them */
+#define G "render door --width 24 --height 16 --threads 2 --quiet --method guided-nee --photons 20000 " \
+          "--train-spp 3 --keep-training "
+  EXPECT_RUN(G "--spp 6 -o gfull.exr", 0, "");
+  EXPECT_RUN(G "--spp 4 -o g0.exr", 0, "");
+  EXPECT_RUN(G "--spp 2 --sample-offset 4 -o g1.exr", 0, "");
+  CHECK_EQ_STR(meta_value("gfull.exr", "iris:train_spp", v, sizeof v), "3");
+  CHECK_EQ_STR(meta_value("g0.exr", "iris:train_spp", v, sizeof v), "3");
+  CHECK_EQ_STR(meta_value("g1.exr", "iris:train_spp", v, sizeof v), "0");
+  EXPECT_RUN("merge g1.exr g0.exr -o gm.exr", 0, "2 parts (1 windows)");
+  expect_close("gm.exr", "gfull.exr");
+  CHECK_EQ_STR(meta_value("gm.exr", "iris:train_spp", v, sizeof v), "3");
+  CHECK_EQ_STR(meta_value("gm.exr", "iris:spp", v, sizeof v), "6");
+#undef G
+
   /* refusals: exit 2, one line naming the part, no output */
   EXPECT_RUN(R "--spp 4 --sample-offset 6 --seed 12 -o seed.exr", 0, "");
   EXPECT_RUN("merge a.exr seed.exr -o x.exr", 2, "iris: seed.exr: rendered with seed 12, but a.exr has 11");
