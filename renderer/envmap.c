@@ -101,12 +101,6 @@ iris_status iris_envmap_check(const char *path, iris_error *err) {
 
 void iris_envmap_destroy(iris_envmap *env) {
   if (!env) return;
-  if (env->bins)
-    for (int b = 0; b < IRIS_ENVMAP_NORMAL_BINS * IRIS_ENVMAP_NORMAL_BINS; b++) iris_distrib1d_destroy(&env->bins[b]);
-  free(env->bins);
-  free(env->blk_off);
-  free(env->blk_cdf);
-  free(env->blk_sum);
   if (env->cols)
     for (int r = 0; r < env->height; r++) iris_distrib1d_destroy(&env->cols[r]);
   free(env->cols);
@@ -131,116 +125,6 @@ static double tent_sin_integral(double t0, double t1, double a, double b) {
   double F1 = -(a + b * t1) * cos(pi * t1) / pi + b * sin(pi * t1) / (pi * pi);
   double F0 = -(a + b * t0) * cos(pi * t0) / pi + b * sin(pi * t0) / (pi * pi);
   return F1 - F0;
-}
-
-/* Octahedral map of unit vectors to [0,1]^2 and back (bins of receiver normals). */
-static void oct_encode(iris_vec3 n, float *u, float *v) {
-  float a = fabsf(n.x) + fabsf(n.y) + fabsf(n.z);
-  float x = n.x / a, y = n.y / a;
-  if (n.z < 0.0f) {
-    float ox = x;
-    x = (1.0f - fabsf(y)) * (ox < 0.0f ? -1.0f : 1.0f);
-    y = (1.0f - fabsf(ox)) * (y < 0.0f ? -1.0f : 1.0f);
-  }
-  *u = 0.5f * x + 0.5f, *v = 0.5f * y + 0.5f;
-}
-static iris_vec3 oct_decode(float u, float v) {
-  float x = 2.0f * u - 1.0f, y = 2.0f * v - 1.0f, z = 1.0f - fabsf(x) - fabsf(y);
-  if (z < 0.0f) {
-    float ox = x;
-    x = (1.0f - fabsf(y)) * (ox < 0.0f ? -1.0f : 1.0f);
-    y = (1.0f - fabsf(ox)) * (y < 0.0f ? -1.0f : 1.0f);
-  }
-  return iris_normalize(iris_v3(x, y, z));
-}
-static int normal_bin(iris_vec3 n) {
-  const int NB = IRIS_ENVMAP_NORMAL_BINS;
-  float u, v;
-  oct_encode(n, &u, &v);
-  int i = (int)(u * NB), j = (int)(v * NB);
-  i = i < 0 ? 0 : i >= NB ? NB - 1 : i;
-  j = j < 0 ? 0 : j >= NB ? NB - 1 : j;
-  return j * NB + i;
-}
-static double angle_between(iris_vec3 a, iris_vec3 b) {
-  return acos(fmax(-1.0, fmin(1.0, (double)iris_dot(a, b))));
-}
-/* Centre direction and angular radius of a rectangle of a 2D parametrisation
- * (lat-long (s, t) or octahedral (u, v)): the largest angle from the centre
- * to 5 points per edge, widened by 5% + 0.01 rad (the edges bulge between them). */
-static void region_bound(int oct, const iris_envmap *env, float u0, float v0, float u1, float v1,
-                         iris_vec3 *c, double *r) {
-  float uc = 0.5f * (u0 + u1), vc = 0.5f * (v0 + v1);
-  *c = oct ? oct_decode(uc, vc) : iris_envmap_st_to_dir(env, uc, vc);
-  double m = 0.0;
-  for (int k = 0; k <= 4; k++) {
-    float f = (float)k / 4.0f;
-    float pu[4] = {u0 + f * (u1 - u0), u0 + f * (u1 - u0), u0, u1};
-    float pv[4] = {v0, v1, v0 + f * (v1 - v0), v0 + f * (v1 - v0)};
-    for (int e = 0; e < 4; e++) {
-      iris_vec3 q = oct ? oct_decode(pu[e], pv[e]) : iris_envmap_st_to_dir(env, pu[e], pv[e]);
-      m = fmax(m, angle_between(*c, q));
-    }
-  }
-  *r = 1.05 * m + 0.01;
-}
-
-/* The receiver-aware tables (iris_envmap_sample_at), from the cells' weights
- * (cols[y].func). */
-static iris_status build_receiver_tables(iris_envmap *env, const char *path, iris_error *err) {
-  const int W = env->width, H = env->height, NB = IRIS_ENVMAP_NORMAL_BINS;
-  env->bw = (W + 63) / 64, env->bh = (H + 31) / 32;
-  env->bcols = (W + env->bw - 1) / env->bw, env->brows = (H + env->bh - 1) / env->bh;
-  const int nblk = env->bcols * env->brows;
-  env->blk_off = malloc(sizeof(uint32_t) * ((size_t)nblk + 1));
-  env->blk_cdf = malloc(sizeof(float) * (size_t)W * (size_t)H);
-  env->blk_sum = malloc(sizeof(float) * (size_t)nblk);
-  env->bins = calloc((size_t)NB * NB, sizeof *env->bins);
-  iris_vec3 *bc = malloc(sizeof(iris_vec3) * (size_t)nblk);
-  double *br = malloc(sizeof(double) * (size_t)nblk);
-  float *w = malloc(sizeof(float) * (size_t)nblk);
-  if (!env->blk_off || !env->blk_cdf || !env->blk_sum || !env->bins || !bc || !br || !w) {
-    free(bc), free(br), free(w);
-    return iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory for the environment map");
-  }
-  uint32_t k = 0;
-  for (int j = 0; j < nblk; j++) {
-    int bx = j % env->bcols, by = j / env->bcols;
-    int x0 = bx * env->bw, y0 = by * env->bh;
-    int x1 = x0 + env->bw < W ? x0 + env->bw : W, y1 = y0 + env->bh < H ? y0 + env->bh : H;
-    env->blk_off[j] = k;
-    double acc = 0.0;
-    for (int y = y0; y < y1; y++)
-      for (int x = x0; x < x1; x++) {
-        acc += env->cols[y].func[x];
-        env->blk_cdf[k++] = (float)acc;
-      }
-    /* normalised; 1 from the last cell with weight on, so no sample lands on a zero tail */
-    uint32_t last = k;
-    while (last > env->blk_off[j] + 1 && env->cols[y0 + (int)(last - 1 - env->blk_off[j]) / (x1 - x0)]
-                                                 .func[x0 + (int)(last - 1 - env->blk_off[j]) % (x1 - x0)] == 0.0f)
-      last--;
-    for (uint32_t i = env->blk_off[j]; i < k; i++)
-      env->blk_cdf[i] = acc > 0.0 && i + 1 < last ? (float)(env->blk_cdf[i] / acc) : 1.0f;
-    env->blk_sum[j] = (float)acc;
-    region_bound(0, env, (float)x0 / (float)W, (float)y0 / (float)H, (float)x1 / (float)W, (float)y1 / (float)H,
-                 &bc[j], &br[j]);
-  }
-  env->blk_off[nblk] = k;
-  iris_status st = IRIS_OK;
-  for (int b = 0; b < NB * NB && st == IRIS_OK; b++) {
-    int i = b % NB, jj = b / NB;
-    iris_vec3 nc;
-    double nr;
-    region_bound(1, env, (float)i / NB, (float)jj / NB, (float)(i + 1) / NB, (float)(jj + 1) / NB, &nc, &nr);
-    for (int j = 0; j < nblk; j++) {
-      double a = angle_between(nc, bc[j]) - nr - br[j];
-      w[j] = a >= 0.5 * IRIS_PI ? 0.0f : env->blk_sum[j] * (float)cos(fmax(a, 0.0));
-    }
-    st = iris_distrib1d_create(&env->bins[b], w, (size_t)nblk, err);
-  }
-  free(bc), free(br), free(w);
-  return st;
 }
 
 iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, iris_error *err) {
@@ -325,11 +209,6 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
     iris_envmap_destroy(out);
     return st;
   }
-  st = build_receiver_tables(out, map->path, err);
-  if (st != IRIS_OK) {
-    iris_envmap_destroy(out);
-    return st;
-  }
   /* integral over the sphere = 2 pi^2 sum A_r mean_r; mean = that / 4 pi */
   out->mean_luminance = acc[0] * 2.0 * IRIS_PI * IRIS_PI / (4.0 * IRIS_PI);
   for (int k = 0; k < 3; k++) out->mean_rgb[k] = (float)(acc[1 + k] * 2.0 * IRIS_PI * IRIS_PI / (4.0 * IRIS_PI));
@@ -409,73 +288,4 @@ float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d) {
   texel_of(env, s, t, &x, &y);
   float p = iris_distrib1d_pmf(&env->rows, (size_t)y) * iris_distrib1d_pmf(&env->cols[y], (size_t)x);
   return p * (float)env->width * (float)env->height / (2.0f * IRIS_PI * IRIS_PI * sin_t);
-}
-
-/* Mixture density of cell (x, y) for normal bin b (-1: the whole map only). */
-static float pdf_cell(const iris_envmap *env, int b, int x, int y, float sin_t) {
-  float p = iris_distrib1d_pmf(&env->rows, (size_t)y) * iris_distrib1d_pmf(&env->cols[y], (size_t)x);
-  if (b >= 0 && env->bins[b].total > 0.0) {
-    int j = (y / env->bh) * env->bcols + x / env->bw;
-    float q = env->blk_sum[j] > 0.0f
-                  ? iris_distrib1d_pmf(&env->bins[b], (size_t)j) * env->cols[y].func[x] / env->blk_sum[j]
-                  : 0.0f;
-    p = IRIS_ENVMAP_DEFENSIVE * p + (1.0f - IRIS_ENVMAP_DEFENSIVE) * q;
-  }
-  return p * (float)env->width * (float)env->height / (2.0f * IRIS_PI * IRIS_PI * sin_t);
-}
-
-static int bin_of(const iris_envmap *env, iris_vec3 n) {
-  if (!env->bins || !(iris_dot(n, n) > 0.25f)) return -1;
-  int b = normal_bin(n);
-  return env->bins[b].total > 0.0 ? b : -1;
-}
-
-bool iris_envmap_sample_at(const iris_envmap *env, iris_vec3 n, float u0, float u1, iris_vec3 *d, float *pdf) {
-  int b = bin_of(env, n);
-  if (b < 0) return iris_envmap_sample(env, u0, u1, d, pdf);
-  const float a = IRIS_ENVMAP_DEFENSIVE;
-  int x, y;
-  float ur, uc;
-  if (u0 < a) {
-    float pr, pc;
-    y = (int)iris_distrib1d_sample(&env->rows, fminf(u0 / a, 0x1.fffffep-1f), &pr, &ur);
-    x = (int)iris_distrib1d_sample(&env->cols[y], u1, &pc, &uc);
-    if (!(pr > 0.0f) || !(pc > 0.0f)) return false;
-  } else {
-    float pb;
-    size_t j = iris_distrib1d_sample(&env->bins[b], fminf((u0 - a) / (1.0f - a), 0x1.fffffep-1f), &pb, &ur);
-    if (!(pb > 0.0f)) return false;
-    /* the cell in the block: first inclusive CDF entry above u1 */
-    const float *cdf = &env->blk_cdf[env->blk_off[j]];
-    uint32_t lo = 0, hi = env->blk_off[j + 1] - env->blk_off[j] - 1;
-    while (lo < hi) {
-      uint32_t mid = (lo + hi) / 2;
-      if (cdf[mid] > u1) hi = mid;
-      else lo = mid + 1;
-    }
-    float c0 = lo ? cdf[lo - 1] : 0.0f, c1 = cdf[lo];
-    uc = c1 > c0 ? fminf((u1 - c0) / (c1 - c0), 0x1.fffffep-1f) : 0.5f;
-    int bx = (int)j % env->bcols, by = (int)j / env->bcols;
-    int x0 = bx * env->bw, y0 = by * env->bh;
-    int bwid = (x0 + env->bw < env->width ? env->bw : env->width - x0);
-    x = x0 + (int)lo % bwid;
-    y = y0 + (int)lo / bwid;
-    if (!(env->cols[y].func[x] > 0.0f)) return false;
-  }
-  float t = ((float)y + ur) / (float)env->height, s = ((float)x + uc) / (float)env->width;
-  float sin_t = sinf(t * IRIS_PI);
-  if (!(sin_t > 0.0f)) return false;
-  *d = iris_envmap_st_to_dir(env, s, t);
-  *pdf = pdf_cell(env, b, x, y, sin_t);
-  return isfinite(*pdf) && *pdf > 0.0f;
-}
-
-float iris_envmap_pdf_at(const iris_envmap *env, iris_vec3 n, iris_vec3 d) {
-  float s, t;
-  int x, y;
-  iris_envmap_dir_to_st(env, d, &s, &t);
-  float sin_t = sinf(t * IRIS_PI);
-  if (!(sin_t > 0.0f)) return 0.0f;
-  texel_of(env, s, t, &x, &y);
-  return pdf_cell(env, bin_of(env, n), x, y, sin_t);
 }

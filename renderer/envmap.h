@@ -11,7 +11,6 @@
 
 #include <stdbool.h>
 #include <stddef.h>
-#include <stdint.h>
 
 #include "core/error.h"
 #include "core/math.h"
@@ -30,23 +29,7 @@ typedef struct iris_envmap {
   iris_distrib1d *cols;   /* one conditional per row (height of them) */
   double mean_luminance;  /* (1 / 4pi) * integral of the luminance over the sphere */
   float mean_rgb[3];      /* the same per channel */
-  /* Receiver-aware sampling (iris_envmap_sample_at): the cells grouped in
-   * blocks of bw x bh, one distribution over the blocks per bin of receiver
-   * normals (IRIS_ENVMAP_NORMAL_BINS^2 octahedral bins), weighted by the
-   * block's weight times a bound on the cosine, and within a block the cells
-   * in proportion to their weights. NULL bins: plain sampling only. */
-  int bw, bh, bcols, brows;
-  uint32_t *blk_off;      /* bcols * brows + 1 offsets into blk_cdf */
-  float *blk_cdf;         /* per block, its cells' normalised inclusive CDF (row-major in the block) */
-  float *blk_sum;         /* per block, the sum of its cells' weights */
-  iris_distrib1d *bins;   /* per normal bin, over the blocks */
 } iris_envmap;
-
-/* Octahedral bins of receiver normals per side, and the share of samples that
- * iris_envmap_sample_at still draws from the whole map (defensive mixture:
- * the pdf stays positive wherever there is radiance, behind the receiver too). */
-#define IRIS_ENVMAP_NORMAL_BINS 8
-#define IRIS_ENVMAP_DEFENSIVE 0.2f
 
 /* Reads and checks the map (extension .exr or .hdr, or by the file's magic):
  * a missing, unreadable or empty file, one with NaN, Inf or negative texels,
@@ -72,16 +55,6 @@ iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d);
 bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf);
 /* Solid-angle density with which iris_envmap_sample returns d. */
 float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
-/* Sampling for a receiver with normal n (unit; the zero vector: none, then
- * exactly iris_envmap_sample): with probability 1 - IRIS_ENVMAP_DEFENSIVE a
- * block of cells in proportion to its weight times the largest cosine any
- * normal of n's bin can make with any of its directions (blocks wholly behind
- * the bin get none), then a cell in the block by weight; else the whole map.
- * *pdf is the mixture's solid-angle density. docs/rendering.md. */
-bool iris_envmap_sample_at(const iris_envmap *env, iris_vec3 n, float u0, float u1, iris_vec3 *d,
-                           float *pdf);
-/* Solid-angle density with which iris_envmap_sample_at(env, n, ...) returns d. */
-float iris_envmap_pdf_at(const iris_envmap *env, iris_vec3 n, iris_vec3 d);
 
 #ifdef __cplusplus
 }

@@ -211,14 +211,6 @@ static float power_heuristic(float pa, float pb) {
   return a / (a + b);
 }
 
-/* The normal on the side a reflecting BSDF gathers light from, for
- * receiver-aware environment sampling (iris_envmap_sample_at); zero (sample
- * the whole map) when the BSDF also transmits. */
-static iris_vec3 receiver_normal(const iris_shading_point *sp) {
-  if (sp->lobes & IRIS_LOBE_TRANSMISSION) return iris_v3(0, 0, 0);
-  return iris_dot(sp->si.ns, sp->wo) < 0.0f ? iris_neg(sp->si.ns) : sp->si.ns;
-}
-
 /* Direct light at a shading point by light sampling (NEE), MIS-weighted
  * against the path's direction sampler when `mis`. The light was chosen at
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
@@ -258,7 +250,6 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o;
-  iris_vec3 prev_n = iris_v3(0, 0, 0); /* the previous vertex's receiver normal (receiver_normal) */
   stats->paths++;
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -269,7 +260,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
         float w = 1.0f;
         if (!prev_delta && nee)
-          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment_at(it->lights, prev_p, prev_n, ray.d)) : 0.0f;
+          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, ray.d)) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
         if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }
@@ -280,7 +271,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the point is shaded. */
-    iris_light_choice choice = {0, 0.0f, {0.0f, 0.0f, 0.0f}};
+    iris_light_choice choice = {0, 0.0f};
     if (nee) iris_lights_choose(it->lights, si.p, iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
     iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
@@ -296,7 +287,6 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
     iris_integrator_prepare_direction(it, &sp);
-    choice.receiver = receiver_normal(&sp);
     if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, stats)));
 
     iris_direction_sample ds;
@@ -325,7 +315,6 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;
     prev_p = sp.si.p;
-    prev_n = choice.receiver;
     ray = iris_spawn_ray(&sp.si, ds.wi);
 
     /* Russian roulette (docs/rendering.md): survive with q = min(1, sqrt(max beta)),

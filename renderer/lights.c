@@ -510,7 +510,6 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select
                         iris_light_choice *c) {
   c->light = 0;
   c->pmf_group = 0.0f;
-  c->receiver = iris_v3(0, 0, 0);
   if (lights->count == 0) return;
   float coin = -1.0f;
   uint32_t slot = select_at(lights, ref, u_select, &c->pmf_group, &coin);
@@ -683,7 +682,7 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     default: {
       if (lights->envmap) {
         float pdf;
-        if (!iris_envmap_sample_at(lights->envmap, c->receiver, u0, u1, &s->wi, &pdf)) return false;
+        if (!iris_envmap_sample(lights->envmap, u0, u1, &s->wi, &pdf)) return false;
         s->L = iris_envmap_radiance(lights->envmap, s->wi);
         s->pdf = pmf * pdf;
       } else {
@@ -724,12 +723,8 @@ iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d) {
 }
 
 float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d) {
-  return iris_lights_pdf_environment_at(lights, ref, iris_v3(0, 0, 0), d);
-}
-
-float iris_lights_pdf_environment_at(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, iris_vec3 d) {
   if (lights->environment < 0) return 0.0f;
-  float pdf = lights->envmap ? iris_envmap_pdf_at(lights->envmap, n, iris_normalize(d))
+  float pdf = lights->envmap ? iris_envmap_pdf(lights->envmap, iris_normalize(d))
                              : iris_sample_uniform_sphere_pdf();
   return iris_lights_select_pmf_at(lights, ref, (uint32_t)lights->environment) * pdf;
 }

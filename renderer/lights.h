@@ -155,9 +155,6 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
 typedef struct iris_light_choice {
   uint32_t light;   /* entry index */
   float pmf_group;  /* probability of its group at ref; 0 = nothing to sample */
-  iris_vec3 receiver; /* normal on the reflecting side at ref, set by the caller after
-                         iris_lights_choose (which zeroes it) for receiver-aware
-                         environment sampling (iris_envmap_sample_at); zero = none */
 } iris_light_choice;
 void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select,
                         iris_light_choice *c);
@@ -194,8 +191,6 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
  * solid-angle pdf that iris_lights_sample, called at `ref`, returns d. */
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
 float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d);
-/* The same for a receiver with normal n (iris_light_choice.receiver; zero = none). */
-float iris_lights_pdf_environment_at(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, iris_vec3 d);
 
 /* ---- photon emission (guiding preprocess) ----------------------------- */
 

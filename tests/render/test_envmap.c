@@ -3,7 +3,6 @@
  *  - the documented texel of six axis directions (docs/format.md);
  *  - chi-square of iris_envmap_sample against iris_envmap_pdf on a map with a
  *    sharp bright block, a smooth gradient and black rows; the pdf integrates to 1;
- *    the same for receiver-aware sampling (iris_envmap_sample_at) at three normals;
  *  - chi-square of light sampling (iris_lights_sample) of a scene lit by the map
  *    against iris_lights_pdf_environment; photon emission's mean power equals
  *    the map's power through the scene's disk (pi r^2 x 4 pi x mean radiance);
@@ -62,29 +61,6 @@ static bool env_sample(void *ctx, const double u[3], double dir[3]) {
 }
 static double env_pdf(void *ctx, const double dir[3]) {
   return iris_envmap_pdf((const iris_envmap *)ctx, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
-}
-
-typedef struct rctx {
-  const iris_envmap *env;
-  iris_vec3 n;
-  long samples, mismatches;
-} rctx;
-static bool env_sample_at(void *vc, const double u[3], double dir[3]) {
-  rctx *c = (rctx *)vc;
-  iris_vec3 d;
-  float pdf;
-  if (!iris_envmap_sample_at(c->env, c->n, (float)u[0], (float)u[1], &d, &pdf)) return false;
-  /* the returned density is the one iris_envmap_pdf_at gives, except where the
-   * cell recomputed from d differs by rounding at its edge (counted) */
-  float q = iris_envmap_pdf_at(c->env, c->n, d);
-  c->samples++;
-  if (!(fabsf(pdf - q) <= 1e-3f * q)) c->mismatches++;
-  dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
-  return true;
-}
-static double env_pdf_at(void *vc, const double dir[3]) {
-  rctx *c = (rctx *)vc;
-  return iris_envmap_pdf_at(c->env, c->n, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
 }
 
 typedef struct lctx {
@@ -160,38 +136,6 @@ static void test_sampling(const char *path) {
   printf("envmap: p = %.3g, pdf integral %.5f, lost %zu\n", r.p_value, r.pdf_integral, r.lost);
   CHECK_NEAR(r.pdf_integral, 1.0, 2e-3);
   CHECK(r.lost == 0);
-  /* Receiver-aware sampling: chi-square against its pdf for normals up, down,
-   * sideways and oblique (bins with and without the sun); the pdf integrates to
-   * 1 over the sphere; it puts more of its samples above the receiver's
-   * horizon than plain sampling; the zero normal is plain sampling exactly. */
-  const iris_vec3 normals[3] = {iris_v3(0, 1, 0), iris_v3(0, -1, 0), iris_normalize(iris_v3(0.2f, -0.4f, -0.9f))};
-  for (int k = 0; k < 3; k++) {
-    rctx rc = {&env, normals[k], 0, 0};
-    chi2_result rr = chi2_run(&dom, env_sample_at, env_pdf_at, &rc, 200000, 0.01, 3 + 2);
-    iris_check_record(rr.passed, __FILE__, __LINE__, "envmap receiver sampling, normal %d: %s", k, rr.message);
-    printf("envmap at normal %d: p = %.3g, pdf integral %.5f, lost %zu\n", k, rr.p_value, rr.pdf_integral, rr.lost);
-    CHECK_NEAR(rr.pdf_integral, 1.0, 2e-3);
-    printf("  returned pdf != pdf_at in %ld of %ld samples\n", rc.mismatches, rc.samples);
-    CHECK(rc.mismatches <= rc.samples / 10000 + 2);
-    uint64_t hs = 17;
-    int above_at = 0, above_plain = 0;
-    for (int i = 0; i < 20000; i++) {
-      float a = (float)chi2_uniform(&hs), b = (float)chi2_uniform(&hs), pdf;
-      iris_vec3 d;
-      if (iris_envmap_sample_at(&env, normals[k], a, b, &d, &pdf) && iris_dot(d, normals[k]) > 0.0f) above_at++;
-      if (iris_envmap_sample(&env, a, b, &d, &pdf) && iris_dot(d, normals[k]) > 0.0f) above_plain++;
-    }
-    printf("  above the horizon: %d receiver-aware, %d plain of 20000\n", above_at, above_plain);
-    CHECK(above_at > above_plain);
-  }
-  for (int i = 0; i < 100; i++) {
-    uint64_t zs = 23 + (uint64_t)i;
-    float a = (float)chi2_uniform(&zs), b = (float)chi2_uniform(&zs), p0, p1;
-    iris_vec3 d0, d1;
-    bool ok0 = iris_envmap_sample(&env, a, b, &d0, &p0), ok1 = iris_envmap_sample_at(&env, iris_v3(0, 0, 0), a, b, &d1, &p1);
-    CHECK(ok0 == ok1 && (!ok0 || (d0.x == d1.x && d0.y == d1.y && d0.z == d1.z && p0 == p1)));
-  }
-
   /* the radiance is the map times the strength, interpolated bilinearly between
    * texel centres: s = 0.9 on 32 columns is 28.3 texels from the first centre
    * (0.7 of column 28, 0.3 of column 29); the map is constant down a column
