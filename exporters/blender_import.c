@@ -111,7 +111,7 @@ static const char *const IMPORT_PRELUDE[] = {
     "        print(\"iris-blender: error: Blender's glTF importer did not finish on %s\" % path, file=sys.stderr)",
     "        sys.exit(1)",
     "    inventory = describe_import(sc)",
-    "    build_world(sc, WORLD)",
+    "    build_world(sc, WORLD, gltf_axes=False)",
     "    build_camera(sc)",
     "    configure(sc, a)",
     "    if a.inventory:",

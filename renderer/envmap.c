@@ -109,6 +109,24 @@ void iris_envmap_destroy(iris_envmap *env) {
   memset(env, 0, sizeof *env);
 }
 
+/* Periodic index (Cycles' EXTENSION_REPEAT, which its Environment Texture uses on both axes). */
+static int wrap(int i, int n) {
+  i %= n;
+  return i < 0 ? i + n : i;
+}
+
+/* Integrals over t in [0, 1] of the (periodic) linear tent of row r times
+ * sin(pi t), per row: the bilinear map's luminance integrates over the sphere
+ * to 2 pi^2 sum_r A_r mean_x(L(x, r)) (each column tent integrates to 1/W, and
+ * dw = 2 pi^2 sin(pi t) ds dt). Exact: integral of (a + b t) sin(pi t). */
+static double tent_sin_integral(double t0, double t1, double a, double b) {
+  /* integral over [t0, t1] of (a + b t) sin(pi t) dt */
+  const double pi = IRIS_PI;
+  double F1 = -(a + b * t1) * cos(pi * t1) / pi + b * sin(pi * t1) / (pi * pi);
+  double F0 = -(a + b * t0) * cos(pi * t0) / pi + b * sin(pi * t0) / (pi * pi);
+  return F1 - F0;
+}
+
 iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   iris_status st = read_rgb(map->path, &out->rgb, &out->width, &out->height, err);
@@ -122,26 +140,43 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
   out->cols = calloc((size_t)H, sizeof *out->cols);
   float *w = malloc(sizeof(float) * (size_t)(W > H ? W : H));
   float *roww = malloc(sizeof(float) * (size_t)H);
-  if (!out->cols || !w || !roww) {
-    free(w), free(roww);
+  float *lum = malloc(sizeof(float) * n);
+  double *hrow = malloc(sizeof(double) * 3 * (size_t)W); /* one row blurred across, 3 rows kept */
+  double *rowmean = malloc(sizeof(double) * 4 * (size_t)H); /* per row: mean L (lum, r, g, b) */
+  if (!out->cols || !w || !roww || !lum || !hrow || !rowmean) {
+    free(w), free(roww), free(lum), free(hrow), free(rowmean);
     iris_envmap_destroy(out);
     return iris_error_set(err, IRIS_ERR_NOMEM, map->path, 0, NULL, "out of memory for the environment map");
   }
-  /* Texel (x, y) covers solid angle (2 pi / W) (cos theta0 - cos theta1): the
-   * means are exact integrals of the piecewise-constant map. Sampling weights
-   * use sin of the row centre (the density within a texel is uniform in (s, t)). */
-  double lum = 0.0, rgbsum[3] = {0, 0, 0};
+  for (size_t i = 0; i < n; i++) lum[i] = luminance3(&out->rgb[3 * i]);
   for (int y = 0; y < H; y++) {
-    double t0 = IRIS_PI * (double)y / H, t1 = IRIS_PI * (double)(y + 1) / H;
-    double omega = (2.0 * IRIS_PI / W) * (cos(t0) - cos(t1));
-    float sin_c = sinf(IRIS_PI * ((float)y + 0.5f) / (float)H);
-    double sum = 0.0;
+    double m[4] = {0, 0, 0, 0};
     for (int x = 0; x < W; x++) {
       const float *c = &out->rgb[3 * ((size_t)y * (size_t)W + (size_t)x)];
-      float l = luminance3(c);
-      lum += l * omega;
-      for (int k = 0; k < 3; k++) rgbsum[k] += c[k] * omega;
-      w[x] = l * sin_c;
+      m[0] += lum[(size_t)y * (size_t)W + (size_t)x];
+      for (int k = 0; k < 3; k++) m[1 + k] += c[k];
+    }
+    for (int k = 0; k < 4; k++) rowmean[4 * y + k] = m[k] / W;
+  }
+  /* The radiance is the bilinear interpolation of the texels (iris_envmap_radiance).
+   * A texel's cell [x, x+1) x [y, y+1) sees its own texel and its 8 neighbours
+   * (periodic in both axes, as the lookup); the integral of the interpolant over
+   * the cell is the texels blurred by (1/8, 3/4, 1/8) across and down. That is
+   * the cell's sampling weight (times sin of the row centre): positive wherever
+   * the interpolated radiance is, so map sampling reaches every direction that
+   * carries light, and the pdf stays exact per cell. */
+  for (int y = 0; y < H; y++) {
+    float sin_c = sinf(IRIS_PI * ((float)y + 0.5f) / (float)H);
+    for (int k = 0; k < 3; k++) {
+      const float *row = &lum[(size_t)wrap(y - 1 + k, H) * (size_t)W];
+      for (int x = 0; x < W; x++)
+        hrow[(size_t)k * (size_t)W + (size_t)x] =
+            0.125 * row[wrap(x - 1, W)] + 0.75 * row[x] + 0.125 * row[wrap(x + 1, W)];
+    }
+    double sum = 0.0;
+    for (int x = 0; x < W; x++) {
+      double b = 0.125 * hrow[x] + 0.75 * hrow[(size_t)W + (size_t)x] + 0.125 * hrow[2 * (size_t)W + (size_t)x];
+      w[x] = (float)b * sin_c;
       sum += w[x];
     }
     roww[y] = (float)sum;
@@ -149,13 +184,34 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
     if (st != IRIS_OK) break;
   }
   if (st == IRIS_OK) st = iris_distrib1d_create(&out->rows, roww, (size_t)H, err);
-  free(w), free(roww);
+  /* Means: the exact integral of the bilinear interpolant over the sphere. Row r's
+   * tent spans t in [(r - 1/2)/H, (r + 3/2)/H], periodic (the half rows at the
+   * poles blend the top and bottom rows, as Cycles' repeat extension does). */
+  double acc[4] = {0, 0, 0, 0};
+  for (int r = 0; r < H && st == IRIS_OK; r++) {
+    double c = (r + 0.5) / H, A = 0.0;
+    for (int side = 0; side < 2; side++) {
+      /* rising half [c - 1/H, c], falling half [c, c + 1/H]; tent = 1 - |t - c| H */
+      double lo = side ? c : c - 1.0 / H, hi = side ? c + 1.0 / H : c;
+      double a = side ? 1.0 + c * H : 1.0 - c * H, b = side ? -(double)H : (double)H;
+      /* the part outside [0, 1] wraps to the other pole: shift by +-1 */
+      double shifts[3] = {-1.0, 0.0, 1.0};
+      for (int k = 0; k < 3; k++) {
+        double sh = shifts[k];
+        double l0 = fmax(lo + sh, 0.0), l1 = fmin(hi + sh, 1.0);
+        if (l1 > l0) A += tent_sin_integral(l0, l1, a - b * sh, b);
+      }
+    }
+    for (int k = 0; k < 4; k++) acc[k] += A * rowmean[4 * r + k];
+  }
+  free(w), free(roww), free(lum), free(hrow), free(rowmean);
   if (st != IRIS_OK) {
     iris_envmap_destroy(out);
     return st;
   }
-  out->mean_luminance = lum / (4.0 * IRIS_PI);
-  for (int k = 0; k < 3; k++) out->mean_rgb[k] = (float)(rgbsum[k] / (4.0 * IRIS_PI));
+  /* integral over the sphere = 2 pi^2 sum A_r mean_r; mean = that / 4 pi */
+  out->mean_luminance = acc[0] * 2.0 * IRIS_PI * IRIS_PI / (4.0 * IRIS_PI);
+  for (int k = 0; k < 3; k++) out->mean_rgb[k] = (float)(acc[1 + k] * 2.0 * IRIS_PI * IRIS_PI / (4.0 * IRIS_PI));
   return IRIS_OK;
 }
 
@@ -184,13 +240,31 @@ static void texel_of(const iris_envmap *env, float s, float t, int *x, int *y) {
   *y = yi < 0 ? 0 : yi >= env->height ? env->height - 1 : yi;
 }
 
+/* Blender 3.4's Environment Texture, interpolation Linear (Cycles'
+ * kernel/device/cpu/image.h interp_linear with EXTENSION_REPEAT): texel
+ * centres at half-integers, so x = s W - 1/2 and y = t H - 1/2 (t counted from
+ * the top row; Cycles' v = 1 - t counts from the bottom, the same pairs and
+ * weights), the integer part floored, both neighbours wrapped periodically
+ * (across the seam in s, and across the poles in t: the top half row blends
+ * the top and the bottom rows, as Cycles does). */
 iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d) {
   float s, t;
-  int x, y;
   iris_envmap_dir_to_st(env, d, &s, &t);
-  texel_of(env, s, t, &x, &y);
-  const float *c = &env->rgb[3 * ((size_t)y * (size_t)env->width + (size_t)x)];
-  return iris_v3(c[0], c[1], c[2]);
+  const int W = env->width, H = env->height;
+  float fx = s * (float)W - 0.5f, fy = t * (float)H - 0.5f;
+  if (!isfinite(fx) || !isfinite(fy)) return iris_v3(0, 0, 0);
+  float flx = floorf(fx), fly = floorf(fy);
+  float tx = fx - flx, ty = fy - fly;
+  int x0 = wrap((int)flx, W), y0 = wrap((int)fly, H);
+  int x1 = x0 + 1 == W ? 0 : x0 + 1, y1 = y0 + 1 == H ? 0 : y0 + 1;
+  const float *c00 = &env->rgb[3 * ((size_t)y0 * (size_t)W + (size_t)x0)];
+  const float *c10 = &env->rgb[3 * ((size_t)y0 * (size_t)W + (size_t)x1)];
+  const float *c01 = &env->rgb[3 * ((size_t)y1 * (size_t)W + (size_t)x0)];
+  const float *c11 = &env->rgb[3 * ((size_t)y1 * (size_t)W + (size_t)x1)];
+  float w00 = (1.0f - ty) * (1.0f - tx), w10 = (1.0f - ty) * tx, w01 = ty * (1.0f - tx), w11 = ty * tx;
+  return iris_v3(w00 * c00[0] + w10 * c10[0] + w01 * c01[0] + w11 * c11[0],
+                 w00 * c00[1] + w10 * c10[1] + w01 * c01[1] + w11 * c11[1],
+                 w00 * c00[2] + w10 * c10[2] + w01 * c01[2] + w11 * c11[2]);
 }
 
 bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf) {

@@ -1,11 +1,11 @@
 /* Equirectangular environment maps: the decoded, validated texels of an
- * OpenEXR or Radiance .hdr map (times its strength), the direction <-> texel
- * mapping that matches Blender's Environment Texture for glTF scenes, and
- * importance sampling of directions in proportion to luminance x sin(theta)
- * (a marginal CDF over rows and one conditional CDF per row; piecewise
- * constant, so the per-texel pdf in solid angle is exact). Lookups are
- * nearest-texel ("Closest" in Blender), which keeps the sampled density and
- * the radiance on the same texels. docs/format.md and docs/rendering.md. */
+ * OpenEXR or Radiance .hdr map (times its strength), the direction <-> (s, t)
+ * mapping and the bilinear lookup of Blender 3.4's Environment Texture
+ * (interpolation Linear, default mapping) for glTF scenes, and importance
+ * sampling of directions in proportion to the interpolated luminance
+ * integrated over each texel's cell x sin(theta) (a marginal CDF over rows and
+ * one conditional CDF per row; piecewise constant, so the pdf in solid angle
+ * is exact per cell). docs/format.md and docs/rendering.md. */
 #ifndef IRIS_RENDERER_ENVMAP_H
 #define IRIS_RENDERER_ENVMAP_H
 
@@ -46,7 +46,9 @@ void iris_envmap_dir_to_st(const iris_envmap *env, iris_vec3 d, float *s, float 
 /* Unit direction of map coordinates (s, t). */
 iris_vec3 iris_envmap_st_to_dir(const iris_envmap *env, float s, float t);
 
-/* Radiance arriving from direction d (unit; travelling towards -d). */
+/* Radiance arriving from direction d (unit; travelling towards -d): the
+ * bilinear interpolation of the four texels around (s, t), texel centres at
+ * half-integers, wrapped periodically on both axes (Cycles' repeat). */
 iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d);
 /* Samples a direction with two uniform numbers; returns false when nothing
  * can be sampled. *pdf is the solid-angle density. */

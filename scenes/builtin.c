@@ -15,7 +15,7 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     "stress-thin-walls", "stress-small-dim", "stress-closed-box",
                                     "stress-firefly", "stress-glossy-room",
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
-                                    "env-objects", "sky-room", NULL};
+                                    "env-objects", "env-spheres", "sky-room", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -323,6 +323,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = build_furnace(s, IRIS_MATERIAL_GLOSSY);
   else if (strcmp(name, "env-objects") == 0)
     st = iris_sky_objects_build(s);
+  else if (strcmp(name, "env-spheres") == 0)
+    st = iris_sky_spheres_build(s);
   else if (strcmp(name, "sky-room") == 0)
     st = iris_sky_room_build(s);
   else if (iris_stress_find(name))

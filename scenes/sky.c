@@ -52,6 +52,31 @@ iris_status iris_sky_objects_build(iris_scene *s) {
   return IRIS_OK;
 }
 
+/* Four spheres on a wide ground under the open sky, the camera seeing the
+ * horizon and the sky above it: a diffuse one and three metals (glossy) of
+ * rising roughness 0.05, 0.2 and 0.5, lit from the front right by the map's
+ * sun (the environment benchmark of docs/benchmarks.md: sun, sharp and rough
+ * metal, diffuse, sky seen directly). */
+iris_status iris_sky_spheres_build(iris_scene *s) {
+  int32_t ground = material(s, "ground", IRIS_MATERIAL_DIFFUSE, 0.5f, 0.5f, 0.5f, 0.0f);
+  int32_t matte = material(s, "matte", IRIS_MATERIAL_DIFFUSE, 0.8f, 0.8f, 0.8f, 0.0f);
+  int32_t m1 = material(s, "metal-0.05", IRIS_MATERIAL_GLOSSY, 0.95f, 0.9f, 0.8f, 0.05f);
+  int32_t m2 = material(s, "metal-0.2", IRIS_MATERIAL_GLOSSY, 0.95f, 0.9f, 0.8f, 0.2f);
+  int32_t m3 = material(s, "metal-0.5", IRIS_MATERIAL_GLOSSY, 0.95f, 0.9f, 0.8f, 0.5f);
+  if (ground < 0 || matte < 0 || m1 < 0 || m2 < 0 || m3 < 0) return IRIS_ERR_NOMEM;
+  bool ok = iris_builtin_add_quad(s, iris_v3(0, 0, 0), iris_v3(0, 0, 10), iris_v3(10, 0, 0), 1, ground, "ground") >= 0;
+  ok = ok && iris_builtin_add_sphere(s, iris_v3(-2.1f, 0.6f, 0), 0.6f, 64, matte, "matte") >= 0;
+  ok = ok && iris_builtin_add_sphere(s, iris_v3(-0.7f, 0.6f, 0), 0.6f, 64, m1, "metal-0.05") >= 0;
+  ok = ok && iris_builtin_add_sphere(s, iris_v3(0.7f, 0.6f, 0), 0.6f, 64, m2, "metal-0.2") >= 0;
+  ok = ok && iris_builtin_add_sphere(s, iris_v3(2.1f, 0.6f, 0), 0.6f, 64, m3, "metal-0.5") >= 0;
+  ok = ok && camera(s, iris_v3(0, 1.4f, 6.5f), iris_v3(0, 0.7f, 0), 35.0f, 1.5f);
+  ok = ok && iris_scene_set_environment_map(s, IRIS_SKY_MAP, 1.0f, 0.0f);
+  if (!ok) return IRIS_ERR_NOMEM;
+  s->render.width = 384;
+  s->render.height = 256;
+  return IRIS_OK;
+}
+
 /* A 4 x 2.5 x 4 m room; the window (1.2 x 1 m) in the +x wall faces the
  * map's sun (direction (0.66, 0.58, 0.48) at rotation 0), which falls through
  * it onto the floor; the camera in a corner by the window looks into the room

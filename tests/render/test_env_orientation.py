@@ -115,7 +115,7 @@ sc.camera = [o for o in sc.objects if o.type == "CAMERA"][0]
 w = bpy.data.worlds.new("w"); sc.world = w; w.use_nodes = True
 nt = w.node_tree; bg = nt.nodes["Background"]
 env = nt.nodes.new("ShaderNodeTexEnvironment")
-env.image = bpy.data.images.load(hdr); env.interpolation = "Closest"
+env.image = bpy.data.images.load(hdr); env.interpolation = "Linear"
 mp = nt.nodes.new("ShaderNodeMapping"); mp.vector_type = "POINT"
 mp.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(float(rot)))
 tc = nt.nodes.new("ShaderNodeTexCoord")
