@@ -27,6 +27,8 @@ typedef struct accel_instance {
   iris_mat4 xf;      /* object to world */
   float nm[3][3];    /* normal matrix (cofactor form, sign kept for mirrors) */
   bool mirrored;     /* det < 0: object-space CCW is world-space CW */
+  float tscale;      /* 1 / cbrt |det|: tangents keep their object-space length under a
+                        uniform scale, so a normal map's strength does not grow with it */
   uint32_t first_prim;
   const iris_material *alpha_material; /* MASK/BLEND material, else NULL (no filter) */
 } accel_instance;
@@ -311,7 +313,10 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
       return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL,
                             "more than 2^32 triangles in the world (over all instances)");
     }
-    ai->mirrored = iris_mat4_det3(&inst->transform) < 0.0f;
+    float det = iris_mat4_det3(&inst->transform);
+    ai->mirrored = det < 0.0f;
+    ai->tscale = 1.0f / cbrtf(fabsf(det));
+    if (!(ai->tscale > 0.0f) || !isfinite(ai->tscale)) ai->tscale = 1.0f;
     iris_mat4 nm = iris_mat4_normal_matrix(&inst->transform);
     for (int r = 0; r < 3; r++)
       for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c];
@@ -555,8 +560,9 @@ static void fill_interaction(const iris_accel *a, size_t inst, uint32_t local, f
       iris_vec3 bw = iris_v3(m3[0][0] * bo.x + m3[0][1] * bo.y + m3[0][2] * bo.z,
                              m3[1][0] * bo.x + m3[1][1] * bo.y + m3[1][2] * bo.z,
                              m3[2][0] * bo.x + m3[2][1] * bo.y + m3[2][2] * bo.z);
-      si->tangent = flipped ? iris_neg(tw) : tw;
-      si->bitangent = flipped ? iris_neg(bw) : bw;
+      float ts = flipped ? -ai->tscale : ai->tscale;
+      si->tangent = iris_scale(tw, ts);
+      si->bitangent = iris_scale(bw, ts);
     }
   } else {
     si->ns = ng;

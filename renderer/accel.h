@@ -51,8 +51,10 @@ typedef struct iris_interaction {
   uint32_t instance; /* scene instance */
   bool front;        /* the ray arrived on the front side (dot(d, ng) < 0) */
   bool has_tangent;  /* the mesh has tangents: the two vectors below are set */
-  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed),
-                                   interpolated, not normalised; flipped with ns */
+  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed,
+                                   divided by the cube root of the placement's |det| so a
+                                   uniform scale leaves their length), interpolated, not
+                                   normalised; flipped with ns */
 } iris_interaction;
 
 typedef struct iris_accel iris_accel;
