@@ -23,6 +23,7 @@
  * scene instance index in both cases. */
 typedef struct accel_instance {
   const iris_mesh *mesh;
+  uint32_t mesh_index;
   float *positions;  /* world space, 3 * vertex_count (+ padding), or NULL when instanced */
   iris_mat4 xf;      /* object to world */
   float nm[3][3];    /* normal matrix (cofactor form, sign kept for mirrors) */
@@ -38,6 +39,7 @@ typedef struct accel_mesh {
   RTCScene rtc;      /* NULL unless placed two or more times */
   float *positions;  /* object-space copy with Embree's padding */
   uint32_t placements;
+  float box[6];      /* object-space bounds (lo, hi), for placements >= 2 */
 } accel_mesh;
 
 struct iris_accel {
@@ -249,22 +251,128 @@ typedef struct bounds_job {
   float (*box)[6];
 } bounds_job;
 
+/* iris_mat4_point for an affine transform, inline: the same products and
+ * sums in the same order (C11 does not contract them), so the same floats. */
+static inline iris_vec3 affine_point(const iris_mat4 *a, const float *p) {
+  return iris_v3(a->m[0][0] * p[0] + a->m[0][1] * p[1] + a->m[0][2] * p[2] + a->m[0][3],
+                 a->m[1][0] * p[0] + a->m[1][1] * p[1] + a->m[1][2] * p[2] + a->m[1][3],
+                 a->m[2][0] * p[0] + a->m[2][1] * p[1] + a->m[2][2] * p[2] + a->m[2][3]);
+}
+
+static bool is_affine(const iris_mat4 *m) {
+  return m->m[3][0] == 0.0f && m->m[3][1] == 0.0f && m->m[3][2] == 0.0f && m->m[3][3] == 1.0f;
+}
+
+/* The exact world box of placement i (its vertices through its transform),
+ * storing the world-space copy of a flattened one on the way. */
+static void exact_box(accel_instance *ai, float b[6]) {
+  const iris_mesh *mesh = ai->mesh;
+  float lo[3] = {FLT_MAX, FLT_MAX, FLT_MAX}, hi[3] = {-FLT_MAX, -FLT_MAX, -FLT_MAX};
+  const bool affine = is_affine(&ai->xf);
+  for (uint32_t v = 0; v < mesh->vertex_count; v++) {
+    const float *src = mesh->positions + 3 * (size_t)v;
+    iris_vec3 q = affine ? affine_point(&ai->xf, src) : iris_mat4_point(&ai->xf, iris_v3_load(src));
+    if (ai->positions) iris_v3_store(q, ai->positions + 3 * (size_t)v);
+    /* plain comparisons: fminf is a libm call here */
+    lo[0] = q.x < lo[0] ? q.x : lo[0], hi[0] = q.x > hi[0] ? q.x : hi[0];
+    lo[1] = q.y < lo[1] ? q.y : lo[1], hi[1] = q.y > hi[1] ? q.y : hi[1];
+    lo[2] = q.z < lo[2] ? q.z : lo[2], hi[2] = q.z > hi[2] ? q.z : hi[2];
+  }
+  b[0] = lo[0], b[1] = lo[1], b[2] = lo[2], b[3] = hi[0], b[4] = hi[1], b[5] = hi[2];
+}
+
+/* Flattened placements: the exact box (and the world-space copy). Instanced
+ * ones: the 8 transformed corners of the mesh's object box, a box that
+ * contains the exact one (refined where it matters by world_bounds). */
 static void bounds_body(void *ctx, uint64_t begin, uint64_t end, int thread) {
   (void)thread;
   bounds_job *job = (bounds_job *)ctx;
   for (uint64_t i = begin; i < end; i++) {
     accel_instance *ai = &job->a->instances[i];
-    const iris_mesh *mesh = ai->mesh;
-    iris_vec3 lo = iris_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = iris_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
-    for (uint32_t v = 0; v < mesh->vertex_count; v++) {
-      iris_vec3 p = iris_mat4_point(&ai->xf, iris_v3_load(mesh->positions + 3 * (size_t)v));
-      if (ai->positions) iris_v3_store(p, ai->positions + 3 * (size_t)v);
-      lo = iris_v3(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
-      hi = iris_v3(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
-    }
     float *b = job->box[i];
-    b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
+    if (ai->positions || ai->mesh->vertex_count == 0) {
+      exact_box(ai, b);
+      continue;
+    }
+    const float *ob = job->a->meshes[ai->mesh_index].box;
+    b[0] = b[1] = b[2] = FLT_MAX, b[3] = b[4] = b[5] = -FLT_MAX;
+    for (int c = 0; c < 8; c++) {
+      float p[3] = {ob[c & 1 ? 3 : 0], ob[c & 2 ? 4 : 1], ob[c & 4 ? 5 : 2]};
+      iris_vec3 q = affine_point(&ai->xf, p);
+      float v[3] = {q.x, q.y, q.z};
+      for (int k = 0; k < 3; k++) {
+        /* one float step outwards: the corners' rounding must not cut a vertex off */
+        b[k] = fminf(b[k], nextafterf(v[k], -INFINITY));
+        b[3 + k] = fmaxf(b[3 + k], nextafterf(v[k], INFINITY));
+      }
+    }
   }
+}
+
+typedef struct side_key {
+  float value;
+  uint32_t index;
+} side_key;
+
+static int side_key_cmp(const void *pa, const void *pb) {
+  const side_key *x = (const side_key *)pa, *y = (const side_key *)pb;
+  if (x->value != y->value) return x->value < y->value ? -1 : 1;
+  return x->index < y->index ? -1 : x->index > y->index;
+}
+
+/* Exact world bounds without transforming every vertex of every placement:
+ * per side of the box, instanced placements in the order of their corner
+ * boxes, made exact one by one until no remaining corner box can beat the
+ * best exact value (branch and bound; in a forest only the placements along
+ * the edges are visited). n log n in the placements. */
+static bool world_bounds(iris_accel *a, float (*box)[6], iris_vec3 *out_lo, iris_vec3 *out_hi, bool *out_any) {
+  size_t n = a->instance_count, m = 0;
+  float best[6] = {FLT_MAX, FLT_MAX, FLT_MAX, -FLT_MAX, -FLT_MAX, -FLT_MAX};
+  bool any = false;
+  for (size_t i = 0; i < n; i++) {
+    if (a->instances[i].mesh->vertex_count == 0) continue;
+    any = true;
+    if (!a->instances[i].positions) {
+      m++;
+      continue;
+    }
+    for (int k = 0; k < 3; k++) {
+      best[k] = fminf(best[k], box[i][k]);
+      best[3 + k] = fmaxf(best[3 + k], box[i][3 + k]);
+    }
+  }
+  if (m > 0) {
+    side_key *keys = malloc(m * sizeof *keys);
+    bool *exact = calloc(n, sizeof *exact);
+    if (!keys || !exact) {
+      free(keys);
+      free(exact);
+      return false; /* out of memory */
+    }
+    for (int side = 0; side < 6; side++) {
+      const bool low = side < 3;
+      size_t j = 0;
+      for (size_t i = 0; i < n; i++)
+        if (!a->instances[i].positions && a->instances[i].mesh->vertex_count > 0)
+          keys[j].value = low ? box[i][side] : -box[i][side], keys[j++].index = (uint32_t)i;
+      qsort(keys, m, sizeof *keys, side_key_cmp);
+      for (j = 0; j < m; j++) {
+        uint32_t i = keys[j].index;
+        if (!exact[i] && (low ? box[i][side] >= best[side] : box[i][side] <= best[side])) break;
+        if (!exact[i]) {
+          exact_box(&a->instances[i], box[i]);
+          exact[i] = true;
+        }
+        best[side] = low ? fminf(best[side], box[i][side]) : fmaxf(best[side], box[i][side]);
+      }
+    }
+    free(keys);
+    free(exact);
+  }
+  *out_lo = iris_v3(best[0], best[1], best[2]);
+  *out_hi = iris_v3(best[3], best[4], best[5]);
+  *out_any = any;
+  return true;
 }
 
 iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err) {
@@ -295,9 +403,12 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   a->meshes = calloc(scene->mesh_count ? scene->mesh_count : 1, sizeof *a->meshes);
   if (!a->instances || !a->meshes) return nomem(a, err, "the instance table");
   a->own_bytes = sizeof *a + a->instance_count * sizeof *a->instances + a->mesh_count * sizeof *a->meshes;
+  /* Embree instances take affine transforms: a projective one (never from
+   * the importers) is flattened, counting as a placement of its own. */
   for (size_t i = 0; i < scene->instance_count; i++) {
     const iris_mesh *mesh = &scene->meshes[scene->instances[i].mesh];
-    if (mesh->triangle_count > 0) a->meshes[scene->instances[i].mesh].placements++;
+    if (mesh->triangle_count > 0 && is_affine(&scene->instances[i].transform))
+      a->meshes[scene->instances[i].mesh].placements++;
   }
   uint64_t prims = 0;
   for (size_t i = 0; i < scene->instance_count; i++) {
@@ -305,6 +416,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     const iris_mesh *mesh = &scene->meshes[inst->mesh];
     accel_instance *ai = &a->instances[i];
     ai->mesh = mesh;
+    ai->mesh_index = inst->mesh;
     ai->xf = inst->transform;
     ai->first_prim = (uint32_t)prims;
     prims += mesh->triangle_count;
@@ -321,7 +433,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     for (int r = 0; r < 3; r++)
       for (int c = 0; c < 3; c++) ai->nm[r][c] = nm.m[r][c];
     if (has_alpha(scene, mesh)) ai->alpha_material = &scene->materials[mesh->material];
-    if (a->meshes[inst->mesh].placements == 1) {
+    if (a->meshes[inst->mesh].placements <= 1 || !is_affine(&inst->transform)) {
       ai->positions = padded_positions(NULL, mesh->vertex_count, &a->own_bytes);
       if (!ai->positions) {
         char label[128];
@@ -333,17 +445,26 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   }
   a->triangle_count = (uint32_t)prims;
 
+  for (size_t k = 0; k < a->mesh_count; k++) { /* object boxes of the instanced meshes */
+    accel_mesh *am = &a->meshes[k];
+    const iris_mesh *mesh = &scene->meshes[k];
+    if (am->placements < 2) continue;
+    float *b = am->box;
+    b[0] = b[1] = b[2] = FLT_MAX, b[3] = b[4] = b[5] = -FLT_MAX;
+    for (uint32_t v = 0; v < mesh->vertex_count; v++)
+      for (int c = 0; c < 3; c++) {
+        float x = mesh->positions[3 * (size_t)v + c];
+        b[c] = x < b[c] ? x : b[c], b[3 + c] = x > b[3 + c] ? x : b[3 + c];
+      }
+  }
   float(*box)[6] = malloc(sizeof *box * (a->instance_count ? a->instance_count : 1));
   if (!box) return nomem(a, err, "the instance bounds");
   bounds_job job = {a, box};
   iris_parallel_for(a->instance_count, 64, 0, bounds_body, &job);
-  iris_vec3 lo = iris_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = iris_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
-  for (size_t i = 0; i < a->instance_count; i++) {
-    if (a->instances[i].mesh->vertex_count == 0) continue;
-    lo = iris_v3(fminf(lo.x, box[i][0]), fminf(lo.y, box[i][1]), fminf(lo.z, box[i][2]));
-    hi = iris_v3(fmaxf(hi.x, box[i][3]), fmaxf(hi.y, box[i][4]), fmaxf(hi.z, box[i][5]));
-  }
+  iris_vec3 lo, hi;
+  bool any_vertex = false, bounds_ok = world_bounds(a, box, &lo, &hi, &any_vertex);
   free(box);
+  if (!bounds_ok) return nomem(a, err, "the instance bounds");
 
   char label[128];
   for (size_t i = 0; i < scene->instance_count; i++) {
@@ -353,7 +474,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     accel_mesh *am = &a->meshes[inst->mesh];
     if (mesh->triangle_count == 0) continue;
     RTCGeometry g;
-    if (am->placements == 1) {
+    if (ai->positions) {
       snprintf(a->building, sizeof a->building, "the BVH of %s",
                mesh_label(scene, inst->mesh, label, sizeof label));
       g = triangle_geometry(a, mesh, ai->positions);
@@ -509,10 +630,10 @@ static inline void world_vertex(const accel_instance *ai, const uint32_t *idx, i
     *p1 = iris_v3_load(ai->positions + 3 * (size_t)idx[1]);
     *p2 = iris_v3_load(ai->positions + 3 * (size_t)idx[2]);
   } else {
-    const float *p = ai->mesh->positions;
-    *p0 = iris_mat4_point(&ai->xf, iris_v3_load(p + 3 * (size_t)idx[0]));
-    *p1 = iris_mat4_point(&ai->xf, iris_v3_load(p + 3 * (size_t)idx[1]));
-    *p2 = iris_mat4_point(&ai->xf, iris_v3_load(p + 3 * (size_t)idx[2]));
+    const float *p = ai->mesh->positions; /* instanced placements are affine */
+    *p0 = affine_point(&ai->xf, p + 3 * (size_t)idx[0]);
+    *p1 = affine_point(&ai->xf, p + 3 * (size_t)idx[1]);
+    *p2 = affine_point(&ai->xf, p + 3 * (size_t)idx[2]);
   }
 }
 

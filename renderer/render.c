@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "core/image.h"
+#include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "renderer/merge.h"
@@ -132,6 +133,14 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   void *guide_state = NULL;
   iris_path_stats *stats = NULL;
   st = iris_accel_build(scene, &accel, err);
+  if (st == IRIS_OK) {
+    size_t unique = 0, placed = 0;
+    iris_accel_stats(accel, &unique, &placed);
+    iris_infof("accel: %u triangles in the world; %zu meshes built once for %zu instanced placements, "
+               "%zu placements flattened; BVH %.1f MB (Embree), vertex copies and tables %.1f MB",
+               iris_accel_triangle_count(accel), unique, placed, scene->instance_count - placed,
+               (double)iris_accel_embree_bytes(accel) / 1e6, (double)iris_accel_memory_bytes(accel) / 1e6);
+  }
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
   if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
