@@ -9,6 +9,7 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/memory.h"
 #include "renderer/merge.h"
 
 #define TILE 8
@@ -124,6 +125,18 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
+  }
+  {
+    /* what the render will need against what the machine has, before any of
+     * it is built (docs/performance.md, "Memory estimate") */
+    iris_memory_estimate est;
+    iris_memory_estimate_scene(scene, b.x1 - b.x0, b.y1 - b.y0,
+                               p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method), &est);
+    char line[400];
+    iris_memory_format(&est, line, sizeof line);
+    iris_infof("memory: %s", line);
+    st = iris_memory_check(&est, scene->source_path ? scene->source_path : "scene", err);
+    if (st != IRIS_OK) return st;
   }
   iris_accel *accel = NULL;
   iris_textures textures;
