@@ -126,15 +126,15 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
   }
+  /* What the render will need against what the machine has, before any of it
+   * is built (docs/performance.md, "Memory estimate"). Logged (with the
+   * accel's line) only once the set-up succeeded: bad input stays one line. */
+  char mem_line[400], accel_line[300] = "";
   {
-    /* what the render will need against what the machine has, before any of
-     * it is built (docs/performance.md, "Memory estimate") */
     iris_memory_estimate est;
     iris_memory_estimate_scene(scene, b.x1 - b.x0, b.y1 - b.y0,
                                p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method), &est);
-    char line[400];
-    iris_memory_format(&est, line, sizeof line);
-    iris_infof("memory: %s", line);
+    iris_memory_format(&est, mem_line, sizeof mem_line);
     st = iris_memory_check(&est, scene->source_path ? scene->source_path : "scene", err);
     if (st != IRIS_OK) return st;
   }
@@ -149,10 +149,11 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   if (st == IRIS_OK) {
     size_t unique = 0, placed = 0;
     iris_accel_stats(accel, &unique, &placed);
-    iris_infof("accel: %u triangles in the world; %zu meshes built once for %zu instanced placements, "
-               "%zu placements flattened; BVH %.1f MB (Embree), vertex copies and tables %.1f MB",
-               iris_accel_triangle_count(accel), unique, placed, scene->instance_count - placed,
-               (double)iris_accel_embree_bytes(accel) / 1e6, (double)iris_accel_memory_bytes(accel) / 1e6);
+    snprintf(accel_line, sizeof accel_line,
+             "accel: %u triangles in the world; %zu meshes built once for %zu instanced placements, "
+             "%zu placements flattened; BVH %.1f MB (Embree), vertex copies and tables %.1f MB",
+             iris_accel_triangle_count(accel), unique, placed, scene->instance_count - placed,
+             (double)iris_accel_embree_bytes(accel) / 1e6, (double)iris_accel_memory_bytes(accel) / 1e6);
   }
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
   if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
@@ -188,6 +189,10 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
       if (guide_state && p.guide->destroy) p.guide->destroy(guide_state);
       guide_state = NULL;
     }
+  }
+  if (st == IRIS_OK) {
+    iris_infof("memory: %s", mem_line);
+    iris_infof("%s", accel_line);
   }
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
   if (st == IRIS_OK) {
