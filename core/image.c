@@ -812,3 +812,18 @@ void iris_ldr_destroy(iris_ldr_image *img) {
   stbi_image_free(img->rgba);
   memset(img, 0, sizeof *img);
 }
+
+bool iris_image_dims(const char *path, const void *data, size_t size, int *w, int *h) {
+  int n = 0;
+  *w = *h = 0;
+  if (data) {
+    if (size > (size_t)INT32_MAX) return false;
+    return stbi_info_from_memory((const stbi_uc *)data, (int)size, w, h, &n) && *w > 0 && *h > 0;
+  }
+  if (!path) return false;
+  FILE *fp = fopen(path, "rb");
+  if (!fp) return false;
+  bool ok = stbi_info_from_file(fp, w, h, &n) && *w > 0 && *h > 0;
+  fclose(fp);
+  return ok;
+}

@@ -4,6 +4,7 @@
 #ifndef IRIS_CORE_IMAGE_H
 #define IRIS_CORE_IMAGE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -65,6 +66,10 @@ iris_status iris_ldr_load_file(const char *path, iris_ldr_image *out, iris_error
 iris_status iris_ldr_load_memory(const void *data, size_t size, const char *what,
                                  iris_ldr_image *out, iris_error *err);
 void iris_ldr_destroy(iris_ldr_image *img);
+/* Width and height from an image's header without decoding it (PNG, JPEG,
+ * Radiance .hdr; from `data` when not NULL, else from the file at `path`):
+ * false when the header cannot be read. Used for memory estimates only. */
+bool iris_image_dims(const char *path, const void *data, size_t size, int *w, int *h);
 
 /* sRGB <-> linear transfer functions (IEC 61966-2-1). */
 float iris_srgb_to_linear(float v);

@@ -393,6 +393,25 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
                     ? v.Get("light").GetNumberAsInt()
                     : INT_MIN;
     }
+    o.inst_translation = o.inst_rotation = o.inst_scale = -1;
+    auto gi = n.extensions.find("EXT_mesh_gpu_instancing");
+    if (gi != n.extensions.end()) {
+      o.gpu_instancing = true;
+      const tinygltf::Value &v = gi->second;
+      if (!v.IsObject() || !v.Has("attributes") || !v.Get("attributes").IsObject()) {
+        o.gpu_instancing_bad = true;
+      } else {
+        const tinygltf::Value &a = v.Get("attributes");
+        // A present but malformed reference becomes INT_MIN: rejected as out of range.
+        auto ref = [&a](const char *key) {
+          if (!a.Has(key)) return -1;
+          return a.Get(key).IsNumber() ? a.Get(key).GetNumberAsInt() : INT_MIN;
+        };
+        o.inst_translation = ref("TRANSLATION");
+        o.inst_rotation = ref("ROTATION");
+        o.inst_scale = ref("SCALE");
+      }
+    }
     o.children = n.children.data();
     o.child_count = n.children.size();
     o.matrix = n.matrix.data();

@@ -29,7 +29,7 @@ static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit"};
+    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit", "EXT_mesh_gpu_instancing"};
 
 /* ---- small helpers ------------------------------------------------------ */
 
@@ -983,6 +983,95 @@ static iris_status add_instance_prims(gltf_ctx *c, int mesh, const dmat4 *world)
   return IRIS_OK;
 }
 
+/* One EXT_mesh_gpu_instancing attribute: accessor `ai` (-1: absent, then
+ * `fallback` for every instance) read as `count` x ncomp floats into out.
+ * Float, or for ROTATION normalized signed byte/short (the extension's
+ * types); every value finite. */
+static iris_status read_instance_attribute(gltf_ctx *c, size_t node, const char *name, int ai, int ncomp,
+                                           bool rotation, size_t count, const float *fallback, float *out) {
+  char el[64];
+  ELEMENT(el, "node %zu EXT_mesh_gpu_instancing %s", node, name);
+  if (ai == -1) {
+    for (size_t i = 0; i < count; i++) memcpy(out + i * (size_t)ncomp, fallback, (size_t)ncomp * sizeof(float));
+    return IRIS_OK;
+  }
+  const iris_gltf_doc *d = c->doc;
+  if (ai < 0 || (size_t)ai >= d->accessor_count)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "accessor %d does not exist (%zu accessors)", ai, d->accessor_count);
+  const iris_gltf_accessor *a = &d->accessors[ai];
+  if (a->type != ncomp)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "accessor %d must be VEC%d", ai, ncomp);
+  bool ok = a->component_type == 5126 ||
+            (rotation && a->normalized && (a->component_type == 5120 || a->component_type == 5122));
+  if (!ok)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "accessor %d has componentType %d (%s)", ai, a->component_type,
+                     rotation ? "float or normalized byte/short" : "float");
+  if (a->count != count)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "accessor %d has %zu elements, the other attributes %zu", ai,
+                     a->count, count);
+  read_floats(d, a, ncomp, out);
+  for (size_t i = 0; i < count * (size_t)ncomp; i++)
+    if (!isfinite(out[i]))
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "instance %zu has a non-finite value", i / (size_t)ncomp);
+  return IRIS_OK;
+}
+
+/* The node's mesh placed once per EXT_mesh_gpu_instancing instance:
+ * world = node world x T(translation) R(rotation) S(scale). */
+static iris_status add_gpu_instances(gltf_ctx *c, size_t node, const dmat4 *world) {
+  const iris_gltf_node *n = &c->doc->nodes[node];
+  char el[64];
+  ELEMENT(el, "node %zu EXT_mesh_gpu_instancing", node);
+  if (n->gpu_instancing_bad)
+    return gltf_fail(c, IRIS_ERR_INVALID, el, "is not an object with an \"attributes\" object");
+  int refs[3] = {n->inst_translation, n->inst_rotation, n->inst_scale};
+  size_t count = 0;
+  bool any = false;
+  for (int k = 0; k < 3; k++) {
+    if (refs[k] == -1) continue;
+    if (refs[k] < 0 || (size_t)refs[k] >= c->doc->accessor_count)
+      return gltf_fail(c, IRIS_ERR_INVALID, el, "%s accessor %d does not exist (%zu accessors)",
+                       k == 0 ? "TRANSLATION" : k == 1 ? "ROTATION" : "SCALE", refs[k], c->doc->accessor_count);
+    if (!any) count = c->doc->accessors[refs[k]].count, any = true;
+  }
+  if (!any) return gltf_fail(c, IRIS_ERR_INVALID, el, "has none of TRANSLATION, ROTATION, SCALE");
+  if (count == 0) return gltf_fail(c, IRIS_ERR_INVALID, el, "has no instances (count 0)");
+  if (c->scene->instance_count + count > MAX_INSTANCES)
+    return gltf_fail(c, IRIS_ERR_NOMEM, el, "%zu instances: more than %zu mesh instances in all", count, MAX_INSTANCES);
+  float *t = malloc(count * 3 * sizeof(float)), *r = malloc(count * 4 * sizeof(float)),
+        *s = malloc(count * 3 * sizeof(float));
+  iris_status st = IRIS_OK;
+  if (!t || !r || !s) st = gltf_fail(c, IRIS_ERR_NOMEM, el, "out of memory for %zu instances", count);
+  static const float zero[3] = {0, 0, 0}, one[3] = {1, 1, 1}, unit_q[4] = {0, 0, 0, 1};
+  if (!st) st = read_instance_attribute(c, node, "TRANSLATION", refs[0], 3, false, count, zero, t);
+  if (!st) st = read_instance_attribute(c, node, "ROTATION", refs[1], 4, true, count, unit_q, r);
+  if (!st) st = read_instance_attribute(c, node, "SCALE", refs[2], 3, false, count, one, s);
+  for (size_t i = 0; !st && i < count; i++) {
+    double q[4] = {r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]};
+    double len = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (!(len > 1e-6)) {
+      st = gltf_fail(c, IRIS_ERR_INVALID, el, "instance %zu: ROTATION quaternion has zero length", i);
+      break;
+    }
+    for (int k = 0; k < 4; k++) q[k] /= len;
+    double x = q[0], y = q[1], z = q[2], w = q[3];
+    double R[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                      {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                      {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    dmat4 local = dmat4_identity();
+    for (int row = 0; row < 3; row++) {
+      for (int col = 0; col < 3; col++) local.m[row][col] = R[row][col] * s[3 * i + (size_t)col];
+      local.m[row][3] = t[3 * i + (size_t)row];
+    }
+    dmat4 w4 = dmat4_mul(world, &local);
+    st = add_instance_prims(c, n->mesh, &w4);
+  }
+  free(t);
+  free(r);
+  free(s);
+  return st;
+}
+
 static iris_status add_light(gltf_ctx *c, int node, const dmat4 *w) {
   const iris_gltf_light *g = &c->doc->lights[c->doc->nodes[node].light];
   iris_light l;
@@ -1147,7 +1236,11 @@ static iris_status traverse(gltf_ctx *c) {
     while (top > 0) {
       int ni = stack[--top];
       const iris_gltf_node *n = &d->nodes[ni];
-      if (n->mesh >= 0 && (st = add_instance_prims(c, n->mesh, &c->world[ni]))) goto done;
+      if (n->mesh >= 0 && n->gpu_instancing) {
+        if ((st = add_gpu_instances(c, (size_t)ni, &c->world[ni]))) goto done;
+      } else if (n->mesh >= 0 && (st = add_instance_prims(c, n->mesh, &c->world[ni]))) {
+        goto done;
+      }
       if (n->light >= 0 && (st = add_light(c, ni, &c->world[ni]))) goto done;
       if (n->camera >= 0) {
         if (strcmp(d->cameras[n->camera].type, "perspective") == 0)

@@ -69,6 +69,12 @@ typedef struct iris_gltf_node {
   const double *matrix, *translation, *rotation, *scale;
   size_t matrix_len, translation_len, rotation_len, scale_len;
   bool has_weights;
+  /* EXT_mesh_gpu_instancing: accessor indices of the per-instance TRANSLATION,
+   * ROTATION and SCALE (-1 absent; INT_MIN present but not a number);
+   * `gpu_instancing` when the node has the extension, `gpu_instancing_bad`
+   * when it is not an object with an "attributes" object. */
+  bool gpu_instancing, gpu_instancing_bad;
+  int inst_translation, inst_rotation, inst_scale;
 } iris_gltf_node;
 
 typedef struct iris_gltf_texture_ref {

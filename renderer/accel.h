@@ -1,7 +1,12 @@
-/* Ray casting over the whole scene through Embree 3. Every instance is
- * flattened into world-space triangles (docs/rendering.md gives the measured
- * reason), and a hit becomes a surface interaction: position, geometric and
- * shading normals, uv, vertex colour and material. */
+/* Ray casting over the whole scene through Embree 3, two-level: a mesh placed
+ * once is flattened into world-space triangles, a mesh placed two or more
+ * times is built once in object space and placed by Embree instances
+ * (docs/rendering.md, "Instancing"). A hit becomes a surface interaction:
+ * position, geometric and shading normals, uv, vertex colour and material,
+ * the same numbers whichever way its mesh was built. Triangles are numbered
+ * globally over all placements in instance order (prim = the placement's
+ * first prim + the mesh's triangle index), so lights, photons and caches see
+ * every placement as its own geometry. */
 #ifndef IRIS_RENDERER_ACCEL_H
 #define IRIS_RENDERER_ACCEL_H
 
@@ -46,14 +51,18 @@ typedef struct iris_interaction {
   uint32_t instance; /* scene instance */
   bool front;        /* the ray arrived on the front side (dot(d, ng) < 0) */
   bool has_tangent;  /* the mesh has tangents: the two vectors below are set */
-  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed),
-                                   interpolated, not normalised; flipped with ns */
+  iris_vec3 tangent, bitangent; /* world-space normal-map frame (T, B = w N x T transformed,
+                                   divided by the cube root of the placement's |det| so a
+                                   uniform scale leaves their length), interpolated, not
+                                   normalised; flipped with ns */
 } iris_interaction;
 
 typedef struct iris_accel iris_accel;
 
-/* Builds the Embree scene (world-space copies of every instance's vertices;
- * index buffers are shared with the scene, which must outlive the accel). */
+/* Builds the Embree scenes (world-space copies of the vertices of meshes
+ * placed once, object-space copies of the others; index buffers are shared
+ * with the scene, which must outlive the accel). An Embree failure ends in one
+ * message naming what was being built (IRIS_ERR_NOMEM when out of memory). */
 iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_error *err);
 void iris_accel_destroy(iris_accel *accel);
 
@@ -140,6 +149,18 @@ bool iris_accel_bounds(const iris_accel *accel, iris_vec3 *lo, iris_vec3 *hi);
  * iris_accel_embree_bytes (from Embree's memory monitor). */
 size_t iris_accel_memory_bytes(const iris_accel *accel);
 size_t iris_accel_embree_bytes(const iris_accel *accel);
+
+/* Placements (= scene instances): the global triangle range [first, first +
+ * count) of placement `instance` and its mesh's material. Enumerating
+ * emissive geometry per placement costs the number of placements, not of
+ * world triangles. */
+size_t iris_accel_instance_count(const iris_accel *accel);
+void iris_accel_instance_prims(const iris_accel *accel, size_t instance, uint32_t *first,
+                               uint32_t *count);
+int32_t iris_accel_instance_material(const iris_accel *accel, size_t instance);
+/* Meshes built once for instancing, and placements made by Embree instances
+ * (the others are flattened). */
+void iris_accel_stats(const iris_accel *accel, size_t *unique_meshes, size_t *instanced_placements);
 
 #ifdef __cplusplus
 }

@@ -290,6 +290,43 @@ static iris_status build_alias(iris_lights *L, const iris_light_group *g) {
   return IRIS_OK;
 }
 
+/* The emissive triangles of placement `instance` (nothing when its mesh does
+ * not emit) appended as entries from *n, and its slots in light_of_prim from
+ * *slot. Each placement's triangles are world-space lights of their own: its
+ * transform scales their area, hence their power. */
+static void add_emissive_placement(iris_lights *out, size_t instance, size_t *n, size_t *slot) {
+  const iris_accel *accel = out->accel;
+  out->light_base[instance] = UINT32_MAX;
+  const iris_material *m = material_of(out->scene, iris_accel_instance_material(accel, instance));
+  if (!is_emissive(m)) return;
+  uint32_t first, count;
+  iris_accel_instance_prims(accel, instance, &first, &count);
+  out->light_base[instance] = (uint32_t)*slot;
+  for (uint32_t t = first; t < first + count; t++) {
+    uint32_t *light = &out->light_of_prim[(*slot)++];
+    *light = UINT32_MAX;
+    iris_vec3 v[3];
+    iris_accel_triangle(accel, t, v);
+    float area = triangle_area(v);
+    if (!(area > 0.0f) || !isfinite(area)) continue; /* degenerate: never sampled, never hit */
+    iris_light_entry *e = &out->entries[*n];
+    e->kind = IRIS_LIGHT_KIND_TRIANGLE;
+    e->prim = t;
+    e->group = (uint32_t)instance; /* provisional: the instance, turned into a group later */
+    e->area = area;
+    e->two_sided = m->emission_two_sided;
+    e->radiance = iris_v3_load(m->emission);
+    e->power = luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
+    e->v0 = v[0];
+    e->e1 = iris_sub(v[1], v[0]);
+    e->e2 = iris_sub(v[2], v[0]);
+    e->ng = iris_normalize(iris_cross(e->e1, e->e2));
+    e->textured = m->emission_texture >= 0 || m->unlit; /* evaluated per point (vertex colours) */
+    *light = (uint32_t)*n;
+    (*n)++;
+  }
+}
+
 iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
                               const iris_textures *textures, iris_lights *out, iris_error *err) {
   memset(out, 0, sizeof *out);
@@ -306,10 +343,17 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     out->center = iris_v3(0, 0, 0);
     out->radius = 1.0f;
   }
-  uint32_t tri_count = iris_accel_triangle_count(accel);
+  /* Emissive triangles, enumerated per placement (issue 20): each placement of
+   * an emissive mesh is its own set of world-space lights. */
+  size_t placements = iris_accel_instance_count(accel);
   size_t emissive = 0;
-  for (uint32_t t = 0; t < tri_count; t++)
-    if (is_emissive(material_of(scene, iris_accel_triangle_material(accel, t)))) emissive++;
+  for (size_t i = 0; i < placements; i++) {
+    uint32_t first, count;
+    iris_accel_instance_prims(accel, i, &first, &count);
+    if (is_emissive(material_of(scene, iris_accel_instance_material(accel, i)))) emissive += count;
+  }
+  if (emissive >= UINT32_MAX)
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "more than 2^32 emissive triangles");
   bool env = scene->has_environment && !scene->environment_map.path &&
              (scene->environment[0] > 0 || scene->environment[1] > 0 || scene->environment[2] > 0);
   iris_vec3 env_mean = iris_v3_load(scene->environment);
@@ -331,41 +375,16 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     }
   }
   size_t cap = emissive + scene->light_count + (env ? 1 : 0);
-  out->light_of_prim = malloc(sizeof(uint32_t) * (tri_count ? tri_count : 1));
+  out->light_base = malloc(sizeof(uint32_t) * (placements ? placements : 1));
+  out->light_of_prim = malloc(sizeof(uint32_t) * (emissive ? emissive : 1));
   out->entries = calloc(cap ? cap : 1, sizeof *out->entries);
-  if (!out->light_of_prim || !out->entries) {
+  if (!out->light_base || !out->light_of_prim || !out->entries) {
     iris_lights_destroy(out);
-    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light list");
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL,
+                          "out of memory for the light list (%zu emissive triangles)", emissive);
   }
-  size_t n = 0;
-  for (uint32_t t = 0; t < tri_count; t++) {
-    out->light_of_prim[t] = UINT32_MAX;
-    const iris_material *m = material_of(scene, iris_accel_triangle_material(accel, t));
-    if (!is_emissive(m)) continue;
-    iris_vec3 v[3];
-    iris_accel_triangle(accel, t, v);
-    float area = triangle_area(v);
-    if (!(area > 0.0f) || !isfinite(area)) continue; /* degenerate: never sampled, never hit */
-    iris_light_entry *e = &out->entries[n];
-    e->kind = IRIS_LIGHT_KIND_TRIANGLE;
-    e->prim = t;
-    {
-      iris_interaction c;
-      iris_accel_surface_at(accel, t, 0.0f, 0.0f, &c);
-      e->group = c.instance; /* provisional: the instance, turned into a group below */
-    }
-    e->area = area;
-    e->two_sided = m->emission_two_sided;
-    e->radiance = iris_v3_load(m->emission);
-    e->power = luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
-    e->v0 = v[0];
-    e->e1 = iris_sub(v[1], v[0]);
-    e->e2 = iris_sub(v[2], v[0]);
-    e->ng = iris_normalize(iris_cross(e->e1, e->e2));
-    e->textured = m->emission_texture >= 0 || m->unlit; /* evaluated per point (vertex colours) */
-    out->light_of_prim[t] = (uint32_t)n;
-    n++;
-  }
+  size_t n = 0, slot = 0;
+  for (size_t i = 0; i < placements; i++) add_emissive_placement(out, i, &n, &slot);
   for (size_t i = 0; i < scene->light_count; i++) {
     const iris_light *l = &scene->lights[i];
     iris_vec3 c = iris_scale(iris_v3_load(l->color), l->intensity);
@@ -466,6 +485,8 @@ void iris_lights_destroy(iris_lights *lights) {
   lights->tris = NULL;
   lights->tri_count = 0;
   free(lights->light_of_prim);
+  free(lights->light_base);
+  lights->light_base = NULL;
   iris_distrib1d_destroy(&lights->select);
   iris_envmap_destroy(lights->envmap);
   free(lights->envmap);
@@ -701,8 +722,13 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
 
 float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
                                const iris_interaction *si) {
-  if (si->prim >= iris_accel_triangle_count(lights->accel)) return 0.0f;
-  uint32_t i = lights->light_of_prim[si->prim];
+  if (!lights->light_base || si->instance >= iris_accel_instance_count(lights->accel)) return 0.0f;
+  uint32_t base = lights->light_base[si->instance];
+  if (base == UINT32_MAX) return 0.0f;
+  uint32_t first, count;
+  iris_accel_instance_prims(lights->accel, si->instance, &first, &count);
+  if (si->prim < first || si->prim - first >= count) return 0.0f;
+  uint32_t i = lights->light_of_prim[base + (si->prim - first)];
   if (i >= lights->tri_count) return 0.0f;
   const iris_light_tri *t = &lights->tris[i];
   iris_vec3 to = iris_sub(si->p, ref);

@@ -100,7 +100,13 @@ typedef struct iris_lights {
   iris_distrib1d select;  /* over entries, in proportion to power (photon emission) */
   iris_light_group *groups;
   size_t group_count;
-  uint32_t *light_of_prim;/* per global triangle: entry index, or UINT32_MAX */
+  /* Emissive triangles per placement (scene instance): light_of_prim[
+   * light_base[instance] + triangle index in the mesh] is the entry index or
+   * UINT32_MAX (degenerate); light_base is UINT32_MAX for a placement of a
+   * non-emissive mesh. Sized by placements and emissive triangles, never by
+   * all triangles in the world. */
+  uint32_t *light_base;
+  uint32_t *light_of_prim;
   int32_t environment;    /* entry index of the environment, or -1 */
   iris_envmap *envmap;    /* the environment's map (owned), NULL for a constant one */
   iris_vec3 center;       /* scene bounding sphere (directional/environment photons) */

@@ -7,8 +7,10 @@
 
 #include "core/cancel.h"
 #include "core/image.h"
+#include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/memory.h"
 #include "renderer/merge.h"
 
 #define TILE 8
@@ -148,6 +150,18 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
   }
+  /* What the render will need against what the machine has, before any of it
+   * is built (docs/performance.md, "Memory estimate"). Logged (with the
+   * accel's line) only once the set-up succeeded: bad input stays one line. */
+  char mem_line[400], accel_line[300] = "";
+  {
+    iris_memory_estimate est;
+    iris_memory_estimate_scene(scene, b.x1 - b.x0, b.y1 - b.y0,
+                               p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method), &est);
+    iris_memory_format(&est, mem_line, sizeof mem_line);
+    st = iris_memory_check(&est, scene->source_path ? scene->source_path : "scene", err);
+    if (st != IRIS_OK) return st;
+  }
   iris_accel *accel = NULL;
   iris_textures textures;
   iris_lights lights;
@@ -157,6 +171,15 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   iris_path_stats *stats = NULL;
   st = enter_phase(&p, IRIS_OK, "bvh", "building the BVH", t0, err);
   if (st == IRIS_OK) st = iris_accel_build(scene, &accel, err);
+  if (st == IRIS_OK) {
+    size_t unique = 0, placed = 0;
+    iris_accel_stats(accel, &unique, &placed);
+    snprintf(accel_line, sizeof accel_line,
+             "accel: %u triangles in the world; %zu meshes built once for %zu instanced placements, "
+             "%zu placements flattened; BVH %.1f MB (Embree), vertex copies and tables %.1f MB",
+             iris_accel_triangle_count(accel), unique, placed, scene->instance_count - placed,
+             (double)iris_accel_embree_bytes(accel) / 1e6, (double)iris_accel_memory_bytes(accel) / 1e6);
+  }
   st = enter_phase(&p, st, "textures", "decoding textures", t0, err);
   if (st == IRIS_OK) st = iris_textures_load(scene, &textures, err);
   if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
@@ -201,6 +224,10 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
   }
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the guide's last phase */
+  if (st == IRIS_OK) {
+    iris_infof("memory: %s", mem_line);
+    iris_infof("%s", accel_line);
+  }
   /* every pixel holds the same number of training samples (whole passes) */
   if (st == IRIS_OK && res->film.count) res->train_spp = (int)res->film.count[0];
   if (st == IRIS_OK) {

@@ -58,6 +58,7 @@ int iris_cli_report(const iris_error *err) {
     case IRIS_ERR_PARSE:
     case IRIS_ERR_INVALID:
     case IRIS_ERR_UNSUPPORTED:
+    case IRIS_ERR_NOMEM: /* a scene too big for the machine, or a declared size out of reason */
       return IRIS_EXIT_USAGE;
     case IRIS_ERR_IO:
       /* Unreadable input is bad input; unwritable output is a failure. Input

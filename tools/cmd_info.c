@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "core/log.h"
+#include "renderer/camera.h"
+#include "renderer/memory.h"
 #include "importers/import.h"
 #include "scene/scene.h"
 #include "tools/cli.h"
@@ -88,6 +90,21 @@ static cJSON *vec(const float *v) {
   return a;
 }
 
+/* The render-memory estimate at the scene's default frame size: `total`
+ * without a guide (mis, or auto where it declines), `guide` what the guided
+ * methods add (auto where it guides). */
+static void estimate_memory(const iris_scene *s, iris_memory_estimate *est, int *w, int *h) {
+  iris_pinhole cam;
+  iris_error err;
+  *w = s->render.width, *h = s->render.height;
+  if (iris_pinhole_setup(s, NULL, *w, *h, &cam, &err) == IRIS_OK) *w = cam.width, *h = cam.height;
+  if (*w <= 0 || *h <= 0) *w = 640, *h = 480;
+  iris_memory_estimate guided;
+  iris_memory_estimate_scene(s, *w, *h, false, est);
+  iris_memory_estimate_scene(s, *w, *h, true, &guided);
+  est->guide = guided.guide; /* reported beside the total, which is without it */
+}
+
 static void print_json(const char *path, const iris_scene *s, const scene_stats *st) {
   cJSON *o = cJSON_CreateObject();
   cJSON_AddStringToObject(o, "file", path);
@@ -158,6 +175,33 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
     cJSON_AddNullToObject(o, "environment_map");
   }
   cJSON_AddBoolToObject(o, "has_light", iris_scene_has_emitter(s));
+  {
+    iris_memory_estimate est;
+    int w, h;
+    estimate_memory(s, &est, &w, &h);
+    cJSON *mem = cJSON_AddObjectToObject(o, "memory");
+    cJSON_AddNumberToObject(mem, "width", w);
+    cJSON_AddNumberToObject(mem, "height", h);
+    cJSON_AddNumberToObject(mem, "estimate_bytes", (double)est.total);
+    cJSON_AddNumberToObject(mem, "bvh_bytes", (double)est.accel);
+    cJSON_AddNumberToObject(mem, "scene_bytes", (double)est.scene);
+    cJSON_AddNumberToObject(mem, "texture_bytes", (double)est.textures);
+    cJSON_AddNumberToObject(mem, "light_bytes", (double)est.lights);
+    cJSON_AddNumberToObject(mem, "guide_bytes", (double)est.guide); /* not in estimate_bytes */
+    cJSON_AddNumberToObject(mem, "film_bytes", (double)est.film);
+    cJSON_AddNumberToObject(mem, "process_bytes", (double)est.base);
+    cJSON_AddNumberToObject(mem, "unique_triangles", (double)est.unique_triangles);
+    cJSON_AddNumberToObject(mem, "instanced_placements", (double)est.instanced_placements);
+    cJSON_AddNumberToObject(mem, "flattened_triangles", (double)est.flattened_triangles);
+    uint64_t avail;
+    char why[32];
+    if (iris_memory_available(&avail, why, sizeof why)) {
+      cJSON_AddNumberToObject(mem, "available_bytes", (double)avail);
+      cJSON_AddStringToObject(mem, "available_limit", why);
+    } else {
+      cJSON_AddNullToObject(mem, "available_bytes");
+    }
+  }
   char *text = cJSON_Print(o);
   if (text) printf("%s\n", text);
   free(text);
@@ -214,6 +258,17 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
     printf("environment  none\n");
   printf("mesh memory  %llu bytes (%.2f MiB)\n", (unsigned long long)st->mesh_bytes,
          (double)st->mesh_bytes / (1024.0 * 1024.0));
+  iris_memory_estimate est;
+  int w, h;
+  estimate_memory(s, &est, &w, &h);
+  printf("instancing   %llu unique triangles built once for %llu placements, %llu triangles flattened\n",
+         (unsigned long long)est.unique_triangles, (unsigned long long)est.instanced_placements,
+         (unsigned long long)est.flattened_triangles);
+  char line[400];
+  uint64_t guide = est.guide;
+  est.guide = 0;
+  iris_memory_format(&est, line, sizeof line);
+  printf("render mem   %dx%d: %s; guided methods add about %.3f GB\n", w, h, line, (double)guide / 1e9);
 }
 
 int iris_cmd_info(int argc, char **argv) {

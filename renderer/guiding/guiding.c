@@ -477,7 +477,7 @@ static iris_status pilot(iris_guiding *g, const iris_guide_setup *s, int stride,
   double t0 = iris_time_now();
   camera_ctx cc = {s, stride, (s->camera->width + stride - 1) / stride, (s->camera->height + stride - 1) / stride, NULL};
   cc.out = malloc(sizeof(seed_point) * (size_t)cc.cols * (size_t)cc.rows);
-  if (!cc.out) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  if (!cc.out) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the pilot's %dx%d camera points", cc.cols, cc.rows);
   iris_parallel_for((uint64_t)cc.rows, 1, s->threads, camera_rows, &cc);
   size_t ncam = 0;
   for (size_t i = 0; i < (size_t)cc.cols * (size_t)cc.rows; ++i) ncam += cc.out[i].valid;
@@ -564,7 +564,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   cc.out = malloc(sizeof(seed_point) * (size_t)cc.cols * (size_t)cc.rows);
   if (!cc.out) {
     iris_photons_destroy(&photons);
-    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %dx%d camera cache points", cc.cols, cc.rows);
   }
   iris_parallel_for((uint64_t)cc.rows, 1, s->threads, camera_rows, &cc);
   if (iris_cancel_requested()) {
@@ -630,7 +630,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   normal_cone cones[NORMAL_GROUPS];
   uint32_t *group = st == IRIS_OK ? malloc(sizeof(uint32_t) * (photons.count ? photons.count : 1)) : NULL;
   if (st == IRIS_OK && (!group || !group_photons(photons.photons, photons.count, direct, s->threads, group, cones)))
-    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+    st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory grouping %zu photons", photons.count);
   if (st == IRIS_OK) /* photon ids stay indices into the whole photon array */
     st = iris_kdtree_build_grouped(&ptree, &photons.photons[0].p, sizeof(iris_photon), (uint32_t)photons.count,
                                    group, NORMAL_GROUPS, s->threads, err);
@@ -662,7 +662,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       iris_parallel_for(total, 64, threads, fill_caches, &fc);
       if (iris_cancel_requested()) st = iris_cancel_error(err);
     } else {
-      st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+      st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory filling %zu caches", total);
     }
     for (int t = 0; t < threads; ++t) {
       if (fc.hist) free(fc.hist[t]);
@@ -713,7 +713,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   *out = NULL;
   double t0 = iris_time_now();
   iris_guiding *g = calloc(1, sizeof *g);
-  if (!g) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
+  if (!g) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the guide");
   g->params = params ? *params : iris_guiding_params_default();
   if (g->params.cache_k > 100000 || g->params.photons > ((int64_t)1 << 32) ||
       g->params.caches > ((int64_t)1 << 26)) {
