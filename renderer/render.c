@@ -23,6 +23,7 @@ iris_render_params iris_render_params_default(void) {
   p.max_depth = -1;
   p.rr_depth = IRIS_DEFAULT_RR_DEPTH;
   p.threads = 0;
+  p.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
 
@@ -123,6 +124,9 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
     res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
+    /* the power sampler keeps the hash renders had before the light tree */
+    if (p.light_sampler != IRIS_LIGHT_SAMPLER_POWER)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_sampler, 0x7ee11ULL, 2);
   }
   iris_accel *accel = NULL;
   iris_textures textures;
@@ -136,6 +140,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   if (st == IRIS_OK) iris_accel_set_textures(accel, &textures); /* alpha-textured surfaces */
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
   if (st == IRIS_OK) iris_lights_set_triangle_sampling(&lights, p.light_sampling);
+  if (st == IRIS_OK) st = iris_lights_set_sampler(&lights, p.light_sampler, err);
   iris_integrator it;
   if (st == IRIS_OK) {
     it = iris_integrator_default(scene, accel, &lights, &textures);
@@ -175,6 +180,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
   res->method = p.method;
   res->sampler = p.sampler;
   res->light_sampling = p.light_sampling;
+  res->light_sampler = p.light_sampler;
   res->seed = p.seed;
   res->threads = p.threads;
   double t1 = iris_time_now();
@@ -284,6 +290,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   if (r->method_reason[0]) META("method_reason", "%s", r->method_reason);
   META("sampler", "%s", iris_sampler_kind_name(r->sampler));
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
+  META("light_sampler", "%s", iris_light_sampler_name(r->light_sampler));
   META("spp", "%d", r->spp);
   META("seed", "%llu", (unsigned long long)r->seed);
   META("render_seconds", "%.3f", r->seconds);

@@ -46,18 +46,21 @@ extern char **environ;
 const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size) {
   const bool indep = p->samplers[k] == IRIS_SAMPLER_INDEPENDENT;
   const bool area = p->light_samplings[k] == IRIS_TRIANGLE_SAMPLING_AREA;
-  snprintf(buf, size, "%s%s%s%s", iris_method_name(p->methods[k]), indep || area ? "@" : "",
-           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "");
+  const bool tree = p->light_samplers[k] != IRIS_LIGHT_SAMPLER_DEFAULT; /* the other light sampler */
+  snprintf(buf, size, "%s%s%s%s%s%s", iris_method_name(p->methods[k]), indep || area || tree ? "@" : "",
+           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "", tree && (indep || area) ? "+" : "",
+           tree ? iris_light_sampler_name(p->light_samplers[k]) : "");
   return buf;
 }
 
-bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
+bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
                              iris_triangle_sampling *light) {
   char name[64];
   snprintf(name, sizeof name, "%s", label);
   char *at = strchr(name, '@');
   *sampler = IRIS_SAMPLER_SOBOL;
   *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+  *light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   if (at) {
     *at++ = '\0';
     for (char *tok = strtok(at, "+"); tok; tok = strtok(NULL, "+")) {
@@ -69,6 +72,8 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
         *light = IRIS_TRIANGLE_SAMPLING_AREA;
       else if (strcmp(tok, "solid-angle") == 0)
         *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+      else if (iris_light_sampler_parse(tok, light_sampler))
+        ;
       else
         return false;
     }
@@ -81,6 +86,7 @@ iris_bench_params iris_bench_params_default(void) {
   memset(&p, 0, sizeof p);
   p.seeds = 1;
   p.max_depth = -1;
+  for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.light_samplers[k] = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
 
@@ -697,12 +703,13 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
       for (int s = 0; s < p.seeds && st == IRIS_OK; s++)
         for (int k = 0; k < p.method_count && st == IRIS_OK; k++) {
           iris_method m = p.methods[k];
-          char label[32];
+          char label[64];
           iris_bench_method_label(&p, k, label, sizeof label);
           begin_run(&ctx, sc->name, label, p.times[t], (uint64_t)s, p.times[t]);
           iris_render_params rp = render_params(&p, sc, bs[i].max_depth, m, (uint64_t)s, &gp, &ctx);
           rp.sampler = p.samplers[k];
           rp.light_sampling = p.light_samplings[k];
+          rp.light_sampler = p.light_samplers[k];
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;
