@@ -22,7 +22,8 @@ static inline float maxf(float a, float b) { return a > b ? a : b; }
 
 static void store_node(iris_light_tree_node *nd, const iris_light_bounds *b) {
   memset(nd, 0, sizeof *nd);
-  iris_v3_store(iris_scale(iris_add(b->lo, b->hi), 0.5f), nd->center);
+  iris_v3_store(b->lo, nd->lo);
+  iris_v3_store(b->hi, nd->hi);
   nd->radius = 0.5f * iris_length(iris_sub(b->hi, b->lo));
   iris_v3_store(b->w, nd->w);
   nd->cos_o = b->cos_o;
@@ -39,10 +40,25 @@ static void store_node(iris_light_tree_node *nd, const iris_light_bounds *b) {
 static inline float node_importance(const iris_light_tree_node *nd, iris_vec3 p, iris_vec3 n) {
   float phi = nd->phi;
   if (!(phi > 0.0f)) return 0.0f;
-  iris_vec3 to_p = iris_v3(p.x - nd->center[0], p.y - nd->center[1], p.z - nd->center[2]);
+  iris_vec3 to_p = iris_v3(p.x - 0.5f * (nd->lo[0] + nd->hi[0]), p.y - 0.5f * (nd->lo[1] + nd->hi[1]),
+                           p.z - 0.5f * (nd->lo[2] + nd->hi[2]));
   float dist2 = iris_dot(to_p, to_p);
   float r = nd->radius, r2 = r * r;
-  if (!(dist2 > r2)) { /* inside the bounding sphere: every direction is possible */
+  if (!(dist2 > r2)) { /* inside the bounding sphere: the box's half-spaces decide */
+    /* one-sided emitters of one normal emit nothing to p behind all of them */
+    if (nd->cos_o >= 1.0f && nd->cos_e >= 0.0f && !(nd->flags & IRIS_LIGHT_NODE_TWO_SIDED)) {
+      float front = nd->w[0] * (p.x - (nd->w[0] > 0.0f ? nd->lo[0] : nd->hi[0])) +
+                    nd->w[1] * (p.y - (nd->w[1] > 0.0f ? nd->lo[1] : nd->hi[1])) +
+                    nd->w[2] * (p.z - (nd->w[2] > 0.0f ? nd->lo[2] : nd->hi[2]));
+      if (front <= 0.0f) return 0.0f;
+    }
+    /* nor to a receiver whose hemisphere holds none of the box */
+    if (n.x != 0.0f || n.y != 0.0f || n.z != 0.0f) {
+      float above = n.x * ((n.x > 0.0f ? nd->hi[0] : nd->lo[0]) - p.x) +
+                    n.y * ((n.y > 0.0f ? nd->hi[1] : nd->lo[1]) - p.y) +
+                    n.z * ((n.z > 0.0f ? nd->hi[2] : nd->lo[2]) - p.z);
+      if (above <= 0.0f) return 0.0f;
+    }
     float imp = phi / maxf(r2, FLT_MIN);
     return imp > 0.0f ? (imp < FLT_MAX ? imp : FLT_MAX) : 0.0f;
   }
@@ -225,7 +241,7 @@ static uint32_t build_node(builder *B, item *it, size_t n, int depth, uint64_t b
     iris_light_tree *t = B->t;
     nd->flags |= IRIS_LIGHT_NODE_LEAF;
     nd->index = (uint32_t)B->next_leaf_light;
-    nd->count = (uint32_t)n;
+    nd->flags |= (uint32_t)n << 8;
     double sum = 0.0, acc = 0.0;
     for (size_t i = 0; i < n; i++) sum += it[i].b.phi;
     for (size_t i = 0; i < n; i++) {
@@ -401,7 +417,7 @@ bool iris_light_tree_sample(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, 
   const iris_light_tree_node *nd = &t->nodes[leaf];
   /* within the leaf by power, with what is left of u: the first cdf above v */
   const float *cdf = &t->leaf_cdf[nd->index];
-  uint32_t j = 0, hi = nd->count - 1;
+  uint32_t j = 0, hi = (nd->flags >> 8) - 1;
   while (j < hi) {
     uint32_t mid = (j + hi) / 2;
     if (v < (double)cdf[mid])

@@ -36,15 +36,13 @@ typedef struct iris_light_bounds {
 } iris_light_bounds;
 
 /* One node, one 64-byte cache line; children of node i are i + 1 and
- * `index`. Importance needs the bounding sphere of the box, not the box. */
+ * `index`. */
 typedef struct iris_light_tree_node {
-  float center[3], radius;
+  float lo[3], hi[3], radius; /* box of the positions, half its diagonal */
   float w[3];
   float cos_o, sin_o, cos_e, phi;
   uint32_t index; /* leaf: its first light in leaf_lights; interior: the second child */
-  uint32_t flags; /* IRIS_LIGHT_NODE_* */
-  uint32_t count; /* leaf: its lights, leaf_lights[index .. index + count) */
-  uint32_t pad_[2];
+  uint32_t flags; /* IRIS_LIGHT_NODE_* | leaf: its light count << 8 (leaf_lights[index ..]) */
 } iris_light_tree_node;
 #define IRIS_LIGHT_NODE_LEAF 1u
 #define IRIS_LIGHT_NODE_TWO_SIDED 2u
