@@ -269,8 +269,8 @@ static bool bounds_usable(const iris_light_bounds *b) {
          isfinite(b->cos_e);
 }
 
-iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count, iris_light_tree *out,
-                                  iris_error *err) {
+iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count, float leaf_radius,
+                                  iris_light_tree *out, iris_error *err) {
   memset(out, 0, sizeof *out);
   if (count >= UINT32_MAX / 2)
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "%zu lights are too many for the light tree", count);
@@ -317,12 +317,7 @@ iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count,
     f++;
   }
   if (f > 0) {
-    iris_vec3 lo = items[0].b.lo, hi = items[0].b.hi;
-    for (size_t i = 1; i < f; i++) {
-      lo = iris_v3(fminf(lo.x, items[i].b.lo.x), fminf(lo.y, items[i].b.lo.y), fminf(lo.z, items[i].b.lo.z));
-      hi = iris_v3(fmaxf(hi.x, items[i].b.hi.x), fmaxf(hi.y, items[i].b.hi.y), fmaxf(hi.z, items[i].b.hi.z));
-    }
-    builder B = {out, 0, 0, 0.5f * iris_length(iris_sub(hi, lo)) / IRIS_LIGHT_LEAF_SIZE_DIV};
+    builder B = {out, 0, 0, leaf_radius};
     build_node(&B, items, f, 0, 0);
     out->node_count = B.next;
   }

@@ -63,16 +63,15 @@ typedef struct iris_light_tree {
 } iris_light_tree;
 
 /* Leaves hold up to this many lights of one cluster, chosen in proportion to
- * power, when their bounding sphere is within 1/IRIS_LIGHT_LEAF_SIZE_DIV of the root's:
- * the descent is the cost of the tree, and the finest levels of a tessellated
- * emitter decide little (docs/rendering.md, "Light tree"). */
-#define IRIS_LIGHT_LEAF_MAX 64
-#define IRIS_LIGHT_LEAF_SIZE_DIV 16.0f
+ * power, when their bounding sphere's radius is at most the build's
+ * leaf_radius: the descent is the cost of the tree, and the finest levels of
+ * a tessellated emitter decide little (docs/rendering.md, "Light tree"). */
+#define IRIS_LIGHT_LEAF_MAX 128
 
 /* Builds the tree over `count` lights (deterministic: the same bounds give
  * the same tree). Depth at most 64. */
-iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count, iris_light_tree *out,
-                                  iris_error *err);
+iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count, float leaf_radius,
+                                  iris_light_tree *out, iris_error *err);
 void iris_light_tree_destroy(iris_light_tree *tree);
 
 /* Importance of bounds b at point p with unit normal n (n = 0: a sphere of

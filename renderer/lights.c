@@ -944,7 +944,8 @@ iris_status iris_lights_set_sampler(iris_lights *L, iris_light_sampler s, iris_e
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light tree");
   }
   for (size_t i = 0; i < L->count; i++) b[i] = iris_lights_bounds(L, (uint32_t)i);
-  iris_status st = iris_light_tree_build(b, L->count, L->tree, err);
+  /* the triangles of one mesh placement within 1/4 of the scene's radius may share a leaf */
+  iris_status st = iris_light_tree_build(b, L->count, L->radius / 4.0f, L->tree, err);
   free(b);
   if (st != IRIS_OK) {
     free(L->tree);

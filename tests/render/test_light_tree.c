@@ -238,9 +238,9 @@ int main(void) {
     size_t n = make_set(set, l);
     iris_light_tree t, t2;
     iris_error err;
-    if (!CHECK(iris_light_tree_build(l, n, &t, &err) == IRIS_OK)) continue;
+    if (!CHECK(iris_light_tree_build(l, n, 0.5f, &t, &err) == IRIS_OK)) continue;
     /* deterministic build */
-    if (CHECK(iris_light_tree_build(l, n, &t2, &err) == IRIS_OK)) {
+    if (CHECK(iris_light_tree_build(l, n, 0.5f, &t2, &err) == IRIS_OK)) {
       CHECK(t.node_count == t2.node_count &&
             memcmp(t.nodes, t2.nodes, t.node_count * sizeof *t.nodes) == 0 &&
             memcmp(t.bits, t2.bits, n * sizeof *t.bits) == 0);
@@ -282,6 +282,11 @@ int main(void) {
       CHECK_OK(iris_accel_build(s, &accel, &err), &err);
       CHECK_OK(iris_lights_build(s, accel, &tex, &lights, &err), &err);
       CHECK_OK(iris_lights_set_sampler(&lights, IRIS_LIGHT_SAMPLER_TREE, &err), &err);
+      if (lights.tree) {
+        size_t leaves = 0;
+        for (size_t i = 0; i < lights.tree->node_count; i++) leaves += lights.tree->nodes[i].flags & IRIS_LIGHT_NODE_LEAF;
+        printf("%s: %zu lights, %zu nodes, %zu leaves\n", names[c], lights.count, lights.tree->node_count, leaves);
+      }
       iris_vec3 refs[3] = {iris_v3(0, 0.5f, 0.5f), iris_v3(0.1f, -0.3f, 1.2f), iris_v3(3, 2, 1)};
       for (int i = 0; i < 3; i++) {
         double sum = 0.0;
