@@ -142,7 +142,9 @@ typedef enum iris_light_sampler {
 #define IRIS_LIGHT_SAMPLER_DEFAULT IRIS_LIGHT_SAMPLER_TREE
 const char *iris_light_sampler_name(iris_light_sampler s); /* "power", "tree" */
 bool iris_light_sampler_parse(const char *name, iris_light_sampler *out);
-/* Switches the NEE light choice (builds or frees the tree). */
+/* Switches the NEE light choice (builds or frees the tree; a tree that
+ * would be a single leaf is not kept: lights->tree stays NULL and the power
+ * sampler, which chooses the same, serves). */
 iris_status iris_lights_set_sampler(iris_lights *lights, iris_light_sampler s, iris_error *err);
 /* The bounds the tree is given for entry i (exposed for tests). */
 iris_light_bounds iris_lights_bounds(const iris_lights *lights, uint32_t i);

@@ -282,6 +282,7 @@ int main(void) {
       CHECK_OK(iris_accel_build(s, &accel, &err), &err);
       CHECK_OK(iris_lights_build(s, accel, &tex, &lights, &err), &err);
       CHECK_OK(iris_lights_set_sampler(&lights, IRIS_LIGHT_SAMPLER_TREE, &err), &err);
+      CHECK((lights.tree != NULL) == (c == 1)); /* Cornell's light is one leaf: no tree kept */
       if (lights.tree) {
         size_t leaves = 0;
         for (size_t i = 0; i < lights.tree->node_count; i++) leaves += lights.tree->nodes[i].flags & IRIS_LIGHT_NODE_LEAF;
