@@ -198,6 +198,15 @@ float iris_integrator_direction_pdf(const iris_integrator *it, const iris_shadin
   return iris_integrator_bsdf_pdf(sp, wi);
 }
 
+/* The normal light selection is told at a shading point (lights.h): the
+ * geometric normal on wo's side for BSDFs that only reflect, since
+ * direction_allowed refuses every direction below that plane whatever the
+ * shading normal or a coat's normal say, so a light wholly below it gives
+ * nothing; the zero vector (any direction) for transmissive BSDFs. */
+static iris_vec3 light_normal(const iris_shading_point *sp) {
+  return (sp->lobes & IRIS_LOBE_TRANSMISSION) ? iris_v3(0, 0, 0) : sp->si.ng;
+}
+
 /* Adjoint-driven Russian roulette: paths whose expected contribution is at
  * least 1/RR_WINDOW of the pixel estimate always survive (Vorba & Krivanek
  * 2016 use a window of width 5: lower end 2/(1+5) = 1/3 of the estimate). */
@@ -249,7 +258,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
   bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
   float prev_pdf = 0.0f;
-  iris_vec3 prev_p = ray.o;
+  iris_vec3 prev_p = ray.o, prev_n = iris_v3(0, 0, 0);
   stats->paths++;
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -260,7 +269,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
         float w = 1.0f;
         if (!prev_delta && nee)
-          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, ray.d)) : 0.0f;
+          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, prev_n, ray.d)) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
         if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }
@@ -269,15 +278,11 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
     if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));
-    /* Choose the light for NEE now, with the number sample_direct will draw,
-     * so that the emitter's record loads while the point is shaded. */
-    iris_light_choice choice = {0, 0.0f};
-    if (nee) iris_lights_choose(it->lights, si.p, iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
     iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
       float w = 1.0f;
       if (!prev_delta && nee)
-        w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_triangle(it->lights, prev_p, &si)) : 0.0f;
+        w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si)) : 0.0f;
       L = iris_add(L, iris_scale(iris_mul(beta, le), w));
       if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
     }
@@ -286,6 +291,11 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
 
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
+    /* Choose the light for NEE now, with the number sample_direct will draw,
+     * so that the emitter's record loads while the guide prepares. */
+    iris_light_choice choice = {0, 0.0f, false};
+    if (nee && !sp.delta)
+      iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
     iris_integrator_prepare_direction(it, &sp);
     if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, stats)));
 
@@ -315,6 +325,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;
     prev_p = sp.si.p;
+    prev_n = light_normal(&sp);
     ray = iris_spawn_ray(&sp.si, ds.wi);
 
     /* Russian roulette (docs/rendering.md): survive with q = min(1, sqrt(max beta)),

@@ -17,6 +17,7 @@
 #include "core/math.h"
 #include "renderer/accel.h"
 #include "renderer/envmap.h"
+#include "renderer/light_tree.h"
 #include "renderer/sampling.h"
 #include "renderer/texture.h"
 #include "scene/scene.h"
@@ -113,6 +114,7 @@ typedef struct iris_lights {
   float radius;
   double total_power;
   uint64_t id;            /* unique per build (keys the per-thread selection cache) */
+  iris_light_tree *tree;  /* --light-sampler tree: NEE chooses through it (owned); NULL: by power */
 } iris_lights;
 
 /* Builds the light list. A scene without emitters gives count == 0 (renders black
@@ -127,8 +129,31 @@ float iris_lights_select_pmf(const iris_lights *lights, uint32_t index);
 /* Picks an entry in proportion to power with one uniform number; returns its
  * index and the pmf (0 when there is no light). */
 uint32_t iris_lights_select(const iris_lights *lights, float u, float *pmf);
-/* Probability with which iris_lights_sample, called at `ref`, picks entry `index`. */
-float iris_lights_select_pmf_at(const iris_lights *lights, iris_vec3 ref, uint32_t index);
+/* Probability with which iris_lights_sample, called at `ref` with normal `n`, picks entry `index`. */
+float iris_lights_select_pmf_at(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, uint32_t index);
+
+/* How next-event estimation chooses a light at a shading point: by power
+ * (groups by estimated irradiance, then entries by power, above) or through
+ * the light tree (renderer/light_tree.h: position, orientation and the
+ * receiver's normal). Every NEE function takes the shading point `ref` and
+ * its normal `n`: the shading normal on wo's side for reflecting BSDFs, the
+ * zero vector where light may come from any direction (transmission,
+ * volumes); the power sampler ignores n. docs/rendering.md, "Light tree". */
+typedef enum iris_light_sampler {
+  IRIS_LIGHT_SAMPLER_POWER = 0,
+  IRIS_LIGHT_SAMPLER_TREE = 1,
+  IRIS_LIGHT_SAMPLER_COUNT
+} iris_light_sampler;
+/* The choice of renders that do not say (measured: docs/performance.md, "Light tree"). */
+#define IRIS_LIGHT_SAMPLER_DEFAULT IRIS_LIGHT_SAMPLER_TREE
+const char *iris_light_sampler_name(iris_light_sampler s); /* "power", "tree" */
+bool iris_light_sampler_parse(const char *name, iris_light_sampler *out);
+/* Switches the NEE light choice (builds or frees the tree; a tree that
+ * would be a single leaf is not kept: lights->tree stays NULL and the power
+ * sampler, which chooses the same, serves). */
+iris_status iris_lights_set_sampler(iris_lights *lights, iris_light_sampler s, iris_error *err);
+/* The bounds the tree is given for entry i (exposed for tests). */
+iris_light_bounds iris_lights_bounds(const iris_lights *lights, uint32_t i);
 
 /* ---- next-event estimation -------------------------------------------- */
 
@@ -145,10 +170,10 @@ typedef struct iris_light_sample {
   uint32_t light;    /* entry index */
 } iris_light_sample;
 
-/* Samples a light as seen from `ref` (a surface point) with three uniform
+/* Samples a light as seen from `ref` (a surface point, normal n) with three uniform
  * numbers. Returns false when nothing was sampled (no lights, back face of a
  * one-sided emitter, zero-area triangle, outside a spot cone...). */
-bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select, float u0,
+bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, float u_select, float u0,
                         float u1, iris_light_sample *s);
 
 /* iris_lights_sample in two halves, so that the path tracer can choose the
@@ -161,8 +186,9 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, float u_select
 typedef struct iris_light_choice {
   uint32_t light;   /* entry index */
   float pmf_group;  /* probability of its group at ref; 0 = nothing to sample */
+  bool pmf_is_entry;/* the tree chose: pmf_group is the entry's own probability */
 } iris_light_choice;
-void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, float u_select,
+void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, float u_select,
                         iris_light_choice *c);
 bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
                                const iris_light_choice *c, float u0, float u1,
@@ -190,13 +216,13 @@ float iris_lights_triangle_solid_angle(const iris_light_tri *t, iris_vec3 ref);
  * one-sided emitters. */
 iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction *si, iris_vec3 d);
 /* Solid-angle pdf (selection included) that iris_lights_sample, called at
- * `ref`, returns the point si->p of an emissive triangle. */
-float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref,
+ * `ref` with normal n, returns the point si->p of an emissive triangle. */
+float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref, iris_vec3 n,
                                const iris_interaction *si);
 /* Environment radiance along direction d (a ray that escaped), and the
- * solid-angle pdf that iris_lights_sample, called at `ref`, returns d. */
+ * solid-angle pdf that iris_lights_sample, called at `ref` with normal n, returns d. */
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
-float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 d);
+float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, iris_vec3 d);
 
 /* ---- photon emission (guiding preprocess) ----------------------------- */
 

@@ -213,6 +213,10 @@ iris_status iris_merge_part_info_parse(const iris_image *img, const iris_image_m
   const char *sampler = meta_get(meta, meta_count, "iris:sampler");
   if (!copy_str(out->sampler, sizeof out->sampler, sampler ? sampler : "independent"))
     return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:sampler", "is too long to be iris's");
+  /* parts written before the light tree existed chose lights by power */
+  const char *light_sampler = meta_get(meta, meta_count, "iris:light_sampler");
+  if (!copy_str(out->light_sampler, sizeof out->light_sampler, light_sampler ? light_sampler : "power"))
+    return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:light_sampler", "is too long to be iris's");
   long long v[4];
   if (!parse_ints(spp, v, 1) || v[0] < 1)
     return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "iris:spp", "'%s' is not a sample count", spp);
@@ -325,6 +329,8 @@ iris_status iris_merge_add(iris_merge *m, const char *path, const iris_image *im
       return mismatch(err, path, "method", fi->method, in->method, f->path);
     if (strcmp(in->sampler, fi->sampler) != 0)
       return mismatch(err, path, "sampler", fi->sampler, in->sampler, f->path);
+    if (strcmp(in->light_sampler, fi->light_sampler) != 0)
+      return mismatch(err, path, "light sampler", fi->light_sampler, in->light_sampler, f->path);
     if (in->full_width != fi->full_width || in->full_height != fi->full_height) {
       char a[32], b[32];
       snprintf(a, sizeof a, "%dx%d", fi->full_width, fi->full_height);

@@ -33,6 +33,7 @@ typedef struct iris_merge_part_info {
   char config_hash[32]; /* iris:config_hash: size, camera, depths, guiding options */
   char method[32];      /* iris:method */
   char sampler[32];     /* iris:sampler ("independent" when absent) */
+  char light_sampler[32]; /* iris:light_sampler ("power" when absent) */
   char seed[32];        /* iris:seed */
   int full_width, full_height; /* iris:full_size (default: the image size) */
   int x0, y0, x1, y1;   /* iris:window, half-open, in full-frame pixels */

@@ -27,6 +27,7 @@ iris_render_params iris_render_params_default(void) {
   p.rr_depth = IRIS_DEFAULT_RR_DEPTH;
   p.threads = 0;
   p.keep_training = IRIS_KEEP_TRAINING_DEFAULT;
+  p.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
 
@@ -149,6 +150,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
+    /* the power sampler keeps the hash renders had before the light tree */
+    if (p.light_sampler != IRIS_LIGHT_SAMPLER_POWER)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_sampler, 0x7ee11ULL, 2);
   }
   /* What the render will need against what the machine has, before any of it
    * is built (docs/performance.md, "Memory estimate"). Logged (with the
@@ -186,6 +190,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   st = enter_phase(&p, st, "lights", "building the light tables", t0, err);
   if (st == IRIS_OK) st = iris_lights_build(scene, accel, &textures, &lights, err);
   if (st == IRIS_OK) iris_lights_set_triangle_sampling(&lights, p.light_sampling);
+  if (st == IRIS_OK) st = iris_lights_set_sampler(&lights, p.light_sampler, err);
   iris_integrator it;
   if (st == IRIS_OK) {
     it = iris_integrator_default(scene, accel, &lights, &textures);
@@ -237,6 +242,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   res->method = p.method;
   res->sampler = p.sampler;
   res->light_sampling = p.light_sampling;
+  res->light_sampler = p.light_sampler;
   res->seed = p.seed;
   res->threads = p.threads;
   double t1 = iris_time_now();
@@ -350,6 +356,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   if (r->method_reason[0]) META("method_reason", "%s", r->method_reason);
   META("sampler", "%s", iris_sampler_kind_name(r->sampler));
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
+  META("light_sampler", "%s", iris_light_sampler_name(r->light_sampler));
   META("spp", "%d", r->spp);
   META("train_spp", "%d", r->train_spp);
   META("seed", "%llu", (unsigned long long)r->seed);

@@ -80,6 +80,7 @@ typedef struct iris_render_params {
   iris_method method;       /* IRIS_METHOD_COUNT: the scene's, else auto */
   iris_sampler_kind sampler; /* default sobol (docs/rendering.md, "Samplers") */
   iris_triangle_sampling light_sampling; /* emitter triangles: default solid angle where it helps */
+  iris_light_sampler light_sampler; /* NEE's light choice (default IRIS_LIGHT_SAMPLER_DEFAULT) */
   int max_depth;            /* Cycles' bounce count; < 0: the scene's, else 64 */
   int rr_depth;             /* first bounce with Russian roulette */
   const char *camera_name;  /* NULL: the scene's first camera */
@@ -137,6 +138,7 @@ typedef struct iris_render_result {
                                                   indirect)"; otherwise "" */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
+  iris_light_sampler light_sampler;
   int spp;               /* samples per pixel completed in the image passes */
   int train_spp;         /* training samples per pixel also in the film (keep_training) */
   uint64_t seed;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "scenes/door.h"
+#include "scenes/office.h"
 #include "scenes/sky.h"
 #include "scenes/stress/stress.h"
 
@@ -15,7 +16,9 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     "stress-thin-walls", "stress-small-dim", "stress-closed-box",
                                     "stress-firefly", "stress-glossy-room",
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
-                                    "env-objects", "env-spheres", "sky-room", NULL};
+                                    "env-objects", "env-spheres", "sky-room",
+                                    /* 400 ceiling lamps (scenes/office.h) */
+                                    "office", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -327,6 +330,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = iris_sky_spheres_build(s);
   else if (strcmp(name, "sky-room") == 0)
     st = iris_sky_room_build(s);
+  else if (strcmp(name, "office") == 0)
+    st = iris_office_scene_build(s);
   else if (iris_stress_find(name))
     st = iris_stress_build(name, s);
   else

@@ -29,12 +29,14 @@ static void print_help(void) {
       "      --methods LIST   comma-separated: auto,bsdf,nee,mis,guided,guided-nee (default\n"
       "                       auto: guided-nee or mis per scene); a method may\n"
       "                       name its variant: mis@independent, mis@area,\n"
-      "                       mis@independent+area (sampler, emitter triangles)\n"
+      "                       mis@independent+area, mis@power (sampler, emitter\n"
+      "                       triangles, light sampler power|tree)\n"
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
-      "                       (--sampler and --light-sampling below: what a plain\n"
-      "                       name uses; the auto reference is always independent)\n"
+      "                       (--sampler, --light-sampling and --light-sampler\n"
+      "                       below: what a plain name uses; the auto reference\n"
+      "                       is always independent)\n"
       "      --width W, --height H   image size (default: the reference's, else the\n"
       "                       scene's; one of them: the other keeps the scene's aspect)\n"
       "      --max-depth B    bounces as Cycles counts them (default: the scene's, else 64)\n"
@@ -108,9 +110,10 @@ int iris_cmd_bench(int argc, char **argv) {
   /* the shared rows bench takes (tools/options.h); its own flags are below */
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
+  ro.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
                             iris_options_rows(&IRIS_RENDER_OPTIONS,
-                                             "threads,width,height,max-depth,sampler,light-sampling")};
+                                             "threads,width,height,max-depth,sampler,light-sampling,light-sampler")};
   for (int i = 1; i < argc; i++) {
     char name[64];
     const char *val;
@@ -199,6 +202,7 @@ int iris_cmd_bench(int argc, char **argv) {
   /* what a method named without @variant uses */
   iris_sampler_kind sampler = (iris_sampler_kind)ro.sampler;
   iris_triangle_sampling light_sampling = (iris_triangle_sampling)ro.light_sampling;
+  iris_light_sampler light_sampler = (iris_light_sampler)ro.light_sampler;
   if (iris_options_seen(&rb, "max-depth")) p.max_depth = ro.max_depth;
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;
@@ -230,18 +234,21 @@ int iris_cmd_bench(int argc, char **argv) {
       iris_method m;
       iris_sampler_kind smp;
       iris_triangle_sampling ls;
-      if (!iris_bench_method_parse(items[k], &m, &smp, &ls))
+      iris_light_sampler lsr;
+      if (!iris_bench_method_parse(items[k], &m, &smp, &lsr, &ls))
         return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee, "
-                                         "optionally @independent, @area or @independent+area)", items[k]);
+                                         "optionally @ and + joined independent, area, power, tree)", items[k]);
       /* --sampler and --light-sampling set what a plain name means */
       if (!strchr(items[k], '@')) {
         smp = sampler;
         ls = light_sampling;
+        lsr = light_sampler;
       }
       p.methods[p.method_count] = m;
       p.samplers[p.method_count] = smp;
       p.light_samplings[p.method_count] = ls;
       p.keep_training[p.method_count] = iris_bench_method_keeps_training(items[k]);
+      p.light_samplers[p.method_count] = lsr;
       char a[64], b[64];
       iris_bench_method_label(&p, p.method_count, a, sizeof a);
       for (int j = 0; j < p.method_count; j++)

@@ -210,6 +210,7 @@ int iris_cmd_render(int argc, char **argv) {
   memset(&rc_opts, 0, sizeof rc_opts);
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
+  ro.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   iris_env_options eo = iris_env_options_default();
   iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0, 0},
                                 {&PARTITION_OPTIONS, &rc_opts, 0, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0, 0},
@@ -235,6 +236,7 @@ int iris_cmd_render(int argc, char **argv) {
     return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee)", ro.method);
   p.sampler = (iris_sampler_kind)ro.sampler;               /* 0 (sobol) unless given */
   p.light_sampling = (iris_triangle_sampling)ro.light_sampling;
+  p.light_sampler = (iris_light_sampler)ro.light_sampler;
   if (iris_options_seen(rb, "max-depth")) p.max_depth = ro.max_depth;
   if (iris_options_seen(rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(rb, "width")) p.width = ro.width;
@@ -387,6 +389,7 @@ int iris_cmd_render(int argc, char **argv) {
     if (res.method_reason[0]) cJSON_AddStringToObject(o, "method_reason", res.method_reason);
     cJSON_AddStringToObject(o, "sampler", iris_sampler_kind_name(res.sampler));
     cJSON_AddStringToObject(o, "light_sampling", iris_triangle_sampling_name(res.light_sampling));
+    cJSON_AddStringToObject(o, "light_sampler", iris_light_sampler_name(res.light_sampler));
     cJSON_AddNumberToObject(o, "spp", res.spp);
     cJSON_AddNumberToObject(o, "sample_offset", (double)res.sample_offset);
     cJSON *win = cJSON_AddArrayToObject(o, "pixel_bounds");

@@ -133,9 +133,10 @@ int iris_cmd_validate(int argc, char **argv) {
   iris_option_binding envb = {&IRIS_ENV_OPTIONS, &eo, 0, 0};
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
+  ro.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
                             iris_options_rows(&IRIS_RENDER_OPTIONS,
-                                             "spp,seed,threads,width,height,max-depth,camera,sampler")};
+                                             "spp,seed,threads,width,height,max-depth,camera,sampler,light-sampler")};
   struct option longopts[sizeof own_opts / sizeof own_opts[0] + 2 * IRIS_OPTIONS_MAX_ROWS + 1];
   memset(longopts, 0, sizeof longopts);
   memcpy(longopts, own_opts, sizeof own_opts);
@@ -200,6 +201,7 @@ int iris_cmd_validate(int argc, char **argv) {
   if (p.quiet) iris_log_set_level(IRIS_LOG_QUIET);
   if (iris_options_seen(&rb, "spp")) p.spp = ro.spp;
   p.sampler = (iris_sampler_kind)ro.sampler; /* 0 (sobol) unless given */
+  p.light_sampler = (iris_light_sampler)ro.light_sampler;
   if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;

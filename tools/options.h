@@ -112,6 +112,7 @@ typedef struct iris_render_options {
   const char *method;
   int sampler;        /* iris_sampler_kind */
   int light_sampling; /* iris_triangle_sampling */
+  int light_sampler;  /* iris_light_sampler; commands set IRIS_LIGHT_SAMPLER_DEFAULT before parsing */
   int max_depth;
   int threads;
   int width, height;

@@ -46,10 +46,17 @@ extern char **environ;
 const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size) {
   const bool indep = p->samplers[k] == IRIS_SAMPLER_INDEPENDENT;
   const bool area = p->light_samplings[k] == IRIS_TRIANGLE_SAMPLING_AREA;
+  const bool tree = p->light_samplers[k] != IRIS_LIGHT_SAMPLER_DEFAULT; /* the other light sampler */
   const bool train = iris_method_uses_guiding(p->methods[k]) && p->keep_training[k] != IRIS_KEEP_TRAINING_DEFAULT;
-  snprintf(buf, size, "%s%s%s%s%s%s", iris_method_name(p->methods[k]), indep || area || train ? "@" : "",
-           indep ? "independent" : "", area ? (indep ? "+area" : "area") : "", train && (indep || area) ? "+" : "",
-           train ? (p->keep_training[k] ? "keep" : "discard") : "");
+  /* "@" and the non-default variants joined by "+" */
+  char suffix[64] = "";
+  const char *parts[4] = {indep ? "independent" : NULL, area ? "area" : NULL,
+                          tree ? iris_light_sampler_name(p->light_samplers[k]) : NULL,
+                          train ? (p->keep_training[k] ? "keep" : "discard") : NULL};
+  for (int i = 0; i < 4; i++)
+    if (parts[i])
+      snprintf(suffix + strlen(suffix), sizeof suffix - strlen(suffix), "%s%s", suffix[0] ? "+" : "@", parts[i]);
+  snprintf(buf, size, "%s%s", iris_method_name(p->methods[k]), suffix);
   return buf;
 }
 
@@ -60,13 +67,14 @@ bool iris_bench_method_keeps_training(const char *label) {
   return IRIS_KEEP_TRAINING_DEFAULT;
 }
 
-bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
+bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
                              iris_triangle_sampling *light) {
   char name[64];
   snprintf(name, sizeof name, "%s", label);
   char *at = strchr(name, '@');
   *sampler = IRIS_SAMPLER_SOBOL;
   *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
+  *light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   if (at) {
     *at++ = '\0';
     for (char *tok = strtok(at, "+"); tok; tok = strtok(NULL, "+")) {
@@ -80,6 +88,8 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
         *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
       else if (strcmp(tok, "keep") == 0 || strcmp(tok, "discard") == 0)
         ; /* iris_bench_method_keeps_training */
+      else if (iris_light_sampler_parse(tok, light_sampler))
+        ;
       else
         return false;
     }
@@ -93,6 +103,7 @@ iris_bench_params iris_bench_params_default(void) {
   for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.keep_training[k] = IRIS_KEEP_TRAINING_DEFAULT;
   p.seeds = 1;
   p.max_depth = -1;
+  for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.light_samplers[k] = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
 
@@ -709,13 +720,14 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
       for (int s = 0; s < p.seeds && st == IRIS_OK; s++)
         for (int k = 0; k < p.method_count && st == IRIS_OK; k++) {
           iris_method m = p.methods[k];
-          char label[32];
+          char label[64];
           iris_bench_method_label(&p, k, label, sizeof label);
           begin_run(&ctx, sc->name, label, p.times[t], (uint64_t)s, p.times[t]);
           iris_render_params rp = render_params(&p, sc, bs[i].max_depth, m, (uint64_t)s, &gp, &ctx);
           rp.sampler = p.samplers[k];
           rp.light_sampling = p.light_samplings[k];
           rp.keep_training = p.keep_training[k];
+          rp.light_sampler = p.light_samplers[k];
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;

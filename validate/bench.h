@@ -52,6 +52,7 @@ typedef struct iris_bench_params {
   /* guided methods: the training samples kept in the image or discarded
    * ("@keep" / "@discard" when not IRIS_KEEP_TRAINING_DEFAULT) */
   bool keep_training[IRIS_BENCH_MAX_METHODS];
+  iris_light_sampler light_samplers[IRIS_BENCH_MAX_METHODS]; /* NEE's light choice (@power, @tree) */
   int method_count;
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
@@ -78,20 +79,22 @@ typedef struct iris_bench_params {
 iris_bench_params iris_bench_params_default(void);
 
 /* Name of run variant k in results, tables and charts: the method's name,
- * followed by "@independent" and/or "@area" ("+area" after a sampler) when it
- * does not use the defaults (sobol, solid-angle): "mis", "mis@independent",
- * "mis@area", "mis@independent+area". iris_bench_method_parse reads it back. */
+ * followed by "@independent", "@area" and/or the light sampler ("@power" or
+ * "@tree", joined with "+") when it does not use the defaults (sobol,
+ * solid-angle, IRIS_LIGHT_SAMPLER_DEFAULT): "mis", "mis@independent",
+ * "mis@area", "mis@independent+area", "mis@power". iris_bench_method_parse
+ * reads it back. */
 const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf, size_t size);
 /* Whether a label asks for the training samples to be kept ("@keep"),
  * discarded ("@discard"), else IRIS_KEEP_TRAINING_DEFAULT. */
 bool iris_bench_method_keeps_training(const char *label);
-bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler,
+bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
                              iris_triangle_sampling *light);
 
 /* One render: a line of results.csv. method is a method name or "cycles". */
 typedef struct iris_bench_row {
   char scene[128];
-  char method[32];
+  char method[64];
   char resolved[32];     /* the method the paths used: auto's choice, else = method */
   char method_reason[200]; /* auto: "auto: guided-nee (75% of the photons indirect)"; else "" */
   uint64_t seed;

@@ -59,6 +59,7 @@ iris_validate_params iris_validate_params_default(void) {
   p.tolerance = IRIS_VALIDATE_DEFAULT_TOLERANCE;
   p.alpha = IRIS_METRIC_ALPHA;
   p.blender_spp = IRIS_VALIDATE_DEFAULT_BLENDER_SPP;
+  p.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
 
@@ -605,6 +606,7 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     rp.height = res->height;
     rp.spp = p.spp;
     rp.sampler = p.sampler;
+    rp.light_sampler = p.light_sampler;
     rp.seed = p.seed;
     rp.threads = p.threads;
     rp.method = p.methods[k];

@@ -61,6 +61,7 @@ typedef struct iris_validate_params {
   iris_method methods[IRIS_METHOD_COUNT];
   int method_count;         /* 0: mis */
   iris_sampler_kind sampler; /* iris's sampler (default sobol) */
+  iris_light_sampler light_sampler; /* NEE's light choice (default IRIS_LIGHT_SAMPLER_DEFAULT) */
   int spp;                  /* iris samples per pixel (0: IRIS_VALIDATE_DEFAULT_SPP) */
   uint64_t seed;
   int threads;              /* <= 0: all cores (iris and Blender) */

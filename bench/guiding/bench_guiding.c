@@ -2,6 +2,7 @@
  *               [--photons N] [--caches N] [--cache-res R] [--cache-k K]
  *               [--pdf-floor F] [--alpha-max A] [--cos-min C] [--bilinear | --nearest]
  *               [--train-spp N] [--train-prior W] [--train-all-light] [--no-learn-alpha]
+ *               [--keep-training | --discard-training]
  *               [--width W --height H] [--threads T] [--seed S]
  * Renders a built-in scene (or `door`) with iris_render and the guiding
  * provider, prints one line: scene method spp seconds setup relMSE. relMSE is
@@ -105,6 +106,8 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--train-prior")) gp.train_prior = (float)atof(v), ++i;
     else if (!strcmp(a, "--train-all-light")) gp.train_all_light = true;
     else if (!strcmp(a, "--no-learn-alpha")) gp.learn_alpha = false;
+    else if (!strcmp(a, "--keep-training")) p.keep_training = true;
+    else if (!strcmp(a, "--discard-training")) p.keep_training = false;
     else if (!strcmp(a, "--width")) p.width = atoi(v), ++i;
     else if (!strcmp(a, "--height")) p.height = atoi(v), ++i;
     else if (!strcmp(a, "--threads")) p.threads = atoi(v), ++i;

@@ -551,6 +551,9 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   }
   bool area_only = s->lights && s->lights->tri_count > 0 && (s->lights->tris[0].flags & IRIS_LIGHT_TRI_AREA_ONLY);
   h = mix_u64(h, area_only);
+  /* training's light samples choose through the tree or by power; the power
+   * sampler keeps the hash guides had before the tree */
+  if (s->lights && s->lights->tree) h = mix_u64(h, 0x7ee11ULL);
   /* The guiding options as requested (auto values resolve the same way from
    * the same scene and camera). train_spp enters as given: with -1 (auto)
    * the training budget follows the writer's spp/time, which are left out so

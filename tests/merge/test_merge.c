@@ -202,6 +202,7 @@ typedef struct job {
 } job;
 
 static iris_guiding_params g_gp;
+static iris_light_sampler g_light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT; /* of every render_to */
 
 static bool render_to(const iris_scene *s, job j, const char *name, iris_render_result *keep) {
   iris_render_params p = iris_render_params_default();
@@ -214,6 +215,7 @@ static bool render_to(const iris_scene *s, job j, const char *name, iris_render_
   p.threads = j.threads;
   p.sample_offset = j.offset;
   p.bounds = j.bounds;
+  p.light_sampler = g_light_sampler;
   if (iris_method_uses_guiding(j.method)) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &g_gp;
@@ -397,6 +399,10 @@ static void test_refusals(const iris_scene *cornell) {
   j = h2;
   j.max_depth = 3;
   render_to(cornell, j, "r-depth.exr", NULL);
+  g_light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT == IRIS_LIGHT_SAMPLER_TREE ? IRIS_LIGHT_SAMPLER_POWER
+                                                                          : IRIS_LIGHT_SAMPLER_TREE;
+  render_to(cornell, h2, "r-lights.exr", NULL);
+  g_light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   j = h;
   j.offset = 2;
   render_to(cornell, j, "r-overlap.exr", NULL);
@@ -425,6 +431,8 @@ static void test_refusals(const iris_scene *cornell) {
   expect_refusal(seed, 2, "seed");
   const char *method[2] = {"r-a.exr", "r-method.exr"};
   expect_refusal(method, 2, "method");
+  const char *lights[2] = {"r-a.exr", "r-lights.exr"};
+  expect_refusal(lights, 2, "light sampler");
   const char *scene[2] = {"r-a.exr", "r-scene.exr"};
   expect_refusal(scene, 2, "scene hash");
   const char *depth[2] = {"r-a.exr", "r-depth.exr"};

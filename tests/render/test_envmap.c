@@ -70,13 +70,13 @@ typedef struct lctx {
 static bool light_sample(void *vc, const double u[3], double dir[3]) {
   lctx *c = (lctx *)vc;
   iris_light_sample s;
-  if (!iris_lights_sample(c->lights, c->ref, (float)u[0], (float)u[1], (float)u[2], &s)) return false;
+  if (!iris_lights_sample(c->lights, c->ref, iris_v3(0, 0, 0), (float)u[0], (float)u[1], (float)u[2], &s)) return false;
   dir[0] = s.wi.x, dir[1] = s.wi.y, dir[2] = s.wi.z;
   return true;
 }
 static double light_pdf(void *vc, const double dir[3]) {
   lctx *c = (lctx *)vc;
-  return iris_lights_pdf_environment(c->lights, c->ref,
+  return iris_lights_pdf_environment(c->lights, c->ref, iris_v3(0, 0, 0),
                                      iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
 }
 

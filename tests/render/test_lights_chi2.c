@@ -22,7 +22,7 @@ typedef struct ctx {
 static bool sample_fn(void *vc, const double u[3], double dir[3]) {
   ctx *c = (ctx *)vc;
   iris_light_sample s;
-  if (!iris_lights_sample(c->lights, c->ref, (float)u[0], (float)u[1], (float)u[2], &s)) return false;
+  if (!iris_lights_sample(c->lights, c->ref, iris_v3(0, 0, 0), (float)u[0], (float)u[1], (float)u[2], &s)) return false;
   if (s.delta) return false;
   dir[0] = s.wi.x, dir[1] = s.wi.y, dir[2] = s.wi.z;
   return true;
@@ -31,13 +31,13 @@ static bool sample_fn(void *vc, const double u[3], double dir[3]) {
 static double pdf_fn(void *vc, const double dir[3]) {
   ctx *c = (ctx *)vc;
   iris_vec3 d = iris_normalize(iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
-  double pdf = iris_lights_pdf_environment(c->lights, c->ref, d);
+  double pdf = iris_lights_pdf_environment(c->lights, c->ref, iris_v3(0, 0, 0), d);
   iris_ray r = {c->ref, 0.0f, d, INFINITY};
   iris_hit h;
   if (iris_accel_intersect(c->accel, &r, &h)) {
     iris_interaction si;
     iris_accel_interaction(c->accel, d, &h, &si);
-    pdf += iris_lights_pdf_triangle(c->lights, c->ref, &si);
+    pdf += iris_lights_pdf_triangle(c->lights, c->ref, iris_v3(0, 0, 0), &si);
   }
   return pdf;
 }
