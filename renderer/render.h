@@ -23,7 +23,7 @@ extern "C" {
 #define IRIS_RENDER_DEFAULT_SPP 64
 /* Whether the guide's training samples go into the image by default
  * (iris_render_params.keep_training; docs/guiding.md, "Training samples"). */
-#define IRIS_KEEP_TRAINING_DEFAULT false
+#define IRIS_KEEP_TRAINING_DEFAULT true
 
 /* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
 typedef struct iris_pixel_bounds {

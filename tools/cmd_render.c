@@ -336,7 +336,7 @@ int iris_cmd_render(int argc, char **argv) {
   progress_state ps = {!quiet && !json && iris_log_progress_enabled(), 0};
   /* Guide only: the guide is built (and written by the provider), no pass runs. */
   p.no_passes = guide_only;
-  p.keep_training = gp.keep_training;
+  p.keep_training = !gp.discard_training;
   p.cancel = iris_cli_stop_flag();
   p.progress = draw_progress;
   p.progress_ctx = &ps;

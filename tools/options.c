@@ -103,9 +103,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("train-prior", 0, IRIS_OPT_FLOAT, "W", 0, 1e9, iris_guiding_params, train_prior,
         "photon-equivalent weight of a cache's photons against its\n"
         "n training samples, mixed n / (n + W) (default 200)"),
-    OPT("keep-training", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, keep_training,
-        "add the training passes' paths to the image (unbiased\n"
-        "samples of each pixel; docs/guiding.md)"),
+    OPT("discard-training", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, discard_training,
+        "leave the training passes' paths out of the image (by\n"
+        "default they are in it: unbiased samples of each pixel)"),
     OPT("train-all-light", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, train_all_light,
         "train towards all incident light, not only the part light\n"
         "sampling leaves to the sampled direction"),

@@ -61,8 +61,8 @@ typedef struct iris_guiding_params {
                            n path samples: mixed with weight n / (n + prior) (--train-prior) */
   bool train_all_light; /* train towards all incident light, not only what light sampling's MIS
                            leaves to the sampled direction (--train-all-light) */
-  bool keep_training;   /* the training paths' radiance goes into the image too
-                           (--keep-training; iris_render_params.keep_training) */
+  bool discard_training; /* leave the training paths out of the image (--discard-training;
+                            iris_render_params.keep_training is the renderer's switch) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):

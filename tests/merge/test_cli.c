@@ -107,11 +107,11 @@ int main(int argc, char **argv) {
   EXPECT_RUN("merge t3.exr t1.exr t0.exr t2.exr -o tiles.exr --json", 0, "\"windows\":\t4");
   expect_close("tiles.exr", "full.exr");
 
-  /* guided-nee keeping its training samples (3 spp, the same guide in every
+  /* guided-nee keeping its training samples (the default; 3 spp, the same guide in every
    * part): the part at sample 0 holds them, the later part does not, and the
    * merge equals the single render that kept them */
 #define G "render door --width 24 --height 16 --threads 2 --quiet --method guided-nee --photons 20000 " \
-          "--train-spp 3 --keep-training "
+          "--train-spp 3 "
   EXPECT_RUN(G "--spp 6 -o gfull.exr", 0, "");
   EXPECT_RUN(G "--spp 4 -o g0.exr", 0, "");
   EXPECT_RUN(G "--spp 2 --sample-offset 4 -o g1.exr", 0, "");
@@ -122,6 +122,8 @@ int main(int argc, char **argv) {
   expect_close("gm.exr", "gfull.exr");
   CHECK_EQ_STR(meta_value("gm.exr", "iris:train_spp", v, sizeof v), "3");
   CHECK_EQ_STR(meta_value("gm.exr", "iris:spp", v, sizeof v), "6");
+  EXPECT_RUN(G "--spp 4 --discard-training -o gd.exr", 0, "");
+  CHECK_EQ_STR(meta_value("gd.exr", "iris:train_spp", v, sizeof v), "0");
 #undef G
 
   /* refusals: exit 2, one line naming the part, no output */
