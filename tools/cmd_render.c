@@ -391,6 +391,7 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_AddStringToObject(o, "light_sampling", iris_triangle_sampling_name(res.light_sampling));
     cJSON_AddStringToObject(o, "light_sampler", iris_light_sampler_name(res.light_sampler));
     cJSON_AddNumberToObject(o, "spp", res.spp);
+    cJSON_AddNumberToObject(o, "train_spp", res.train_spp);
     cJSON_AddNumberToObject(o, "sample_offset", (double)res.sample_offset);
     cJSON *win = cJSON_AddArrayToObject(o, "pixel_bounds");
     int wb[4] = {res.bounds.x0, res.bounds.y0, res.bounds.x1, res.bounds.y1};
