@@ -414,8 +414,10 @@ int iris_cmd_render(int argc, char **argv) {
     free(text);
     cJSON_Delete(o);
   } else if (!quiet) {
-    iris_infof("render: %s, %dx%d, %d spp (%s), %.2f s, %.2f Msamples/s, %.1f Mrays/s%s",
-               input, res.film.width, res.film.height, res.spp,
+    char train[48] = "";
+    if (res.train_spp > 0) snprintf(train, sizeof train, " + %d training spp", res.train_spp);
+    iris_infof("render: %s, %dx%d, %d spp%s (%s), %.2f s, %.2f Msamples/s, %.1f Mrays/s%s",
+               input, res.film.width, res.film.height, res.spp, train,
                res.method_reason[0] ? res.method_reason : iris_method_name(res.method),
                res.seconds, res.seconds > 0 ? samples / res.seconds * 1e-6 : 0.0,
                res.seconds > 0 ? rays / res.seconds * 1e-6 : 0.0,
