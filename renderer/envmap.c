@@ -101,12 +101,39 @@ iris_status iris_envmap_check(const char *path, iris_error *err) {
 
 void iris_envmap_destroy(iris_envmap *env) {
   if (!env) return;
-  if (env->cols)
-    for (int r = 0; r < env->height; r++) iris_distrib1d_destroy(&env->cols[r]);
-  free(env->cols);
-  iris_distrib1d_destroy(&env->rows);
+  free(env->row_cdf);
+  free(env->cdf);
+  free(env->coarse);
   free(env->rgb);
   memset(env, 0, sizeof *env);
+}
+
+/* cdf[0..n] of n weights, accumulated in double; uniform when all are 0; 1
+ * exactly from the entry after the last positive weight on, so that rounding
+ * never hands a sample to a zero-weight tail. Returns the weights' sum. */
+static double build_cdf(const float *w, int n, float *cdf) {
+  double sum = 0.0;
+  for (int i = 0; i < n; i++) sum += w[i];
+  double acc = 0.0;
+  cdf[0] = 0.0f;
+  for (int i = 0; i < n; i++) {
+    acc += sum > 0.0 ? (double)w[i] / sum : 1.0 / n;
+    cdf[i + 1] = (float)acc;
+  }
+  int last = n;
+  while (last > 1 && sum > 0.0 && !(w[last - 1] > 0.0f)) --last;
+  for (int i = last; i <= n; i++) cdf[i] = 1.0f;
+  return sum;
+}
+
+/* Largest i in [lo, hi) with cdf[i] <= u, given cdf[lo] <= u (binary search). */
+static int search_cdf(const float *cdf, int lo, int hi, float u) {
+  while (hi - lo > 1) {
+    int mid = lo + (hi - lo) / 2;
+    if (cdf[mid] <= u) lo = mid;
+    else hi = mid;
+  }
+  return lo;
 }
 
 /* Periodic index (Cycles' EXTENSION_REPEAT, which its Environment Texture uses on both axes). */
@@ -137,13 +164,18 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
   out->sin_rot = sinf(rad);
   size_t n = (size_t)W * (size_t)H;
   for (size_t i = 0; i < 3 * n; i++) out->rgb[i] *= map->strength;
-  out->cols = calloc((size_t)H, sizeof *out->cols);
+  out->blocks = (W + IRIS_ENVMAP_BLOCK - 1) / IRIS_ENVMAP_BLOCK;
+  out->stride = (W + 1 + 15) / 16 * 16; /* 64-byte rows */
+  out->pdf_scale = (float)((double)W * (double)H / (2.0 * IRIS_PI * IRIS_PI));
+  out->row_cdf = malloc(sizeof(float) * ((size_t)H + 1));
+  out->cdf = aligned_alloc(64, sizeof(float) * (size_t)out->stride * (size_t)H);
+  out->coarse = malloc(sizeof(float) * ((size_t)out->blocks + 1) * (size_t)H);
   float *w = malloc(sizeof(float) * (size_t)(W > H ? W : H));
-  float *roww = malloc(sizeof(float) * (size_t)H);
+  float *roww = calloc((size_t)H + 1, sizeof(float));
   float *lum = malloc(sizeof(float) * n);
   double *hrow = malloc(sizeof(double) * 3 * (size_t)W); /* one row blurred across, 3 rows kept */
   double *rowmean = malloc(sizeof(double) * 4 * (size_t)H); /* per row: mean L (lum, r, g, b) */
-  if (!out->cols || !w || !roww || !lum || !hrow || !rowmean) {
+  if (!out->row_cdf || !out->cdf || !out->coarse || !w || !roww || !lum || !hrow || !rowmean) {
     free(w), free(roww), free(lum), free(hrow), free(rowmean);
     iris_envmap_destroy(out);
     return iris_error_set(err, IRIS_ERR_NOMEM, map->path, 0, NULL, "out of memory for the environment map");
@@ -173,17 +205,18 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
         hrow[(size_t)k * (size_t)W + (size_t)x] =
             0.125 * row[wrap(x - 1, W)] + 0.75 * row[x] + 0.125 * row[wrap(x + 1, W)];
     }
-    double sum = 0.0;
     for (int x = 0; x < W; x++) {
       double b = 0.125 * hrow[x] + 0.75 * hrow[(size_t)W + (size_t)x] + 0.125 * hrow[2 * (size_t)W + (size_t)x];
       w[x] = (float)b * sin_c;
-      sum += w[x];
     }
-    roww[y] = (float)sum;
-    st = iris_distrib1d_create(&out->cols[y], w, (size_t)W, err);
-    if (st != IRIS_OK) break;
+    float *cdf = &out->cdf[(size_t)y * (size_t)out->stride];
+    roww[y] = (float)build_cdf(w, W, cdf);
+    for (int x = W + 1; x < out->stride; x++) cdf[x] = 1.0f;
+    float *coarse = &out->coarse[(size_t)y * ((size_t)out->blocks + 1)];
+    for (int k = 0; k < out->blocks; k++) coarse[k] = cdf[k * IRIS_ENVMAP_BLOCK];
+    coarse[out->blocks] = cdf[W];
   }
-  if (st == IRIS_OK) st = iris_distrib1d_create(&out->rows, roww, (size_t)H, err);
+  build_cdf(roww, H, out->row_cdf); /* a black map: uniform, and the lights leave it out */
   /* Means: the exact integral of the bilinear interpolant over the sphere. Row r's
    * tent spans t in [(r - 1/2)/H, (r + 3/2)/H], periodic (the half rows at the
    * poles blend the top and bottom rows, as Cycles' repeat extension does). */
@@ -250,6 +283,11 @@ static void texel_of(const iris_envmap *env, float s, float t, int *x, int *y) {
 iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d) {
   float s, t;
   iris_envmap_dir_to_st(env, d, &s, &t);
+  return iris_envmap_radiance_st(env, s, t);
+}
+
+/* Bilinear lookup at map coordinates; see iris_envmap_radiance. */
+iris_vec3 iris_envmap_radiance_st(const iris_envmap *env, float s, float t) {
   const int W = env->width, H = env->height;
   float fx = s * (float)W - 0.5f, fy = t * (float)H - 0.5f;
   if (!isfinite(fx) || !isfinite(fy)) return iris_v3(0, 0, 0);
@@ -267,25 +305,57 @@ iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d) {
                  w00 * c00[2] + w10 * c10[2] + w01 * c01[2] + w11 * c11[2]);
 }
 
-bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf) {
-  float pr, pc, ur, uc;
-  size_t y = iris_distrib1d_sample(&env->rows, u0, &pr, &ur);
-  size_t x = iris_distrib1d_sample(&env->cols[y], u1, &pc, &uc);
-  float t = ((float)y + ur) / (float)env->height, s = ((float)x + uc) / (float)env->width;
+/* The cell's probability: the row's times the cell's within it, both CDF
+ * differences (the measure of the u that choose them). */
+static float cell_probability(const iris_envmap *env, int x, int y) {
+  const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
+  return (env->row_cdf[y + 1] - env->row_cdf[y]) * (cdf[x + 1] - cdf[x]);
+}
+
+bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf,
+                        iris_vec3 *radiance) {
+  const int W = env->width, H = env->height, B = IRIS_ENVMAP_BLOCK;
+  if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return false;
+  /* row: largest y with row_cdf[y] <= u0 (row_cdf[H] = 1 > u0) */
+  int y = search_cdf(env->row_cdf, 0, H, u0);
+  float r0 = env->row_cdf[y], r1 = env->row_cdf[y + 1];
+  if (!(r1 > r0)) return false;
+  float ur = iris_clampf((u0 - r0) / (r1 - r0), 0.0f, 0x1.fffffep-1f);
+  /* cell: the block from the coarse CDF, then the cell within the block's line */
+  const float *coarse = &env->coarse[(size_t)y * ((size_t)env->blocks + 1)];
+  int k = search_cdf(coarse, 0, env->blocks, u1);
+  const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
+  int lo = k * B, hi = lo + B < W ? lo + B : W;
+  int x = search_cdf(cdf, lo, hi, u1);
+  float c0 = cdf[x], c1 = x + 1 == hi ? coarse[k + 1] : cdf[x + 1];
+  if (!(c1 > c0)) return false;
+  float uc = iris_clampf((u1 - c0) / (c1 - c0), 0.0f, 0x1.fffffep-1f);
+  float t = ((float)y + ur) / (float)H, s = ((float)x + uc) / (float)W;
   float sin_t = sinf(t * IRIS_PI);
-  if (!(pr > 0.0f) || !(pc > 0.0f) || !(sin_t > 0.0f)) return false;
+  if (!(sin_t > 0.0f)) return false;
   *d = iris_envmap_st_to_dir(env, s, t);
-  *pdf = pr * pc * (float)env->width * (float)env->height / (2.0f * IRIS_PI * IRIS_PI * sin_t);
+  *pdf = (r1 - r0) * (c1 - c0) * env->pdf_scale / sin_t;
+  if (radiance) *radiance = iris_envmap_radiance_st(env, s, t);
   return isfinite(*pdf) && *pdf > 0.0f;
+}
+
+static float pdf_st(const iris_envmap *env, float s, float t) {
+  float sin_t = sinf(t * IRIS_PI);
+  if (!(sin_t > 0.0f)) return 0.0f;
+  int x, y;
+  texel_of(env, s, t, &x, &y);
+  return cell_probability(env, x, y) * env->pdf_scale / sin_t;
 }
 
 float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d) {
   float s, t;
-  int x, y;
   iris_envmap_dir_to_st(env, d, &s, &t);
-  float sin_t = sinf(t * IRIS_PI);
-  if (!(sin_t > 0.0f)) return 0.0f;
-  texel_of(env, s, t, &x, &y);
-  float p = iris_distrib1d_pmf(&env->rows, (size_t)y) * iris_distrib1d_pmf(&env->cols[y], (size_t)x);
-  return p * (float)env->width * (float)env->height / (2.0f * IRIS_PI * IRIS_PI * sin_t);
+  return pdf_st(env, s, t);
+}
+
+iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf) {
+  float s, t;
+  iris_envmap_dir_to_st(env, d, &s, &t);
+  if (pdf) *pdf = pdf_st(env, s, t);
+  return iris_envmap_radiance_st(env, s, t);
 }

@@ -21,21 +21,33 @@
 extern "C" {
 #endif
 
+/* The sampling tables are laid out for the few cache lines a sample touches
+ * (docs/rendering.md, "Environment maps"): the rows' CDF (small, stays in
+ * cache), then per row a coarse CDF at every 16th cell boundary (all rows
+ * together ~1/16 of the map's texel count, stays in L2) and the full CDF,
+ * each row 64-byte aligned, so that the search within a block of 16 cells
+ * reads one cache line. Probabilities are CDF differences, which are exactly
+ * the measure of the numbers u that pick a cell, and the pdf reads the same
+ * two entries. */
+#define IRIS_ENVMAP_BLOCK 16
 typedef struct iris_envmap {
   int width, height;
   float *rgb;             /* 3 * width * height, linear radiance (strength applied), row 0 top */
   float cos_rot, sin_rot; /* rotation about +Y */
-  iris_distrib1d rows;    /* marginal over rows: sum of the row's weights */
-  iris_distrib1d *cols;   /* one conditional per row (height of them) */
+  float *row_cdf;         /* height + 1 entries: marginal CDF over rows */
+  float *cdf;             /* height rows of `stride` floats: row y's CDF over its cells, width + 1 used */
+  float *coarse;          /* height rows of `blocks + 1` floats: cdf at cells 0, 16, 32, ..., width */
+  int stride, blocks;
+  float pdf_scale;        /* width * height / (2 pi^2): cell probability to solid-angle density times sin */
   double mean_luminance;  /* (1 / 4pi) * integral of the luminance over the sphere */
   float mean_rgb[3];      /* the same per channel */
 } iris_envmap;
 
 /* Reads and checks the map (extension .exr or .hdr, or by the file's magic):
- * a missing, unreadable or empty file, one with NaN, Inf or negative texels,
- * or a map that is black everywhere is an error naming the file; a map that
- * is not 2:1 gets a warning (it is still usable). Then builds the sampling
- * tables. */
+ * a missing, unreadable or empty file, or one with NaN, Inf or negative
+ * texels is an error naming the file; a map that is not 2:1 gets a warning
+ * (it is still usable). Then builds the sampling tables (uniform for a map
+ * that is black everywhere, which iris_lights leaves out: mean_luminance 0). */
 iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, iris_error *err);
 /* Only the checks of iris_envmap_load (for commands that do not render). */
 iris_status iris_envmap_check(const char *path, iris_error *err);
@@ -50,11 +62,17 @@ iris_vec3 iris_envmap_st_to_dir(const iris_envmap *env, float s, float t);
  * bilinear interpolation of the four texels around (s, t), texel centres at
  * half-integers, wrapped periodically on both axes (Cycles' repeat). */
 iris_vec3 iris_envmap_radiance(const iris_envmap *env, iris_vec3 d);
+/* The same at map coordinates (s, t) (no trigonometry). */
+iris_vec3 iris_envmap_radiance_st(const iris_envmap *env, float s, float t);
 /* Samples a direction with two uniform numbers; returns false when nothing
- * can be sampled. *pdf is the solid-angle density. */
-bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf);
+ * can be sampled. *pdf is the solid-angle density; *radiance (optional) the
+ * radiance from *d, as iris_envmap_radiance gives it. */
+bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf,
+                        iris_vec3 *radiance);
 /* Solid-angle density with which iris_envmap_sample returns d. */
 float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
+/* Radiance from d and (optional) that density, with one conversion of d. */
+iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf);
 
 #ifdef __cplusplus
 }

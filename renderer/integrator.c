@@ -265,11 +265,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
-      iris_vec3 le = iris_lights_environment(it->lights, ray.d);
+      float env_pdf = 0.0f;
+      iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
+                                                 !prev_delta && mis ? &env_pdf : NULL);
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
         float w = 1.0f;
-        if (!prev_delta && nee)
-          w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_environment(it->lights, prev_p, prev_n, ray.d)) : 0.0f;
+        if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
         if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }

@@ -715,8 +715,7 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     default: {
       if (lights->envmap) {
         float pdf;
-        if (!iris_envmap_sample(lights->envmap, u0, u1, &s->wi, &pdf)) return false;
-        s->L = iris_envmap_radiance(lights->envmap, s->wi);
+        if (!iris_envmap_sample(lights->envmap, u0, u1, &s->wi, &pdf, &s->L)) return false;
         s->pdf = pmf * pdf;
       } else {
         s->wi = iris_sample_uniform_sphere(u0, u1);
@@ -766,6 +765,19 @@ float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris
   float pdf = lights->envmap ? iris_envmap_pdf(lights->envmap, iris_normalize(d))
                              : iris_sample_uniform_sphere_pdf();
   return iris_lights_select_pmf_at(lights, ref, n, (uint32_t)lights->environment) * pdf;
+}
+
+iris_vec3 iris_lights_environment_pdf(const iris_lights *lights, iris_vec3 d, iris_vec3 ref, iris_vec3 n,
+                                      float *pdf) {
+  if (!pdf) return iris_lights_environment(lights, d);
+  *pdf = 0.0f;
+  if (lights->environment < 0) return iris_v3(0, 0, 0);
+  float map_pdf = iris_sample_uniform_sphere_pdf();
+  iris_vec3 L = lights->envmap ? iris_envmap_eval(lights->envmap, iris_normalize(d), &map_pdf)
+                               : lights->entries[lights->environment].radiance;
+  if (L.x > 0.0f || L.y > 0.0f || L.z > 0.0f)
+    *pdf = iris_lights_select_pmf_at(lights, ref, n, (uint32_t)lights->environment) * map_pdf;
+  return L;
 }
 
 iris_status iris_lights_emission_selection(const iris_lights *lights, iris_emission_selection by,
@@ -864,8 +876,7 @@ bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_dist
         e->pdf_dir = 1.0f;
       } else if (lights->envmap) { /* photons travel against the sampled incident direction */
         iris_vec3 wi;
-        if (!iris_envmap_sample(lights->envmap, u2, u3, &wi, &e->pdf_dir)) return false;
-        radiance = iris_envmap_radiance(lights->envmap, wi);
+        if (!iris_envmap_sample(lights->envmap, u2, u3, &wi, &e->pdf_dir, &radiance)) return false;
         e->dir = iris_neg(wi);
       } else {
         e->dir = iris_sample_uniform_sphere(u2, u3);

@@ -223,6 +223,10 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref, iris_ve
  * solid-angle pdf that iris_lights_sample, called at `ref` with normal n, returns d. */
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
 float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, iris_vec3 d);
+/* Both with one lookup of d: the radiance, and in *pdf (when not NULL) the
+ * value of iris_lights_pdf_environment(lights, ref, n, d). */
+iris_vec3 iris_lights_environment_pdf(const iris_lights *lights, iris_vec3 d, iris_vec3 ref, iris_vec3 n,
+                                      float *pdf);
 
 /* ---- photon emission (guiding preprocess) ----------------------------- */
 

@@ -35,7 +35,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     for (int i = 0; i < 16; i++) {
       iris_vec3 d;
       float pdf;
-      if (iris_envmap_sample(&env, (float)i / 16.0f, (float)((i * 7) % 16) / 16.0f, &d, &pdf) &&
+      if (iris_envmap_sample(&env, (float)i / 16.0f, (float)((i * 7) % 16) / 16.0f, &d, &pdf, NULL) &&
           !(pdf > 0.0f && pdf < INFINITY))
         __builtin_trap();
     }

@@ -55,7 +55,7 @@ static void write_map(const char *path, int w, int h, int kind) {
 static bool env_sample(void *ctx, const double u[3], double dir[3]) {
   iris_vec3 d;
   float pdf;
-  if (!iris_envmap_sample((const iris_envmap *)ctx, (float)u[0], (float)u[1], &d, &pdf)) return false;
+  if (!iris_envmap_sample((const iris_envmap *)ctx, (float)u[0], (float)u[1], &d, &pdf, NULL)) return false;
   dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
   return true;
 }
