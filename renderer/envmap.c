@@ -103,7 +103,7 @@ void iris_envmap_destroy(iris_envmap *env) {
   if (!env) return;
   free(env->row_cdf);
   free(env->cdf);
-  free(env->coarse);
+  free(env->guide);
   free(env->rgb);
   memset(env, 0, sizeof *env);
 }
@@ -169,13 +169,13 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
   out->pdf_scale = (float)((double)W * (double)H / (2.0 * IRIS_PI * IRIS_PI));
   out->row_cdf = malloc(sizeof(float) * ((size_t)H + 1));
   out->cdf = aligned_alloc(64, sizeof(float) * (size_t)out->stride * (size_t)H);
-  out->coarse = malloc(sizeof(float) * ((size_t)out->blocks + 1) * (size_t)H);
+  out->guide = malloc(sizeof(uint32_t) * (size_t)out->blocks * (size_t)H);
   float *w = malloc(sizeof(float) * (size_t)(W > H ? W : H));
   float *roww = calloc((size_t)H + 1, sizeof(float));
   float *lum = malloc(sizeof(float) * n);
   double *hrow = malloc(sizeof(double) * 3 * (size_t)W); /* one row blurred across, 3 rows kept */
   double *rowmean = malloc(sizeof(double) * 4 * (size_t)H); /* per row: mean L (lum, r, g, b) */
-  if (!out->row_cdf || !out->cdf || !out->coarse || !w || !roww || !lum || !hrow || !rowmean) {
+  if (!out->row_cdf || !out->cdf || !out->guide || !w || !roww || !lum || !hrow || !rowmean) {
     free(w), free(roww), free(lum), free(hrow), free(rowmean);
     iris_envmap_destroy(out);
     return iris_error_set(err, IRIS_ERR_NOMEM, map->path, 0, NULL, "out of memory for the environment map");
@@ -212,9 +212,12 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
     float *cdf = &out->cdf[(size_t)y * (size_t)out->stride];
     roww[y] = (float)build_cdf(w, W, cdf);
     for (int x = W + 1; x < out->stride; x++) cdf[x] = 1.0f;
-    float *coarse = &out->coarse[(size_t)y * ((size_t)out->blocks + 1)];
-    for (int k = 0; k < out->blocks; k++) coarse[k] = cdf[k * IRIS_ENVMAP_BLOCK];
-    coarse[out->blocks] = cdf[W];
+    uint32_t *guide = &out->guide[(size_t)y * (size_t)out->blocks];
+    for (int j = 0, x = 0; j < out->blocks; j++) {
+      float lo = (float)j / (float)out->blocks;
+      while (x + 1 < W && cdf[x + 1] <= lo) x++;
+      guide[j] = (uint32_t)x;
+    }
   }
   build_cdf(roww, H, out->row_cdf); /* a black map: uniform, and the lights leave it out */
   /* Means: the exact integral of the bilinear interpolant over the sphere. Row r's
@@ -314,20 +317,32 @@ static float cell_probability(const iris_envmap *env, int x, int y) {
 
 bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf,
                         iris_vec3 *radiance) {
-  const int W = env->width, H = env->height, B = IRIS_ENVMAP_BLOCK;
+  float s, t;
+  if (!iris_envmap_sample_st(env, u0, u1, d, pdf, &s, &t)) return false;
+  if (radiance) *radiance = iris_envmap_radiance_st(env, s, t);
+  return true;
+}
+
+bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf, float *s_out,
+                           float *t_out) {
+  const int W = env->width, H = env->height;
   if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return false;
   /* row: largest y with row_cdf[y] <= u0 (row_cdf[H] = 1 > u0) */
   int y = search_cdf(env->row_cdf, 0, H, u0);
   float r0 = env->row_cdf[y], r1 = env->row_cdf[y + 1];
   if (!(r1 > r0)) return false;
   float ur = iris_clampf((u0 - r0) / (r1 - r0), 0.0f, 0x1.fffffep-1f);
-  /* cell: the block from the coarse CDF, then the cell within the block's line */
-  const float *coarse = &env->coarse[(size_t)y * ((size_t)env->blocks + 1)];
-  int k = search_cdf(coarse, 0, env->blocks, u1);
+  /* cell: the guide entry bounds the search (the walks mend u * blocks's rounding) */
   const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
-  int lo = k * B, hi = lo + B < W ? lo + B : W;
+  const uint32_t *guide = &env->guide[(size_t)y * (size_t)env->blocks];
+  int j = (int)(u1 * (float)env->blocks);
+  j = j < 0 ? 0 : j >= env->blocks ? env->blocks - 1 : j;
+  int lo = (int)guide[j], hi = j + 1 < env->blocks ? (int)guide[j + 1] + 1 : W;
+  while (lo > 0 && cdf[lo] > u1) --lo;
+  if (hi <= lo) hi = lo + 1;
+  while (hi < W && cdf[hi] <= u1) ++hi;
   int x = search_cdf(cdf, lo, hi, u1);
-  float c0 = cdf[x], c1 = x + 1 == hi ? coarse[k + 1] : cdf[x + 1];
+  float c0 = cdf[x], c1 = cdf[x + 1];
   if (!(c1 > c0)) return false;
   float uc = iris_clampf((u1 - c0) / (c1 - c0), 0.0f, 0x1.fffffep-1f);
   float t = ((float)y + ur) / (float)H, s = ((float)x + uc) / (float)W;
@@ -335,8 +350,19 @@ bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d
   if (!(sin_t > 0.0f)) return false;
   *d = iris_envmap_st_to_dir(env, s, t);
   *pdf = (r1 - r0) * (c1 - c0) * env->pdf_scale / sin_t;
-  if (radiance) *radiance = iris_envmap_radiance_st(env, s, t);
+  *s_out = s;
+  *t_out = t;
   return isfinite(*pdf) && *pdf > 0.0f;
+}
+
+void iris_envmap_prefetch(const iris_envmap *env, float u0, float u1, int stage) {
+  if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return;
+  int y = search_cdf(env->row_cdf, 0, env->height, u0);
+  int j = (int)(u1 * (float)env->blocks);
+  j = j < 0 ? 0 : j >= env->blocks ? env->blocks - 1 : j;
+  const uint32_t *g = &env->guide[(size_t)y * (size_t)env->blocks + (size_t)j];
+  if (stage == 0) __builtin_prefetch(g);
+  else __builtin_prefetch(&env->cdf[(size_t)y * (size_t)env->stride + *g]);
 }
 
 static float pdf_st(const iris_envmap *env, float s, float t) {

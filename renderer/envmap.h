@@ -23,12 +23,13 @@ extern "C" {
 
 /* The sampling tables are laid out for the few cache lines a sample touches
  * (docs/rendering.md, "Environment maps"): the rows' CDF (small, stays in
- * cache), then per row a coarse CDF at every 16th cell boundary (all rows
- * together ~1/16 of the map's texel count, stays in L2) and the full CDF,
- * each row 64-byte aligned, so that the search within a block of 16 cells
- * reads one cache line. Probabilities are CDF differences, which are exactly
- * the measure of the numbers u that pick a cell, and the pdf reads the same
- * two entries. */
+ * cache), then per row a guide table (Chen & Asau 1974) of one entry per 16
+ * cells (the first cell whose CDF interval holds j / entries) and the full
+ * CDF, each row 64-byte aligned, so that a sample reads one guide entry and
+ * usually one line of the CDF, and both can be prefetched while a ray is
+ * traced (iris_envmap_prefetch). Probabilities are CDF differences, which are
+ * exactly the measure of the numbers u that pick a cell, and the pdf reads
+ * the same two entries. */
 #define IRIS_ENVMAP_BLOCK 16
 typedef struct iris_envmap {
   int width, height;
@@ -36,7 +37,7 @@ typedef struct iris_envmap {
   float cos_rot, sin_rot; /* rotation about +Y */
   float *row_cdf;         /* height + 1 entries: marginal CDF over rows */
   float *cdf;             /* height rows of `stride` floats: row y's CDF over its cells, width + 1 used */
-  float *coarse;          /* height rows of `blocks + 1` floats: cdf at cells 0, 16, 32, ..., width */
+  uint32_t *guide;        /* height rows of `blocks` entries: largest cell x with cdf[x] <= j / blocks */
   int stride, blocks;
   float pdf_scale;        /* width * height / (2 pi^2): cell probability to solid-angle density times sin */
   double mean_luminance;  /* (1 / 4pi) * integral of the luminance over the sphere */
@@ -69,6 +70,15 @@ iris_vec3 iris_envmap_radiance_st(const iris_envmap *env, float s, float t);
  * radiance from *d, as iris_envmap_radiance gives it. */
 bool iris_envmap_sample(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf,
                         iris_vec3 *radiance);
+/* The same without the radiance: *s, *t are the map coordinates of *d, for
+ * iris_envmap_radiance_st when the radiance is needed (after a shadow ray). */
+bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3 *d, float *pdf, float *s,
+                           float *t);
+/* Prefetching for iris_envmap_sample(u0, u1), in two steps a ray trace
+ * apart: stage 0 starts loading the guide entry (the rows' CDF is small and
+ * stays cached), stage 1 reads it and starts loading the CDF line the
+ * search will read. Hints only: nothing else changes. */
+void iris_envmap_prefetch(const iris_envmap *env, float u0, float u1, int stage);
 /* Solid-angle density with which iris_envmap_sample returns d. */
 float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
 /* Radiance from d and (optional) that density, with one conversion of d. */

@@ -229,7 +229,7 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
-  if (!iris_lights_sample_choice(it->lights, sp->si.p, choice, u0, u1, &ls)) return iris_v3(0, 0, 0);
+  if (!iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls)) return iris_v3(0, 0, 0);
   if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
   iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
@@ -243,6 +243,7 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   }
   stats->shadow_rays++;
   if (iris_accel_occluded(it->accel, &shadow)) return iris_v3(0, 0, 0);
+  iris_lights_sample_radiance(it->lights, &ls); /* an environment map's lookup, only now */
   float w = 1.0f;
   if (mis && !ls.delta) w = power_heuristic(ls.pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
   return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / ls.pdf);
@@ -253,6 +254,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_path_vertex *last = NULL; /* the recorded vertex the current ray left from */
   const bool nee = iris_method_uses_nee(it->method) && it->lights->count > 0;
   const bool mis = nee && method_uses_mis(it->method);
+  const bool nee_env = nee && it->lights->envmap;
   iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
   const bool adjoint_rr = iris_method_uses_guiding(it->method) && it->guide.radiance_estimate;
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
@@ -262,6 +264,13 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   stats->paths++;
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
+    /* The map's tables load while the ray is traced and the hit shaded
+     * (sample_direct reads them): the guide entry now, the CDF line after. */
+    float env_u0 = 0.0f, env_u1 = 0.0f;
+    if (nee_env) {
+      iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &env_u0, &env_u1);
+      iris_lights_prefetch_environment(it->lights, env_u0, env_u1, 0);
+    }
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
@@ -276,6 +285,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       }
       break;
     }
+    if (nee_env) iris_lights_prefetch_environment(it->lights, env_u0, env_u1, 1);
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
     if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));

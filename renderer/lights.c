@@ -627,9 +627,33 @@ bool iris_lights_sample(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, f
   return iris_lights_sample_choice(lights, ref, &c, u0, u1, s);
 }
 
+static bool sample_choice(const iris_lights *lights, iris_vec3 ref, const iris_light_choice *c, float u0,
+                          float u1, iris_light_sample *s, bool lazy);
+
 bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
                                const iris_light_choice *c, float u0, float u1,
                                iris_light_sample *s) {
+  return sample_choice(lights, ref, c, u0, u1, s, false);
+}
+
+bool iris_lights_sample_choice_lazy(const iris_lights *lights, iris_vec3 ref, const iris_light_choice *c,
+                                    float u0, float u1, iris_light_sample *s) {
+  return sample_choice(lights, ref, c, u0, u1, s, true);
+}
+
+void iris_lights_prefetch_environment(const iris_lights *lights, float u0, float u1, int stage) {
+  if (lights->envmap) iris_envmap_prefetch(lights->envmap, u0, u1, stage);
+}
+
+void iris_lights_sample_radiance(const iris_lights *lights, iris_light_sample *s) {
+  if (!s->L_pending) return;
+  s->L = iris_envmap_radiance_st(lights->envmap, s->map_s, s->map_t);
+  s->L_pending = false;
+}
+
+static bool sample_choice(const iris_lights *lights, iris_vec3 ref, const iris_light_choice *c, float u0,
+                          float u1, iris_light_sample *s, bool lazy) {
+  s->L_pending = false;
   if (!(c->pmf_group > 0.0f) || c->light >= lights->count) return false;
   uint32_t i = c->light;
   float pmf = c->pmf_is_entry ? c->pmf_group : c->pmf_group * pmf_in_group(lights, i); /* 1 * pe = pe exactly */
@@ -715,7 +739,9 @@ bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
     default: {
       if (lights->envmap) {
         float pdf;
-        if (!iris_envmap_sample(lights->envmap, u0, u1, &s->wi, &pdf, &s->L)) return false;
+        if (!iris_envmap_sample_st(lights->envmap, u0, u1, &s->wi, &pdf, &s->map_s, &s->map_t)) return false;
+        if (lazy) s->L_pending = true;
+        else s->L = iris_envmap_radiance_st(lights->envmap, s->map_s, s->map_t);
         s->pdf = pmf * pdf;
       } else {
         s->wi = iris_sample_uniform_sphere(u0, u1);

@@ -167,7 +167,10 @@ typedef struct iris_light_sample {
   float pdf;         /* solid-angle pdf including the selection pmf; for delta
                         lights the selection pmf alone */
   bool delta;        /* point, spot, directional: cannot be hit by BSDF sampling */
+  bool L_pending;    /* L not looked up yet (iris_lights_sample_choice_lazy on an
+                        environment map): iris_lights_sample_radiance does it */
   uint32_t light;    /* entry index */
+  float map_s, map_t;/* environment map coordinates of wi (L_pending) */
 } iris_light_sample;
 
 /* Samples a light as seen from `ref` (a surface point, normal n) with three uniform
@@ -193,6 +196,17 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, f
 bool iris_lights_sample_choice(const iris_lights *lights, iris_vec3 ref,
                                const iris_light_choice *c, float u0, float u1,
                                iris_light_sample *s);
+/* The same, but an environment map's radiance is left for
+ * iris_lights_sample_radiance (s->L_pending): the caller looks it up only
+ * for samples that pass their shadow ray (a room lit through a window sees
+ * most map samples blocked, and the lookup is a cache miss or two). */
+bool iris_lights_sample_choice_lazy(const iris_lights *lights, iris_vec3 ref, const iris_light_choice *c,
+                                    float u0, float u1, iris_light_sample *s);
+/* With an environment map: starts loading what sampling the map with
+ * (u0, u1) will read (iris_envmap_prefetch's stages); a hint, nothing else changes. */
+void iris_lights_prefetch_environment(const iris_lights *lights, float u0, float u1, int stage);
+/* Fills s->L of a lazily drawn sample; nothing to do for the others. */
+void iris_lights_sample_radiance(const iris_lights *lights, iris_light_sample *s);
 
 /* How next-event estimation samples emitter triangles: by solid angle where
  * that lowers variance and by area elsewhere (the default), or always by area
