@@ -104,6 +104,7 @@ void iris_envmap_destroy(iris_envmap *env) {
   free(env->row_cdf);
   free(env->cdf);
   free(env->guide);
+  free(env->row_guide);
   free(env->rgb);
   memset(env, 0, sizeof *env);
 }
@@ -125,6 +126,11 @@ static double build_cdf(const float *w, int n, float *cdf) {
   for (int i = last; i <= n; i++) cdf[i] = 1.0f;
   return sum;
 }
+
+/* Largest i in [0, n) with cdf[i] <= u (cdf[n] = 1 > u), searched between
+ * the guide entries of u's bucket (guide[j]: largest i with cdf[i] <= j / m);
+ * the walks mend the rounding of u * m. */
+static int search_guided(const float *cdf, const uint32_t *guide, int m, int n, float u);
 
 /* Largest i in [lo, hi) with cdf[i] <= u, given cdf[lo] <= u (binary search). */
 static int search_cdf(const float *cdf, int lo, int hi, float u) {
@@ -169,13 +175,14 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
   out->pdf_scale = (float)((double)W * (double)H / (2.0 * IRIS_PI * IRIS_PI));
   out->row_cdf = malloc(sizeof(float) * ((size_t)H + 1));
   out->cdf = aligned_alloc(64, sizeof(float) * (size_t)out->stride * (size_t)H);
+  out->row_guide = malloc(sizeof(uint32_t) * (size_t)H);
   out->guide = malloc(sizeof(uint32_t) * (size_t)out->blocks * (size_t)H);
   float *w = malloc(sizeof(float) * (size_t)(W > H ? W : H));
   float *roww = calloc((size_t)H + 1, sizeof(float));
   float *lum = malloc(sizeof(float) * n);
   double *hrow = malloc(sizeof(double) * 3 * (size_t)W); /* one row blurred across, 3 rows kept */
   double *rowmean = malloc(sizeof(double) * 4 * (size_t)H); /* per row: mean L (lum, r, g, b) */
-  if (!out->row_cdf || !out->cdf || !out->guide || !w || !roww || !lum || !hrow || !rowmean) {
+  if (!out->row_cdf || !out->cdf || !out->guide || !out->row_guide || !w || !roww || !lum || !hrow || !rowmean) {
     free(w), free(roww), free(lum), free(hrow), free(rowmean);
     iris_envmap_destroy(out);
     return iris_error_set(err, IRIS_ERR_NOMEM, map->path, 0, NULL, "out of memory for the environment map");
@@ -220,6 +227,11 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
     }
   }
   build_cdf(roww, H, out->row_cdf); /* a black map: uniform, and the lights leave it out */
+  for (int j = 0, y = 0; j < H && st == IRIS_OK; j++) {
+    float lo = (float)j / (float)H;
+    while (y + 1 < H && out->row_cdf[y + 1] <= lo) y++;
+    out->row_guide[j] = (uint32_t)y;
+  }
   /* Means: the exact integral of the bilinear interpolant over the sphere. Row r's
    * tent spans t in [(r - 1/2)/H, (r + 3/2)/H], periodic (the half rows at the
    * poles blend the top and bottom rows, as Cycles' repeat extension does). */
@@ -328,20 +340,13 @@ bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3
   const int W = env->width, H = env->height;
   if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return false;
   /* row: largest y with row_cdf[y] <= u0 (row_cdf[H] = 1 > u0) */
-  int y = search_cdf(env->row_cdf, 0, H, u0);
+  int y = search_guided(env->row_cdf, env->row_guide, H, H, u0);
   float r0 = env->row_cdf[y], r1 = env->row_cdf[y + 1];
   if (!(r1 > r0)) return false;
   float ur = iris_clampf((u0 - r0) / (r1 - r0), 0.0f, 0x1.fffffep-1f);
   /* cell: the guide entry bounds the search (the walks mend u * blocks's rounding) */
   const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
-  const uint32_t *guide = &env->guide[(size_t)y * (size_t)env->blocks];
-  int j = (int)(u1 * (float)env->blocks);
-  j = j < 0 ? 0 : j >= env->blocks ? env->blocks - 1 : j;
-  int lo = (int)guide[j], hi = j + 1 < env->blocks ? (int)guide[j + 1] + 1 : W;
-  while (lo > 0 && cdf[lo] > u1) --lo;
-  if (hi <= lo) hi = lo + 1;
-  while (hi < W && cdf[hi] <= u1) ++hi;
-  int x = search_cdf(cdf, lo, hi, u1);
+  int x = search_guided(cdf, &env->guide[(size_t)y * (size_t)env->blocks], env->blocks, W, u1);
   float c0 = cdf[x], c1 = cdf[x + 1];
   if (!(c1 > c0)) return false;
   float uc = iris_clampf((u1 - c0) / (c1 - c0), 0.0f, 0x1.fffffep-1f);
@@ -355,9 +360,19 @@ bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3
   return isfinite(*pdf) && *pdf > 0.0f;
 }
 
+static int search_guided(const float *cdf, const uint32_t *guide, int m, int n, float u) {
+  int j = (int)(u * (float)m);
+  j = j < 0 ? 0 : j >= m ? m - 1 : j;
+  int lo = (int)guide[j], hi = j + 1 < m ? (int)guide[j + 1] + 1 : n;
+  while (lo > 0 && cdf[lo] > u) --lo;
+  if (hi <= lo) hi = lo + 1;
+  while (hi < n && cdf[hi] <= u) ++hi;
+  return search_cdf(cdf, lo, hi, u);
+}
+
 void iris_envmap_prefetch(const iris_envmap *env, float u0, float u1, int stage) {
   if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return;
-  int y = search_cdf(env->row_cdf, 0, env->height, u0);
+  int y = search_guided(env->row_cdf, env->row_guide, env->height, env->height, u0);
   int j = (int)(u1 * (float)env->blocks);
   j = j < 0 ? 0 : j >= env->blocks ? env->blocks - 1 : j;
   const uint32_t *g = &env->guide[(size_t)y * (size_t)env->blocks + (size_t)j];

@@ -36,6 +36,7 @@ typedef struct iris_envmap {
   float *rgb;             /* 3 * width * height, linear radiance (strength applied), row 0 top */
   float cos_rot, sin_rot; /* rotation about +Y */
   float *row_cdf;         /* height + 1 entries: marginal CDF over rows */
+  uint32_t *row_guide;    /* height entries: largest row y with row_cdf[y] <= j / height */
   float *cdf;             /* height rows of `stride` floats: row y's CDF over its cells, width + 1 used */
   uint32_t *guide;        /* height rows of `blocks` entries: largest cell x with cdf[x] <= j / blocks */
   int stride, blocks;
