@@ -255,6 +255,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   const bool nee = iris_method_uses_nee(it->method) && it->lights->count > 0;
   const bool mis = nee && method_uses_mis(it->method);
   const bool nee_env = nee && it->lights->envmap;
+  const bool guide_prefetch = iris_method_uses_guiding(it->method) && it->guide.prefetch;
   iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
   const bool adjoint_rr = iris_method_uses_guiding(it->method) && it->guide.radiance_estimate;
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
@@ -286,6 +287,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       break;
     }
     if (nee_env) iris_lights_prefetch_environment(it->lights, env_u0, env_u1, 1);
+    if (guide_prefetch) it->guide.prefetch(it->guide.ctx, iris_madd(ray.o, ray.d, hit.t));
     iris_interaction si;
     iris_accel_interaction(it->accel, ray.d, &hit, &si);
     if (!si.front) beta = iris_mul(beta, iris_integrator_volume_transmittance(it, &si, hit.t * iris_length(ray.d)));

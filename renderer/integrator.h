@@ -124,6 +124,9 @@ typedef struct iris_direction_sampler {
    * < 0 when unknown. Drives the guided methods' Russian roulette
    * (docs/guiding.md, "Russian roulette"). */
   float (*radiance_estimate)(void *ctx, const iris_shading_point *sp);
+  /* Optional: a hint with the hit point, called as soon as the ray has hit
+   * (before shading), to start loading what prepare will read. */
+  void (*prefetch)(void *ctx, iris_vec3 p);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

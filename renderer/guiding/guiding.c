@@ -332,7 +332,10 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
   int64_t cam = p->caches / 2 > 0 ? p->caches / 2 : 1;
   int st = (int)lrint(sqrt((double)pixels / (double)cam));
   *stride = st < 1 ? 1 : st;
-  if (p->cache_res <= 0) p->cache_res = 8; /* 12-16 (thesis-like) cost more than they save: docs/guiding.md */
+  /* 12-16 (thesis-like) cost more than they save on lamp-lit rooms, but a sky
+   * seen through openings (its photons kept, below) puts the window and the
+   * sun's patch into small solid angles: res 16 there (docs/guiding.md). */
+  if (p->cache_res <= 0) p->cache_res = environment_share(s->lights) >= 0.5 ? 16 : 8;
   if (p->cache_k <= 0) p->cache_k = 200;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
@@ -824,7 +827,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
     const size_t texels = ci->sphere ? g->sphere.texel_count : g->hemi.texel_count;
     const char *pdf = (const char *)(g->pdf + ci->table), *alias = (const char *)(g->alias + ci->table);
     for (size_t b = 0; b < texels * sizeof(float); b += 64) __builtin_prefetch(pdf + b);
-    for (size_t b = 0; b < texels * sizeof(iris_cache_alias); b += 64) __builtin_prefetch(alias + b);
+    (void)alias;
   }
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
@@ -897,6 +900,11 @@ static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
   return v->radiance;
 }
 
+static void guided_prefetch(void *ctx, iris_vec3 p) {
+  const iris_guiding *g = ctx;
+  if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
+}
+
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   iris_direction_sampler s;
   memset(&s, 0, sizeof s);
@@ -905,6 +913,7 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.sample = guided_sample;
   s.pdf = guided_pdf;
   s.prepare = guided_prepare;
+  s.prefetch = guided_prefetch;
   if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
   return s;
 }

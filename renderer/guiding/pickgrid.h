@@ -65,6 +65,16 @@ static inline uint32_t iris_pick_grid_query(const iris_pick_grid *g, iris_vec3 q
   return n;
 }
 
+/* Starts loading the answer of q's cell (a hint before iris_pick_grid_query). */
+static inline void iris_pick_grid_prefetch(const iris_pick_grid *g, iris_vec3 q) {
+  float fx = (q.x - g->lo[0]) * g->inv_cell, fy = (q.y - g->lo[1]) * g->inv_cell,
+        fz = (q.z - g->lo[2]) * g->inv_cell;
+  if (!(fx >= 0.0f && fy >= 0.0f && fz >= 0.0f)) return;
+  int ix = (int)fx, iy = (int)fy, iz = (int)fz;
+  if (ix >= g->n[0] || iy >= g->n[1] || iz >= g->n[2]) return;
+  __builtin_prefetch(&g->answer[((size_t)iz * (size_t)g->n[1] + (size_t)iy) * (size_t)g->n[0] + (size_t)ix]);
+}
+
 #ifdef __cplusplus
 }
 #endif
