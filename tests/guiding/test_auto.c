@@ -8,7 +8,8 @@
  *    count, same caches);
  *  - `auto` agrees with mis on door per image (3 sigma) and per 8x8 block
  *    (Bonferroni for 0.1% family-wise, never below 3 sigma), z on the
- *    variance of the mean (tests/common/film_stats.h).
+ *    variance of the mean (tests/common/film_stats.h);
+ *  - the budget's cache resolution: 16 on sky-room (sky-lit), 8 on door.
  * The summary line, --json and the EXR metadata: guiding.auto_cli. */
 #include <math.h>
 #include <stdio.h>
@@ -220,7 +221,26 @@ static void test_unbiased(void) {
   iris_scene_destroy(s);
 }
 
+/* The budget's map resolution: 16 where the sky holds most of the power
+ * (sky-room: the window and the sun's patch are small), 8 for lamp-lit
+ * scenes (door); an explicit --cache-res wins (docs/guiding.md). */
+static void test_cache_res(void) {
+  static const struct { const char *name; int res; } E[] = {{"door", 8}, {"sky-room", 16}};
+  for (size_t i = 0; i < sizeof E / sizeof E[0]; i++) {
+    iris_scene *s = make_scene(E[i].name);
+    if (!CHECK(s != NULL)) continue;
+    iris_render_result r;
+    if (CHECK(render(s, IRIS_METHOD_GUIDED_NEE, 32, 24, 1, 1, 0, &r))) {
+      printf("%s: cache res %d\n", E[i].name, g_stats.cache_res);
+      CHECK_EQ_INT(g_stats.cache_res, E[i].res);
+      iris_render_result_destroy(&r);
+    }
+    iris_scene_destroy(s);
+  }
+}
+
 int main(void) {
+  test_cache_res();
   test_defaults();
   test_decisions();
   test_unbiased();
