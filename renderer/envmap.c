@@ -127,11 +127,6 @@ static double build_cdf(const float *w, int n, float *cdf) {
   return sum;
 }
 
-/* Largest i in [0, n) with cdf[i] <= u (cdf[n] = 1 > u), searched between
- * the guide entries of u's bucket (guide[j]: largest i with cdf[i] <= j / m);
- * the walks mend the rounding of u * m. */
-static int search_guided(const float *cdf, const uint32_t *guide, int m, int n, float u);
-
 /* Largest i in [lo, hi) with cdf[i] <= u, given cdf[lo] <= u (binary search). */
 static int search_cdf(const float *cdf, int lo, int hi, float u) {
   while (hi - lo > 1) {
@@ -140,6 +135,19 @@ static int search_cdf(const float *cdf, int lo, int hi, float u) {
     else hi = mid;
   }
   return lo;
+}
+
+/* Largest i in [0, n) with cdf[i] <= u (cdf[n] = 1 > u), searched between
+ * the guide entries of u's bucket (guide[j]: largest i with cdf[i] <= j / m);
+ * the walks mend the rounding of u * m. */
+static int search_guided(const float *cdf, const uint32_t *guide, int m, int n, float u) {
+  int j = (int)(u * (float)m);
+  j = j < 0 ? 0 : j >= m ? m - 1 : j;
+  int lo = (int)guide[j], hi = j + 1 < m ? (int)guide[j + 1] + 1 : n;
+  while (lo > 0 && cdf[lo] > u) --lo;
+  if (hi <= lo) hi = lo + 1;
+  while (hi < n && cdf[hi] <= u) ++hi;
+  return search_cdf(cdf, lo, hi, u);
 }
 
 /* Periodic index (Cycles' EXTENSION_REPEAT, which its Environment Texture uses on both axes). */
@@ -227,7 +235,7 @@ iris_status iris_envmap_load(const iris_environment_map *map, iris_envmap *out, 
     }
   }
   build_cdf(roww, H, out->row_cdf); /* a black map: uniform, and the lights leave it out */
-  for (int j = 0, y = 0; j < H && st == IRIS_OK; j++) {
+  for (int j = 0, y = 0; j < H; j++) {
     float lo = (float)j / (float)H;
     while (y + 1 < H && out->row_cdf[y + 1] <= lo) y++;
     out->row_guide[j] = (uint32_t)y;
@@ -358,16 +366,6 @@ bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3
   *s_out = s;
   *t_out = t;
   return isfinite(*pdf) && *pdf > 0.0f;
-}
-
-static int search_guided(const float *cdf, const uint32_t *guide, int m, int n, float u) {
-  int j = (int)(u * (float)m);
-  j = j < 0 ? 0 : j >= m ? m - 1 : j;
-  int lo = (int)guide[j], hi = j + 1 < m ? (int)guide[j + 1] + 1 : n;
-  while (lo > 0 && cdf[lo] > u) --lo;
-  if (hi <= lo) hi = lo + 1;
-  while (hi < n && cdf[hi] <= u) ++hi;
-  return search_cdf(cdf, lo, hi, u);
 }
 
 void iris_envmap_prefetch(const iris_envmap *env, float u0, float u1, int stage) {

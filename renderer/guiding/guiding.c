@@ -819,15 +819,15 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
     v->radiance = r / (float)v->m;
     if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
   }
-  /* The tables of the tied caches are needed after this vertex's shadow ray
-   * (the light sample's mixture pdf, then sampling): start loading them now so
-   * the ray hides the memory latency. */
+  /* The pdf tables of the tied caches are needed after this vertex's shadow
+   * ray (the light sample's mixture pdf): start loading them now so the ray
+   * hides the memory latency. Not the alias tables: sampling reads one entry,
+   * and loading all of them cost more than it saved (docs/guiding.md). */
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
     const size_t texels = ci->sphere ? g->sphere.texel_count : g->hemi.texel_count;
-    const char *pdf = (const char *)(g->pdf + ci->table), *alias = (const char *)(g->alias + ci->table);
+    const char *pdf = (const char *)(g->pdf + ci->table);
     for (size_t b = 0; b < texels * sizeof(float); b += 64) __builtin_prefetch(pdf + b);
-    (void)alias;
   }
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
