@@ -189,6 +189,15 @@ static iris_status rtc_error_status(iris_accel *a, iris_error *err) {
                         a->rtc_message);
 }
 
+/* Gives up a build: destroys what was built and returns why (the user's
+ * interrupt, noticed by the progress monitor or between placements, else
+ * Embree's error). */
+static iris_status abandon_build(iris_accel *a, iris_error *err) {
+  iris_status st = iris_cancel_requested() ? iris_cancel_error(err) : rtc_error_status(a, err);
+  iris_accel_destroy(a);
+  return st;
+}
+
 static iris_status nomem(iris_accel *a, iris_error *err, const char *what) {
   iris_status st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for %s", what);
   iris_accel_destroy(a);
@@ -400,11 +409,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   rtcSetDeviceErrorFunction(a->device, error_callback, a);
   rtcSetDeviceMemoryMonitorFunction(a->device, memory_monitor, a);
   a->rtc = rtcNewScene(a->device);
-  if (!a->rtc || rtc_failed(a)) {
-    iris_status st = rtc_error_status(a, err);
-    iris_accel_destroy(a);
-    return st;
-  }
+  if (!a->rtc || rtc_failed(a)) return abandon_build(a, err);
   configure_scene(a->rtc);
 
   a->instance_count = scene->instance_count;
@@ -430,10 +435,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
     const iris_instance *inst = &scene->instances[i];
     const iris_mesh *mesh = &scene->meshes[inst->mesh];
     accel_instance *ai = &a->instances[i];
-    if ((i & 255) == 255 && iris_cancel_requested()) {
-      iris_accel_destroy(a);
-      return iris_cancel_error(err);
-    }
+    if ((i & 255) == 255 && iris_cancel_requested()) return abandon_build(a, err);
     ai->mesh = mesh;
     ai->mesh_index = inst->mesh;
     ai->xf = inst->transform;
@@ -504,11 +506,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
         am->positions = padded_positions(mesh->positions, mesh->vertex_count, &a->own_bytes);
         if (!am->positions) return nomem(a, err, a->building);
         am->rtc = rtcNewScene(a->device);
-        if (!am->rtc || rtc_failed(a)) {
-          iris_status st = rtc_error_status(a, err);
-          iris_accel_destroy(a);
-          return st;
-        }
+        if (!am->rtc || rtc_failed(a)) return abandon_build(a, err);
         configure_scene(am->rtc);
         RTCGeometry mg = triangle_geometry(a, mesh, am->positions);
         if (mg) {
@@ -516,15 +514,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
           rtcReleaseGeometry(mg);
         }
         rtcCommitScene(am->rtc);
-        if (iris_cancel_requested()) { /* the progress monitor cancelled the build */
-          iris_accel_destroy(a);
-          return iris_cancel_error(err);
-        }
-        if (rtc_failed(a)) {
-          iris_status st = rtc_error_status(a, err);
-          iris_accel_destroy(a);
-          return st;
-        }
+        if (iris_cancel_requested() || rtc_failed(a)) return abandon_build(a, err);
         a->unique_meshes++;
       }
       snprintf(a->building, sizeof a->building, "instance %zu of %s", i,
@@ -542,24 +532,12 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
       rtcAttachGeometryByID(a->rtc, g, (unsigned)i);
       rtcReleaseGeometry(g);
     }
-    if (!g || rtc_failed(a)) {
-      iris_status st = rtc_error_status(a, err);
-      iris_accel_destroy(a);
-      return st;
-    }
+    if (!g || rtc_failed(a)) return abandon_build(a, err);
   }
   snprintf(a->building, sizeof a->building, "the top-level BVH (%zu placements, %u triangles)",
            a->instance_count, a->triangle_count);
   rtcCommitScene(a->rtc);
-  if (iris_cancel_requested()) { /* the progress monitor cancelled the build */
-    iris_accel_destroy(a);
-    return iris_cancel_error(err);
-  }
-  if (rtc_failed(a)) {
-    iris_status st = rtc_error_status(a, err);
-    iris_accel_destroy(a);
-    return st;
-  }
+  if (iris_cancel_requested() || rtc_failed(a)) return abandon_build(a, err);
   a->building[0] = '\0';
   a->has_bounds = prims > 0;
   a->lo = lo;
