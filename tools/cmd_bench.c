@@ -1,7 +1,6 @@
 /* `iris bench INPUT... --methods LIST --times LIST --reference REF.exr|auto
  * --out DIR`: fills iris_bench_params from the flags and runs validate/bench.h.
  * docs/cli.md ("bench") and docs/benchmarks.md. */
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,8 +65,6 @@ static void print_help(void) {
       IRIS_BENCH_DEFAULT_REFERENCE_SPP);
 }
 
-static volatile sig_atomic_t g_stop = 0;
-static void on_signal(int sig) { g_stop = sig; }
 
 static void draw_progress(void *ctx, const iris_bench_progress *p) {
   (void)ctx;
@@ -300,26 +297,18 @@ int iris_cmd_bench(int argc, char **argv) {
      * statistics) would break it */
     iris_log_set_level(IRIS_LOG_WARN);
   }
-  p.cancel = &g_stop;
-
-  struct sigaction sa, old_int, old_term;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sa.sa_flags = SA_RESETHAND; /* a second signal stops at once */
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  iris_cli_catch_signals(); /* a second signal stops at once */
+  p.cancel = iris_cli_stop_flag();
   iris_error err;
   iris_error_clear(&err);
   iris_bench_result res;
   iris_status st = iris_bench_run(&p, &res, &err);
-  sigaction(SIGINT, &old_int, NULL);
-  sigaction(SIGTERM, &old_term, NULL);
+  iris_cli_release_signals();
   if (bar) fprintf(stderr, "\n");
   if (st == IRIS_ERR_INTERRUPTED) {
     iris_warnf("bench: interrupted; %zu run(s) written to %s", res.row_count, p.out_dir);
     iris_bench_result_destroy(&res);
-    return g_stop == SIGTERM ? 143 : 130;
+    return iris_cli_interrupt_exit();
   }
   if (st != IRIS_OK) {
     iris_bench_result_destroy(&res);

@@ -4,7 +4,6 @@
  * does the work (validate/validate.h); docs/cli.md ("validate") lists the flags. */
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,8 +69,6 @@ static void print_help(void) {
       IRIS_VALIDATE_DEFAULT_BLENDER_SPP, IRIS_VALIDATE_DEFAULT_SPP);
 }
 
-static volatile sig_atomic_t g_stop = 0;
-static void on_signal(int sig) { g_stop = sig; }
 
 static const char *default_references_dir(void) {
 #ifdef IRIS_SOURCE_DIR
@@ -280,19 +277,12 @@ int iris_cmd_validate(int argc, char **argv) {
     }
   }
 
-  struct sigaction sa, old_int, old_term;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_signal;
-  sa.sa_flags = SA_RESETHAND;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
-  p.cancel = &g_stop;
+  iris_cli_catch_signals(); /* a second signal stops at once */
+  p.cancel = iris_cli_stop_flag();
   iris_validate_result res;
   iris_status st = iris_validate_run(&p, &res, &err);
-  sigaction(SIGINT, &old_int, NULL);
-  sigaction(SIGTERM, &old_term, NULL);
-  if (st == IRIS_ERR_INTERRUPTED) return g_stop == SIGTERM ? 143 : 130;
+  iris_cli_release_signals();
+  if (st == IRIS_ERR_INTERRUPTED) return iris_cli_interrupt_exit();
   if (st != IRIS_OK) {
     /* A reference that cannot be read or used is bad input (2); Blender
      * failing is a failure of the run (1). */
