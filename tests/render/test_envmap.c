@@ -10,7 +10,9 @@
  *    radiance 1 is rho everywhere (convex: no interreflection), for every
  *    method; a constant sky (environment.radiance) gives the same image
  *    within statistical error;
- *  - same seed, 1 or 2 threads: bit-identical images under a map, every method. */
+ *  - same seed, 1 or 2 threads: bit-identical images under a map, every method;
+ *  - maps of sizes the tables do not divide (1 x 1 to 50 x 25): sampling never
+ *    fails, its pdf is the lookup's, the pdf integrates to 1. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -342,6 +344,54 @@ static void test_determinism(const char *map) {
   iris_scene_destroy(s);
 }
 
+/* Sizes the block and guide tables do not divide (1 x 1 up to 50 x 25, one
+ * black everywhere): every stratified sample succeeds, its pdf is the
+ * lookup's, and the pdf integrates to 1 over the sphere (Monte Carlo with
+ * uniform directions). */
+static void test_odd_sizes(void) {
+  static const int S[][2] = {{1, 1}, {2, 1}, {3, 2}, {17, 9}, {33, 16}, {50, 25}};
+  for (size_t k = 0; k < sizeof S / sizeof S[0]; k++) {
+    char path[1200];
+    snprintf(path, sizeof path, "%s/odd%zu.exr", g_dir, k);
+    write_map(path, S[k][0], S[k][1], 1);
+    iris_environment_map m = {path, 1.0f, 0.0f};
+    iris_envmap env;
+    iris_error err;
+    iris_error_clear(&err);
+    iris_status lst = iris_envmap_load(&m, &env, &err);
+    CHECK_OK(lst, &err);
+    if (lst != IRIS_OK) continue;
+    int failed = 0, differ = 0;
+    for (int i = 0; i < 64; i++)
+      for (int j = 0; j < 64; j++) {
+        iris_vec3 d, L;
+        float pdf;
+        if (!iris_envmap_sample(&env, (i + 0.5f) / 64.0f, (j + 0.5f) / 64.0f, &d, &pdf, &L)) {
+          failed++;
+          continue;
+        }
+        differ += !(fabsf(iris_envmap_pdf(&env, d) - pdf) <= 1e-3f * pdf);
+      }
+    uint64_t st = 99 + k;
+    double sum = 0.0, sum2 = 0.0;
+    const int n = 400000;
+    for (int i = 0; i < n; i++) {
+      double u0 = chi2_uniform(&st), u1 = chi2_uniform(&st);
+      float z = (float)(1.0 - 2.0 * u0), r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = (float)(2.0 * IRIS_PI * u1);
+      double v = 4.0 * IRIS_PI * iris_envmap_pdf(&env, iris_v3(r * cosf(phi), z, r * sinf(phi)));
+      sum += v;
+      sum2 += v * v;
+    }
+    double integral = sum / n, se = sqrt(fmax(0.0, sum2 / n - integral * integral) / n);
+    printf("envmap %dx%d: %d failed, %d pdfs differ, pdf integral %.4f +- %.4f\n", S[k][0], S[k][1], failed,
+           differ, integral, se);
+    CHECK_EQ_INT(failed, 0);
+    CHECK(differ <= 8); /* directions within rounding of a cell edge */
+    CHECK_NEAR(integral, 1.0, 4.0 * se + 1e-3);
+    iris_envmap_destroy(&env);
+  }
+}
+
 int main(void) {
   if (iris_test_tmpdir(g_dir, sizeof g_dir, "envmap") != 0) return TEST_SKIP("no temporary folder");
   char patterned[1200], uniform[1200];
@@ -353,5 +403,6 @@ int main(void) {
   test_sampling(patterned);
   test_furnace(uniform);
   test_determinism(patterned);
+  test_odd_sizes();
   return TEST_SUMMARY();
 }
