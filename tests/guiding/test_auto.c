@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "film_stats.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
@@ -56,13 +57,7 @@ static bool render(const iris_scene *s, iris_method method, int w, int h, int sp
   p.guide_options = &gp;
   memset(&g_stats, 0, sizeof g_stats);
   g_caches = 0;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 typedef struct expectation {

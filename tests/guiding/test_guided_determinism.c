@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/accel.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/lights.h"
@@ -53,13 +54,7 @@ static bool render(const iris_scene *s, int threads, bool keep, iris_render_resu
   p.method = IRIS_METHOD_GUIDED_NEE;
   p.guide = &iris_guiding_provider;
   p.guide_options = &gp;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 static bool same_film(const iris_film *a, const iris_film *b) {

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "film_stats.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/render.h"
@@ -51,13 +52,7 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   p.seed = seed;
   p.guide = &iris_guiding_provider;
   p.guide_options = &gp;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 int main(int argc, char **argv) {

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 
@@ -16,13 +17,7 @@ static bool render(const iris_scene *s, int threads, uint64_t seed, iris_method 
   p.threads = threads;
   p.seed = seed;
   p.method = m;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 static bool same_film(const iris_film *a, const iris_film *b) {

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "film_stats.h"
 #include "core/fileio.h"
 #include "core/image.h"
@@ -39,13 +40,7 @@ static bool render(const iris_scene *s, iris_method m, int w, int h, int spp, ui
   p.spp = spp;
   p.method = m;
   p.seed = seed;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 

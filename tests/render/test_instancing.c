@@ -25,6 +25,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "core/image.h"
 #include "film_stats.h"
 #include "renderer/accel.h"
@@ -284,13 +285,7 @@ static bool render(const iris_scene *s, iris_method method, int w, int h, int sp
   p.bounds = bounds;
   p.guide = &iris_guiding_provider;
   p.guide_options = &gp;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 static void test_images(const iris_scene *inst, const iris_scene *baked) {

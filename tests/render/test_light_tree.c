@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "chi2.h"
 #include "film_stats.h"
 #include "renderer/light_tree.h"
@@ -224,13 +225,7 @@ static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, in
   p.seed = seed;
   p.threads = threads;
   p.light_sampler = ls;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 int main(void) {

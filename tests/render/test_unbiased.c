@@ -15,6 +15,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "film_stats.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
@@ -29,13 +30,7 @@ static bool render(const iris_scene *s, iris_method m, iris_sampler_kind k, int 
   p.spp = spp;
   p.method = m;
   p.seed = seed;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  return true;
+  return iris_test_render(s, &p, r);
 }
 
 
