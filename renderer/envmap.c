@@ -398,3 +398,105 @@ iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf) {
   if (pdf) *pdf = pdf_st(env, s, t);
   return iris_envmap_radiance_st(env, s, t);
 }
+
+float iris_envmap_pdf_st(const iris_envmap *env, float s, float t) { return pdf_st(env, s, t); }
+
+/* ---- regions (envmap.h) ------------------------------------------------------ */
+
+void iris_envmap_regions_destroy(iris_envmap_regions *r) {
+  free(r->col0);
+  free(r->row0);
+  free(r->col_of);
+  free(r->row_of);
+  free(r->prob);
+  free(r->row_cdf);
+  memset(r, 0, sizeof *r);
+}
+
+iris_status iris_envmap_regions_build(const iris_envmap *env, int bx, int by, iris_envmap_regions *out,
+                                      iris_error *err) {
+  memset(out, 0, sizeof *out);
+  if (bx < 1 || by < 1 || bx > 4096 || by > 4096)
+    return iris_error_set(err, IRIS_ERR_INVALID, NULL, 0, "environment", "%d x %d map regions (1 to 4096 each)", bx, by);
+  const int W = env->width, H = env->height;
+  out->bx = bx, out->by = by;
+  out->col0 = malloc(sizeof(int) * ((size_t)bx + 1));
+  out->row0 = malloc(sizeof(int) * ((size_t)by + 1));
+  out->col_of = malloc(sizeof(uint16_t) * (size_t)W);
+  out->row_of = malloc(sizeof(uint16_t) * (size_t)H);
+  out->prob = calloc((size_t)bx * (size_t)by, sizeof(float));
+  out->row_cdf = malloc(sizeof(float) * (size_t)bx * ((size_t)H + (size_t)by));
+  float *w = malloc(sizeof(float) * (size_t)H);
+  if (!out->col0 || !out->row0 || !out->col_of || !out->row_of || !out->prob || !out->row_cdf || !w) {
+    free(w);
+    iris_envmap_regions_destroy(out);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "environment", "out of memory for map regions");
+  }
+  for (int i = 0; i <= bx; i++) out->col0[i] = (int)((int64_t)i * W / bx);
+  for (int j = 0; j <= by; j++) out->row0[j] = (int)((int64_t)j * H / by);
+  for (int i = 0; i < bx; i++)
+    for (int x = out->col0[i]; x < out->col0[i + 1]; x++) out->col_of[x] = (uint16_t)i;
+  for (int j = 0; j < by; j++)
+    for (int y = out->row0[j]; y < out->row0[j + 1]; y++) out->row_of[y] = (uint16_t)j;
+  /* A row's share of region column i: the row's probability times the
+   * probability of the region's cells within it, both the CDF differences
+   * that sampling the whole map uses (so a region's sample has the map's
+   * density over the region's probability, up to rounding). */
+  for (int i = 0; i < bx; i++) {
+    const int c0 = out->col0[i], c1 = out->col0[i + 1];
+    for (int y = 0; y < H; y++) {
+      const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
+      w[y] = (env->row_cdf[y + 1] - env->row_cdf[y]) * (cdf[c1] - cdf[c0]);
+    }
+    for (int j = 0; j < by; j++) {
+      const int r0 = out->row0[j], n = out->row0[j + 1] - r0;
+      double p = 0.0;
+      for (int k = 0; k < n; k++) p += w[r0 + k];
+      out->prob[(size_t)j * (size_t)bx + (size_t)i] = (float)p;
+      float *rc = &out->row_cdf[(size_t)i * ((size_t)H + (size_t)by) + (size_t)r0 + (size_t)j];
+      if (n > 0) build_cdf(&w[r0], n, rc);
+      else rc[0] = 1.0f;
+    }
+  }
+  free(w);
+  return IRIS_OK;
+}
+
+int iris_envmap_region_of(const iris_envmap *env, const iris_envmap_regions *r, float s, float t) {
+  int x, y;
+  texel_of(env, s, t, &x, &y);
+  return (int)r->row_of[y] * r->bx + (int)r->col_of[x];
+}
+
+bool iris_envmap_sample_region(const iris_envmap *env, const iris_envmap_regions *r, int region, float u0,
+                               float u1, iris_vec3 *d, float *pdf_map, float *s_out, float *t_out) {
+  if (region < 0 || region >= r->bx * r->by || !(r->prob[region] > 0.0f)) return false;
+  if (!(u0 >= 0.0f && u0 < 1.0f && u1 >= 0.0f && u1 < 1.0f)) return false;
+  const int i = region % r->bx, j = region / r->bx, H = env->height;
+  const int r0 = r->row0[j], n = r->row0[j + 1] - r0, c0 = r->col0[i], c1 = r->col0[i + 1];
+  const float *rc = &r->row_cdf[(size_t)i * ((size_t)H + (size_t)r->by) + (size_t)r0 + (size_t)j];
+  int k = search_cdf(rc, 0, n, u0);
+  float a = rc[k], b = rc[k + 1];
+  if (!(b > a)) return false;
+  const int y = r0 + k;
+  float ur = iris_clampf((u0 - a) / (b - a), 0.0f, 0x1.fffffep-1f);
+  const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
+  float lo = cdf[c0], hi = cdf[c1];
+  if (!(hi > lo)) return false;
+  /* u1 scaled into the region's part of the row's CDF: the row's guide
+   * entries find it as they do for the whole map */
+  float target = lo + u1 * (hi - lo);
+  int x = search_guided(cdf, &env->guide[(size_t)y * (size_t)env->blocks], env->blocks, env->width, target);
+  x = x < c0 ? c0 : x >= c1 ? c1 - 1 : x;
+  float x0 = cdf[x], x1 = cdf[x + 1];
+  if (!(x1 > x0)) return false;
+  float uc = iris_clampf((target - x0) / (x1 - x0), 0.0f, 0x1.fffffep-1f);
+  float t = ((float)y + ur) / (float)H, s = ((float)x + uc) / (float)env->width;
+  float sin_t = sinf(t * IRIS_PI);
+  if (!(sin_t > 0.0f)) return false;
+  *d = iris_envmap_st_to_dir(env, s, t);
+  *pdf_map = cell_probability(env, x, y) * env->pdf_scale / sin_t;
+  *s_out = s;
+  *t_out = t;
+  return isfinite(*pdf_map) && *pdf_map > 0.0f;
+}

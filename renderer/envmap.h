@@ -85,6 +85,37 @@ float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
 /* Radiance from d and (optional) that density, with one conversion of d. */
 iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf);
 
+/* Regions: the map's cells cut into bx x by rectangles of whole cells
+ * (region column i holds the cell columns [col0[i], col0[i+1]), col0[i] =
+ * i W / bx, rows likewise), for samplers that first choose a region and then
+ * a direction in it in proportion to the map (guiding's sky visibility,
+ * docs/guiding.md). A region of a map smaller than the grid may hold no
+ * cell; its probability is 0. */
+typedef struct iris_envmap_regions {
+  int bx, by;
+  int *col0, *row0;   /* bx + 1 and by + 1 entries (col0[bx] = W, row0[by] = H) */
+  uint16_t *col_of;   /* W entries: the region column of a cell column */
+  uint16_t *row_of;   /* H entries */
+  float *prob;        /* bx * by (index j * bx + i): the map's probability of the region */
+  float *row_cdf;     /* per region column i, per region row j, at i * (H + by) + row0[j] + j:
+                         the CDF over the region's rows of the map's probability */
+} iris_envmap_regions;
+
+/* bx, by in [1, 4096]. */
+iris_status iris_envmap_regions_build(const iris_envmap *env, int bx, int by, iris_envmap_regions *out,
+                                      iris_error *err);
+void iris_envmap_regions_destroy(iris_envmap_regions *r);
+/* The region holding map coordinates (s, t) (the cell's). */
+int iris_envmap_region_of(const iris_envmap *env, const iris_envmap_regions *r, float s, float t);
+/* Samples a direction within `region` in proportion to the map: the map's own
+ * density there divided by the region's probability. *pdf_map is the map's
+ * own solid-angle density of *d (iris_envmap_pdf), *s, *t its coordinates.
+ * False when the region holds no probability. */
+bool iris_envmap_sample_region(const iris_envmap *env, const iris_envmap_regions *r, int region, float u0,
+                               float u1, iris_vec3 *d, float *pdf_map, float *s, float *t);
+/* iris_envmap_pdf at map coordinates. */
+float iris_envmap_pdf_st(const iris_envmap *env, float s, float t);
+
 #ifdef __cplusplus
 }
 #endif

@@ -224,12 +224,23 @@ static float power_heuristic(float pa, float pb) {
  * against the path's direction sampler when `mis`. The light was chosen at
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
-                               const iris_light_choice *choice, const iris_sampler *rng, bool mis,
+                               const iris_light_choice *choice, float u_region, const iris_sampler *rng, bool mis,
                                iris_path_stats *stats) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
-  if (!iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls)) return iris_v3(0, 0, 0);
+  int guided = -1; /* the map sampled by the guide (its sky visibility), or not (-1) */
+  if (it->guide.sample_environment && iris_method_uses_guiding(it->method) &&
+      iris_lights_choice_is_environment_map(it->lights, choice)) {
+    iris_vec3 wi;
+    float pdf, s, t;
+    guided = it->guide.sample_environment(it->guide.ctx, it->lights->envmap, sp, u_region, u0, u1, &wi, &pdf, &s, &t);
+    if (guided == 0 || (guided > 0 && !iris_lights_environment_sample_at(it->lights, choice, sp->si.p, wi, pdf, s,
+                                                                          t, &ls)))
+      return iris_v3(0, 0, 0);
+  }
+  if (guided < 0 && !iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls))
+    return iris_v3(0, 0, 0);
   if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
   iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
@@ -256,6 +267,10 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   const bool mis = nee && method_uses_mis(it->method);
   const bool nee_env = nee && it->lights->envmap;
   const bool guide_prefetch = iris_method_uses_guiding(it->method) && it->guide.prefetch;
+  /* light sampling of the map guided per vertex: escaping rays weigh against
+   * the density at the vertex they left (its guide state kept in prev_guide) */
+  const bool env_guided = nee_env && iris_method_uses_guiding(it->method) && it->guide.environment_scale;
+  iris_guide_vertex prev_guide;
   iris_vec3 L = iris_v3(0, 0, 0), beta = iris_v3(1, 1, 1);
   const bool adjoint_rr = iris_method_uses_guiding(it->method) && it->guide.radiance_estimate;
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
@@ -279,6 +294,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
                                                  !prev_delta && mis ? &env_pdf : NULL);
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
+        if (env_guided && !prev_delta && mis && bounce > 0)
+          env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, ray.d);
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
@@ -307,10 +324,14 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the guide prepares. */
     iris_light_choice choice = {0, 0.0f, false};
-    if (nee && !sp.delta)
-      iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
+    float u_choice = 0.0f, u_region = 0.0f; /* IRIS_SLOT_ENV_REGION is the pair's second number */
+    if (nee && !sp.delta) {
+      if (env_guided) iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_CHOICE, &u_choice, &u_region);
+      else u_choice = iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE);
+      iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), u_choice, &choice);
+    }
     iris_integrator_prepare_direction(it, &sp);
-    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, stats)));
+    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, stats)));
 
     iris_direction_sample ds;
     if (!iris_integrator_sample_direction(it, &sp, rng, &ds)) break;
@@ -339,6 +360,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     prev_pdf = ds.pdf;
     prev_p = sp.si.p;
     prev_n = light_normal(&sp);
+    if (env_guided) prev_guide = sp.guide;
     ray = iris_spawn_ray(&sp.si, ds.wi);
 
     /* Russian roulette (docs/rendering.md): survive with q = min(1, sqrt(max beta)),

@@ -56,6 +56,7 @@ enum {
   IRIS_DIM_PIXEL = 0,          /* 2D: position in the pixel */
   IRIS_DIM_BOUNCE0 = 2,
   IRIS_SLOT_LIGHT_CHOICE = 0,  /* NEE: which light */
+  IRIS_SLOT_ENV_REGION = 1,    /* NEE of an environment map guided by the caches: cache and region */
   IRIS_SLOT_LOBE = 2,          /* BSDF: which lobe */
   IRIS_SLOT_LIGHT_POS = 4,     /* 2D: NEE point on the light */
   IRIS_SLOT_DIRECTION = 6,     /* 2D: BSDF direction, or the position in the guide's texel */
@@ -127,6 +128,18 @@ typedef struct iris_direction_sampler {
   /* Optional: a hint with the hit point, called as soon as the ray has hit
    * (before shading), to start loading what prepare will read. */
   void (*prefetch)(void *ctx, iris_vec3 p);
+  /* Optional: light sampling of the environment map env (the lights') at a
+   * prepared vertex (guiding's sky visibility). Returns -1 when it has nothing to add there
+   * (the lights sample the map themselves), 0 when nothing could be sampled,
+   * 1 with a direction, its solid-angle density (of the map alone, the light
+   * choice left out) and its map coordinates. u picks among its own choices,
+   * (u0, u1) as the map's sampling uses them. */
+  int (*sample_environment)(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u,
+                            float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t);
+  /* With sample_environment: its density for direction wi over the map's own,
+   * at the vertex whose prepared state is v (for the MIS weight of a ray that
+   * left that vertex and escaped). */
+  float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, iris_vec3 wi);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

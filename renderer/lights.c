@@ -651,6 +651,28 @@ void iris_lights_sample_radiance(const iris_lights *lights, iris_light_sample *s
   s->L_pending = false;
 }
 
+bool iris_lights_choice_is_environment_map(const iris_lights *lights, const iris_light_choice *c) {
+  return lights->envmap && lights->environment >= 0 && c->light == (uint32_t)lights->environment &&
+         c->pmf_group > 0.0f;
+}
+
+bool iris_lights_environment_sample_at(const iris_lights *lights, const iris_light_choice *c, iris_vec3 ref,
+                                       iris_vec3 wi, float pdf_dir, float s, float t, iris_light_sample *out) {
+  if (!iris_lights_choice_is_environment_map(lights, c)) return false;
+  float pmf = c->pmf_is_entry ? c->pmf_group : c->pmf_group * pmf_in_group(lights, c->light);
+  out->light = c->light;
+  out->delta = false;
+  out->wi = wi;
+  out->map_s = s;
+  out->map_t = t;
+  out->L_pending = true;
+  out->pdf = pmf * pdf_dir;
+  out->dist = INFINITY;
+  out->p = iris_madd(ref, wi, 2.0f * lights->radius);
+  out->n = iris_neg(wi);
+  return isfinite(out->pdf) && out->pdf > 0.0f;
+}
+
 static bool sample_choice(const iris_lights *lights, iris_vec3 ref, const iris_light_choice *c, float u0,
                           float u1, iris_light_sample *s, bool lazy) {
   s->L_pending = false;

@@ -241,6 +241,15 @@ float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris
  * value of iris_lights_pdf_environment(lights, ref, n, d). */
 iris_vec3 iris_lights_environment_pdf(const iris_lights *lights, iris_vec3 d, iris_vec3 ref, iris_vec3 n,
                                       float *pdf);
+/* Whether a light choice is the environment map (which a direction sampler
+ * may sample itself: iris_direction_sampler.sample_environment). */
+bool iris_lights_choice_is_environment_map(const iris_lights *lights, const iris_light_choice *c);
+/* A light sample of the environment map in direction wi drawn with density
+ * pdf_dir by another sampler, at map coordinates (s, t): as
+ * iris_lights_sample_choice_lazy fills it (the radiance pending), its pdf the
+ * choice's probability times pdf_dir. */
+bool iris_lights_environment_sample_at(const iris_lights *lights, const iris_light_choice *c, iris_vec3 ref,
+                                       iris_vec3 wi, float pdf_dir, float s, float t, iris_light_sample *out);
 
 /* ---- photon emission (guiding preprocess) ----------------------------- */
 

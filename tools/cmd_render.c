@@ -151,7 +151,8 @@ static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
   double v[] = {(double)gp->photons, (double)gp->caches, gp->cache_res, gp->cache_k,
                 gp->pdf_floor, gp->alpha_max, gp->cos_min, (double)gp->splat, gp->force,
                 (double)gp->photon_lights, gp->train_spp, gp->train_prior, gp->train_all_light,
-                gp->learn_alpha, gp->adjoint_rr, gp->direct_photons};
+                gp->learn_alpha, gp->adjoint_rr, gp->direct_photons, gp->sky_regions, gp->sky_probes,
+                gp->sky_beta};
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
     uint64_t bits;
     memcpy(&bits, &v[i], sizeof bits);

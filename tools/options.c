@@ -92,6 +92,15 @@ static const iris_option GUIDING_ROWS[] = {
         "own up to 0.95, or up to A when given)"),
     OPT("cos-min", 0, IRIS_OPT_FLOAT, "C", -1, 1, iris_guiding_params, cos_min,
         "cache normal agreement needed (default 0.9)"),
+    OPT("sky-regions", 0, IRIS_OPT_INT, "N", 1, 4096, iris_guiding_params, sky_regions,
+        "environment map regions across for light sampling from\n"
+        "what each cache sees of the sky (default 16; N/2 down)"),
+    OPT("sky-probes", 0, IRIS_OPT_INT, "N", 0, 1024, iris_guiding_params, sky_probes,
+        "shadow rays per cache and map region (default 2; 0: map\n"
+        "sampling alone, as mis)"),
+    OPT("sky-beta", 0, IRIS_OPT_FLOAT, "B", 0, 1, iris_guiding_params, sky_beta,
+        "probability of a cache's seen regions in light sampling\n"
+        "of the map (default 0.75; the map's own the rest)"),
     CHOICE("splat", "nearest|bilinear", iris_guiding_params, splat, SPLAT_CHOICES,
            "photon splatting (default bilinear)"),
     CHOICE("photon-lights", "power|area", iris_guiding_params, photon_lights, PHOTON_LIGHT_CHOICES,

@@ -103,6 +103,9 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--pilot")) gp.pilot_paths = atoll(v), ++i; /* 0: decide on the full pass */
     else if (!strcmp(a, "--direct-photons")) gp.direct_photons = atoi(v), ++i;
     else if (!strcmp(a, "--train-spp")) gp.train_spp = atoi(v), ++i;
+    else if (!strcmp(a, "--sky-regions")) gp.sky_regions = atoi(v), ++i;
+    else if (!strcmp(a, "--sky-probes")) gp.sky_probes = atoi(v), ++i;
+    else if (!strcmp(a, "--sky-beta")) gp.sky_beta = (float)atof(v), ++i;
     else if (!strcmp(a, "--train-prior")) gp.train_prior = (float)atof(v), ++i;
     else if (!strcmp(a, "--train-all-light")) gp.train_all_light = true;
     else if (!strcmp(a, "--no-learn-alpha")) gp.learn_alpha = false;

@@ -575,5 +575,9 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_f32(h, p->train_prior);
   h = mix_u64(h, p->train_all_light);
   h = mix_u64(h, (uint64_t)p->photon_lights);
+  /* the sky visibility is rebuilt when the guide is read, with these */
+  h = mix_u64(h, (uint64_t)(int64_t)p->sky_regions);
+  h = mix_u64(h, (uint64_t)(int64_t)p->sky_probes);
+  h = mix_f32(h, p->sky_beta);
   return h;
 }

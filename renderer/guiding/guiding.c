@@ -40,6 +40,9 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.train_prior = 200.0f; /* a path sample weighs as much as a photon (k = 200); docs/guiding.md */
   p.train_all_light = false;
   p.pilot_paths = -1;
+  p.sky_regions = -1;
+  p.sky_probes = -1;
+  p.sky_beta = -1.0f;
   return p;
 }
 
@@ -738,6 +741,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
     if (setup->lights->count == 0 && !g->params.force) skip(g, "no lights");
     else st = build_caches(g, setup, stride, err);
   }
+  if (st == IRIS_OK && !g->stats.skipped && g->cache_count > 0) st = iris_guiding_build_sky(g, setup, err);
   if (st == IRIS_OK && !g->stats.skipped && g->cache_count > 0) st = iris_guiding_train(g, setup, err);
   if (st != IRIS_OK) {
     iris_guiding_destroy(g);
@@ -748,8 +752,28 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   return IRIS_OK;
 }
 
+/* Defaults measured in docs/guiding.md, "Sky visibility". */
+#define SKY_REGIONS 16
+#define SKY_PROBES 2
+#define SKY_BETA 0.75f
+
+iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err) {
+  iris_skyvis_destroy(&g->sky);
+  const iris_guiding_params *p = &g->params;
+  if (!p->use_nee || !setup->lights->envmap || g->stats.skipped || g->cache_count == 0) return IRIS_OK;
+  iris_skyvis_params sp = {p->sky_regions >= 0 ? p->sky_regions : SKY_REGIONS,
+                           p->sky_probes >= 0 ? p->sky_probes : SKY_PROBES,
+                           p->sky_beta >= 0.0f ? p->sky_beta : SKY_BETA};
+  iris_guiding_phase(setup, NULL, "probing the sky from the caches", -1.0);
+  iris_status st = iris_skyvis_build(&g->sky, g->caches, g->cache_count, setup->accel, setup->lights->envmap, &sp,
+                                     setup->seed, setup->threads, err);
+  if (st == IRIS_OK) g->stats.memory_bytes += g->sky.memory_bytes;
+  return st;
+}
+
 void iris_guiding_destroy(iris_guiding *g) {
   if (!g) return;
+  iris_skyvis_destroy(&g->sky);
   iris_octmap_destroy(&g->hemi);
   iris_octmap_destroy(&g->sphere);
   iris_kdtree_destroy(&g->tree);
@@ -900,6 +924,24 @@ static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
   return v->radiance;
 }
 
+/* Sky visibility (skyvis.h): light sampling of the map from the vertex's tied caches. */
+static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u,
+                                     float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return -1;
+  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
+}
+
+static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, iris_vec3 wi) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
+  float s, t;
+  iris_envmap_dir_to_st(env, wi, &s, &t);
+  return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
+}
+
 static void guided_prefetch(void *ctx, iris_vec3 p) {
   const iris_guiding *g = ctx;
   if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
@@ -915,6 +957,10 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.prepare = guided_prepare;
   s.prefetch = guided_prefetch;
   if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
+  if (g->sky.built) {
+    s.sample_environment = guided_sample_environment;
+    s.environment_scale = guided_environment_scale;
+  }
   return s;
 }
 
@@ -935,15 +981,21 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              asum / (double)learned, (double)g->params.alpha_max);
   else
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
+  char sky[128] = "";
+  if (g->sky.built)
+    snprintf(sky, sizeof sky, "; sky seen from the caches: %llu probes, %.0f%% escaped, %.2f s",
+             (unsigned long long)g->sky.probes,
+             g->sky.probes ? 100.0 * (double)g->sky.escaped / (double)g->sky.probes : 0.0, g->sky.seconds);
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, %s; "
-           "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s); cache memory %.1f MiB",
+           "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s)%s; cache memory %.1f MiB",
            (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
            s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
            (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
            (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, s->cache_k,
-           (double)s->pdf_floor, alpha, s->total_seconds, s->photon_seconds, s->train_spp, s->train_iterations, s->train_seconds, (double)s->memory_bytes / (1024.0 * 1024.0));
+           (double)s->pdf_floor, alpha, s->total_seconds, s->photon_seconds, s->train_spp, s->train_iterations, s->train_seconds, sky,
+           (double)s->memory_bytes / (1024.0 * 1024.0));
 }
 
 /* ---- iris_render provider ---------------------------------------------------- */
@@ -959,6 +1011,13 @@ static iris_status provider_guide(const iris_guide_setup *setup, const iris_guid
   }
   iris_status st = p->guide_in ? iris_guiding_load(p->guide_in, scene_hash, settings_hash, setup->threads, g, err)
                                : iris_guiding_build(setup, p, g, err);
+  if (st == IRIS_OK && p->guide_in) { /* not in the file: derived from the caches and the scene */
+    (*g)->params.use_nee = p->use_nee;
+    (*g)->params.sky_regions = p->sky_regions;
+    (*g)->params.sky_probes = p->sky_probes;
+    (*g)->params.sky_beta = p->sky_beta;
+    st = iris_guiding_build_sky(*g, setup, err);
+  }
   if (st == IRIS_OK && p->guide_out) st = iris_guiding_save(*g, p->guide_out, scene_hash, settings_hash, err);
   if (st != IRIS_OK) {
     iris_guiding_destroy(*g);

@@ -19,6 +19,7 @@
 #include "renderer/guiding/pickgrid.h"
 #include "renderer/integrator.h"
 #include "renderer/render.h"
+#include "renderer/guiding/skyvis.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -63,6 +64,12 @@ typedef struct iris_guiding_params {
                            leaves to the sampled direction (--train-all-light) */
   bool discard_training; /* leave the training paths out of the image (--discard-training;
                             iris_render_params.keep_training is the renderer's switch) */
+  /* Sky visibility (skyvis.h; docs/guiding.md, "Sky visibility"): light
+   * sampling of an environment map from what each cache sees of it, with
+   * light sampling only. -1: the default; sky_probes or sky_beta 0: off. */
+  int sky_regions;      /* map regions across (--sky-regions; down: half as many) */
+  int sky_probes;       /* probe rays per cache and region (--sky-probes; 0: off) */
+  float sky_beta;       /* probability of a cache's regions (--sky-beta; 0: off) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):
@@ -135,12 +142,16 @@ typedef struct iris_guiding {
   iris_pick_grid grid; /* candidate caches per cell: Algorithm 1's search without the tree */
   float alpha_cap;     /* cap on learned selection probabilities: --alpha-max when given, else 0.95 */
   float *photon_hist;  /* during training only: each cache's photon histogram, normalised (pdf layout) */
+  iris_skyvis sky;     /* sky visibility per cache (env NULL: none) */
   iris_guiding_stats stats;
 } iris_guiding;
 
 iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
                                iris_guiding **out, iris_error *err);
 void iris_guiding_destroy(iris_guiding *g);
+/* (Re)builds g->sky for the setup's environment map, when the guide is used
+ * with light sampling (a guide read from a file gets it here too). */
+iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err);
 /* Enters a phase of the build (key: core/cancel.h's hook name, NULL: only
  * report) and reports `what` through setup->phase. */
 void iris_guiding_phase(const iris_guide_setup *s, const char *key, const char *what, double eta_first_image);

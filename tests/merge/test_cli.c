@@ -125,6 +125,16 @@ int main(int argc, char **argv) {
   EXPECT_RUN(G "--spp 4 --discard-training -o gd.exr", 0, "");
   CHECK_EQ_STR(meta_value("gd.exr", "iris:train_spp", v, sizeof v), "0");
 #undef G
+  /* the same under a sky through a window, where guided-nee also samples the
+   * map from what its caches see (docs/guiding.md, "Sky visibility") */
+#define S "render sky-room --width 24 --height 16 --threads 2 --quiet --method guided-nee --photons 20000 " \
+          "--train-spp 3 "
+  EXPECT_RUN(S "--spp 6 -o sfull.exr", 0, "");
+  EXPECT_RUN(S "--spp 4 --threads 1 -o s0.exr", 0, "");
+  EXPECT_RUN(S "--spp 2 --sample-offset 4 -o s1.exr", 0, "");
+  EXPECT_RUN("merge s1.exr s0.exr -o sm.exr", 0, "2 parts (1 windows)");
+  expect_close("sm.exr", "sfull.exr");
+#undef S
 
   /* refusals: exit 2, one line naming the part, no output */
   EXPECT_RUN(R "--spp 4 --sample-offset 6 --seed 12 -o seed.exr", 0, "");

@@ -1,0 +1,82 @@
+/* Sky visibility per cache: light sampling of an environment map guided by
+ * what each irradiance cache sees of it (docs/guiding.md, "Sky visibility").
+ *
+ * Inside a room lit through a window, sampling the map by its own luminance
+ * mostly picks directions that hit the walls (and the sun, which only its
+ * patch on the floor sees): the shadow ray fails and the sample is lost. At
+ * build time every cache traces a few shadow rays into each region of the map
+ * (rectangles of whole texels, iris_envmap_regions) and keeps, per region,
+ * the map's probability times the cosine-weighted fraction of those rays that
+ * escaped. Light sampling of the map at a vertex then picks one of the
+ * vertex's tied caches uniformly (as the directional guide does) and, with
+ * probability beta, a region from that cache's distribution and a direction
+ * in it by the map; otherwise (and always for a cache that saw nothing) the
+ * map as before. The density is the map's times the average over the tied
+ * caches of (1 - beta) + beta P_cache(region) / P_map(region), which the
+ * integrator also applies to escaping rays' MIS weights. */
+#ifndef IRIS_RENDERER_GUIDING_SKYVIS_H
+#define IRIS_RENDERER_GUIDING_SKYVIS_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "renderer/accel.h"
+#include "renderer/envmap.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct iris_cache;
+
+/* Built from one map, used with it: the guide keeps no pointer to the map
+ * (the lights own it and may be built again around a guide that is kept);
+ * sampling checks that the map it is given is the one it was built for. */
+typedef struct iris_skyvis {
+  bool built;                   /* false: no sky guiding (the map's own sampling) */
+  int map_width, map_height;    /* the map it was built for ... */
+  double map_mean;              /* ... and its mean luminance */
+  iris_envmap_regions regions;
+  int region_count;
+  float beta;                   /* probability of a seeing cache's regions */
+  float *cdf;                   /* cache_count rows of region_count floats: the CDF's upper ends */
+  uint8_t *sees;                /* per cache: some probe escaped (else the map alone) */
+  size_t cache_count;
+  uint64_t probes, escaped;     /* shadow rays traced and not blocked */
+  double seconds;
+  size_t memory_bytes;
+} iris_skyvis;
+
+/* Settings: regions across (by = bx / 2, at least 1), probe rays per region,
+ * beta. */
+typedef struct iris_skyvis_params {
+  int regions_x, probes;
+  float beta;
+} iris_skyvis_params;
+
+/* Probes the map from every cache (in parallel; the same result for any
+ * thread count: each cache's rays come from a hash of its index). With no
+ * map, beta <= 0 or probes <= 0 it builds nothing (built false). */
+iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, size_t cache_count, const iris_accel *accel,
+                              const iris_envmap *env, const iris_skyvis_params *p, uint64_t seed, int threads,
+                              iris_error *err);
+void iris_skyvis_destroy(iris_skyvis *sv);
+/* Whether sv was built for env (and is in use). */
+bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
+
+/* Light sampling of the map env (the one sv serves) at a vertex whose tied caches are ids[0..m):
+ * u picks the cache, the branch and the region, (u0, u1) the direction as
+ * iris_envmap_sample_st does. *pdf is the whole strategy's solid-angle
+ * density (not the light choice's probability); *s, *t the map coordinates. */
+bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u, float u0, float u1, iris_vec3 *d,
+                        float *pdf, float *s, float *t);
+/* That density over the map's own (1 without a sky guide or caches) for the
+ * direction at map coordinates (s, t). */
+float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float s, float t);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,251 @@
+/* guiding.skyvis: light sampling of an environment map from what the caches
+ * see of it (renderer/guiding/skyvis.h, envmap.h's regions).
+ *  - regions of a map whose size the grid does not divide (61 x 29 cells in
+ *    7 x 3 regions): their probabilities sum to 1; sampling within a region
+ *    passes chi-square against the map's pdf over the region's probability
+ *    (0 outside), which integrates to 1;
+ *  - the mixture (tied caches picked uniformly, repeated ones, a cache that saw
+ *    nothing, beta < 1 and beta = 1) passes chi-square against
+ *    iris_skyvis_scale x the map's pdf, which integrates to 1;
+ *  - built from sky-room's real caches: probes are traced and most are blocked
+ *    by the room; the tables are bit-identical for 1 and 2 threads. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "chi2.h"
+#include "core/fileio.h"
+#include "core/image.h"
+#include "guide_fixture.h"
+#include "renderer/envmap.h"
+#include "renderer/guiding/skyvis.h"
+#include "scenes/builtin.h"
+#include "scenes/sky.h"
+
+static void write_map(const char *path, int w, int h) {
+  static const char *const rgb[3] = {"R", "G", "B"};
+  iris_image img;
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_image_create(&img, w, h, 3, rgb, &err), &err);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++) {
+      float *p = &img.data[3 * ((size_t)y * (size_t)w + (size_t)x)];
+      float v = 0.05f + 0.5f * (float)x / (float)w + 0.2f * (float)y / (float)h;
+      if (y == 0 || y == h - 1) v = 0.0f;                                        /* black polar rows */
+      if (x >= w / 3 && x < w / 3 + 2 && y >= h / 4 && y < h / 4 + 2) v = 300.0f; /* a sun */
+      p[0] = v;
+      p[1] = 0.7f * v;
+      p[2] = 0.3f * v + 0.01f;
+    }
+  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
+  iris_image_destroy(&img);
+}
+
+typedef struct region_ctx {
+  const iris_envmap *env;
+  const iris_envmap_regions *r;
+  int region;
+} region_ctx;
+
+static bool region_sample(void *vc, const double u[3], double dir[3]) {
+  region_ctx *c = vc;
+  iris_vec3 d;
+  float pdf, s, t;
+  if (!iris_envmap_sample_region(c->env, c->r, c->region, (float)u[0], (float)u[1], &d, &pdf, &s, &t)) return false;
+  dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
+  return true;
+}
+static double region_pdf(void *vc, const double dir[3]) {
+  region_ctx *c = vc;
+  iris_vec3 d = iris_v3((float)dir[0], (float)dir[1], (float)dir[2]);
+  float s, t;
+  iris_envmap_dir_to_st(c->env, d, &s, &t);
+  if (iris_envmap_region_of(c->env, c->r, s, t) != c->region) return 0.0;
+  return (double)iris_envmap_pdf(c->env, d) / (double)c->r->prob[c->region];
+}
+
+typedef struct mix_ctx {
+  const iris_skyvis *sv;
+  const iris_envmap *env;
+  const uint32_t *ids;
+  int m;
+} mix_ctx;
+
+static bool mix_sample(void *vc, const double u[3], double dir[3]) {
+  mix_ctx *c = vc;
+  iris_vec3 d;
+  float pdf, s, t;
+  if (!iris_skyvis_sample(c->sv, c->env, c->ids, c->m, (float)u[2], (float)u[0], (float)u[1], &d, &pdf, &s, &t))
+    return false;
+  /* the density it reports is the one the pdf gives for its direction (up to
+   * a cell edge's rounding) */
+  float s2, t2;
+  iris_envmap_dir_to_st(c->env, d, &s2, &t2);
+  float again = iris_envmap_pdf(c->env, d) * iris_skyvis_scale(c->sv, c->env, c->ids, c->m, s2, t2);
+  if (!(fabsf(again - pdf) <= 1e-3f * pdf)) {
+    static int shown;
+    if (shown++ < 3) fprintf(stderr, "sampled pdf %g, pdf of the direction %g\n", (double)pdf, (double)again);
+  }
+  dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
+  return true;
+}
+static double mix_pdf(void *vc, const double dir[3]) {
+  mix_ctx *c = vc;
+  iris_vec3 d = iris_v3((float)dir[0], (float)dir[1], (float)dir[2]);
+  float s, t;
+  iris_envmap_dir_to_st(c->env, d, &s, &t);
+  return (double)iris_envmap_pdf(c->env, d) * (double)iris_skyvis_scale(c->sv, c->env, c->ids, c->m, s, t);
+}
+
+#define N_TESTS 5
+
+static void test_regions_and_mixture(const char *path) {
+  iris_environment_map m = {(char *)path, 1.0f, 23.0f};
+  iris_envmap env;
+  iris_error err;
+  iris_error_clear(&err);
+  iris_status st = iris_envmap_load(&m, &env, &err);
+  CHECK_OK(st, &err);
+  if (st != IRIS_OK) return;
+  iris_envmap_regions R;
+  st = iris_envmap_regions_build(&env, 7, 3, &R, &err);
+  CHECK_OK(st, &err);
+  if (st != IRIS_OK) {
+    iris_envmap_destroy(&env);
+    return;
+  }
+  double sum = 0.0;
+  int sun = -1;
+  for (int b = 0; b < 21; b++) {
+    sum += R.prob[b];
+    if (sun < 0 || R.prob[b] > R.prob[sun]) sun = b;
+  }
+  CHECK_NEAR(sum, 1.0, 1e-5);
+  /* the brightest region (the sun's) and a dim one of the lower row */
+  int regions[2] = {sun, 2 * 7 + 5};
+  chi2_domain dom = {CHI2_SPHERE, 32, 64, 91};
+  for (int k = 0; k < 2; k++) {
+    region_ctx rc = {&env, &R, regions[k]};
+    chi2_result r = chi2_run(&dom, region_sample, region_pdf, &rc, 200000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "region %d: %s", regions[k], r.message);
+    CHECK_NEAR(r.pdf_integral, 1.0, 3e-3);
+    CHECK(r.lost == 0);
+    printf("region %d (probability %.4f): p = %.3g, pdf integral %.5f\n", regions[k], (double)R.prob[regions[k]],
+           r.p_value, r.pdf_integral);
+  }
+  iris_envmap_regions_destroy(&R);
+
+  /* A sky guide made by hand: cache 0 sees some regions (others 0), cache 1
+   * saw nothing, cache 2 sees only the dim region. */
+  iris_skyvis sv;
+  memset(&sv, 0, sizeof sv);
+  st = iris_envmap_regions_build(&env, 7, 3, &sv.regions, &err);
+  CHECK_OK(st, &err);
+  if (st != IRIS_OK) {
+    iris_envmap_destroy(&env);
+    return;
+  }
+  sv.region_count = 21;
+  sv.cache_count = 3;
+  sv.built = true;
+  sv.map_width = env.width, sv.map_height = env.height, sv.map_mean = env.mean_luminance;
+  sv.cdf = calloc(3 * 21, sizeof(float));
+  sv.sees = calloc(3, 1);
+  float w0[21];
+  for (int b = 0; b < 21; b++) w0[b] = (b % 3 == 0) ? 0.0f : (float)(1 + (b * 7) % 5);
+  double acc = 0.0, tot = 0.0;
+  for (int b = 0; b < 21; b++) tot += w0[b];
+  for (int b = 0; b < 21; b++) {
+    acc += w0[b];
+    sv.cdf[b] = (float)(acc / tot);
+    sv.cdf[2 * 21 + b] = b >= regions[1] ? 1.0f : 0.0f;
+  }
+  sv.cdf[20] = 1.0f;
+  sv.sees[0] = 1, sv.sees[1] = 0, sv.sees[2] = 1;
+  CHECK(iris_skyvis_serves(&sv, &env));
+  const uint32_t ids_a[4] = {0, 1, 2, 0}, ids_b[1] = {2};
+  const float betas[2] = {0.75f, 1.0f};
+  for (int k = 0; k < 2; k++) {
+    sv.beta = betas[k];
+    mix_ctx mc = {&sv, &env, k == 0 ? ids_a : ids_b, k == 0 ? 4 : 1};
+    chi2_result r = chi2_run(&dom, mix_sample, mix_pdf, &mc, 300000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "mixture beta %.2f: %s", (double)betas[k], r.message);
+    CHECK_NEAR(r.pdf_integral, 1.0, 3e-3);
+    printf("mixture beta %.2f over %d caches: p = %.3g, pdf integral %.5f, lost %zu\n", (double)betas[k], mc.m,
+           r.p_value, r.pdf_integral, r.lost);
+  }
+  iris_skyvis_destroy(&sv);
+  iris_envmap_destroy(&env);
+}
+
+static void test_built_from_scene(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("sky-room", &s, &err) == IRIS_OK)) return;
+  iris_guiding *g[2] = {NULL, NULL};
+  for (int t = 0; t < 2; t++) {
+    iris_guiding_params gp = iris_guiding_params_default();
+    gp.train_spp = 0;
+    g[t] = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
+  }
+  if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built)) {
+    const iris_skyvis *a = &g[0]->sky, *b = &g[1]->sky;
+    printf("sky-room: %zu caches, %llu probes, %.1f%% escaped, %.3f s\n", a->cache_count,
+           (unsigned long long)a->probes, 100.0 * (double)a->escaped / (double)a->probes, a->seconds);
+    CHECK(a->probes > 0 && a->escaped > 0 && a->escaped < a->probes);
+    /* What the caches saw is the room's geometry: every cache on the roof
+     * (y = 2.5, facing up) sees the sky; one on the floor in the back half
+     * (x < -0.5, facing up) sees it only through the window in the +x wall,
+     * so no region whose centre lies towards -x has any probability. */
+    iris_environment_map m = {(char *)iris_sky_map_path(), 1.0f, 0.0f};
+    iris_envmap env;
+    iris_status st = iris_envmap_load(&m, &env, &err);
+    CHECK_OK(st, &err);
+    if (st == IRIS_OK) {
+      CHECK(iris_skyvis_serves(a, &env));
+      size_t roof = 0, roof_seeing = 0, back = 0, back_seeing = 0, back_wrong = 0;
+      for (size_t i = 0; i < a->cache_count; i++) {
+        const iris_cache *c = &g[0]->caches[i];
+        if (c->frame.n.y < 0.99f) continue;
+        if (c->p.y > 2.49f) roof++, roof_seeing += a->sees[i]; /* on the ceiling, facing up: its top */
+        if (c->p.y < 0.01f && c->p.x < -0.5f && c->p.x > -1.99f && fabsf(c->p.z) < 1.99f) {
+          back++;
+          back_seeing += a->sees[i];
+          const float *row = &a->cdf[i * (size_t)a->region_count];
+          for (int r = 0; r < a->region_count; r++) {
+            const iris_envmap_regions *R = &a->regions;
+            int ci = r % R->bx, rj = r / R->bx;
+            float sc = 0.5f * (float)(R->col0[ci] + R->col0[ci + 1]) / (float)env.width;
+            float tc = 0.5f * (float)(R->row0[rj] + R->row0[rj + 1]) / (float)env.height;
+            float pr = row[r] - (r > 0 ? row[r - 1] : 0.0f);
+            if (a->sees[i] && iris_envmap_st_to_dir(&env, sc, tc).x < -0.5f && pr > 0.0f) back_wrong++;
+          }
+        }
+      }
+      printf("roof caches %zu (%zu see the sky), back floor caches %zu (%zu see it), %zu wrong regions\n", roof,
+             roof_seeing, back, back_seeing, back_wrong);
+      CHECK(roof > 0 && roof_seeing == roof);
+      CHECK(back > 0 && back_seeing > 0 && back_wrong == 0);
+      iris_envmap_destroy(&env);
+    }
+    CHECK(a->cache_count == b->cache_count && a->probes == b->probes && a->escaped == b->escaped);
+    CHECK(memcmp(a->sees, b->sees, a->cache_count) == 0);
+    CHECK(memcmp(a->cdf, b->cdf, sizeof(float) * a->cache_count * (size_t)a->region_count) == 0);
+  }
+  iris_guiding_destroy(g[0]);
+  iris_guiding_destroy(g[1]);
+  iris_scene_destroy(s);
+}
+
+int main(void) {
+  char dir[1024], path[1100];
+  if (iris_test_tmpdir(dir, sizeof dir, "skyvis") != 0) return TEST_SKIP("no temporary folder");
+  snprintf(path, sizeof path, "%s/map.exr", dir);
+  write_map(path, 61, 29);
+  test_regions_and_mixture(path);
+  test_built_from_scene();
+  return iris_check_summary("guiding.skyvis");
+}
