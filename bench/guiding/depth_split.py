@@ -3,7 +3,7 @@
 
   bench/guiding/depth_split.py IRIS SCENE [--methods mis,guided-nee] [--spp 64]
       [--seeds 1,2,3,4] [--ref-spp 4096] [--width 144 --height 96] [--out DIR]
-      [-- extra iris render options]
+      [-- extra iris render options for the methods' renders]
 
 Renders references (mis, independent sampler, seed 999) with --max-depth 0
 (direct light only), 1 (and one bounce) and the default, then each method at
@@ -38,8 +38,8 @@ ap.add_argument("--ref-spp", type=int, default=4096)
 ap.add_argument("--width", type=int, default=144)
 ap.add_argument("--height", type=int, default=96)
 ap.add_argument("--out", default=None)
-ap.add_argument("extra", nargs="*")
-a = ap.parse_args()
+a, extra = ap.parse_known_args()  # the rest goes to every iris render of a method
+extra = [x for x in extra if x != "--"]
 out = a.out or tempfile.mkdtemp(prefix="depth-split-")
 os.makedirs(out, exist_ok=True)
 size = ["--width", str(a.width), "--height", str(a.height)]
@@ -72,7 +72,7 @@ with tempfile.TemporaryDirectory() as tmp:
             v = []
             for s in a.seeds.split(","):
                 p = os.path.join(out, f"{m}-{name}-{s}.exr")
-                render(p, ["--method", m, "--seed", s, "--spp", str(a.spp)] + opts + a.extra)
+                render(p, ["--method", m, "--seed", s, "--spp", str(a.spp)] + opts + extra)
                 v.append(relmse(es.read_exr(p, tmp), refs[name], den))
             vals[name] = float(np.mean(v))
         print(f"| {m} | {vals['0']:.5f} | {vals['1']:.5f} | {vals['full']:.5f} | "
