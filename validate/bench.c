@@ -482,9 +482,12 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
 
 /* ---- Cycles ------------------------------------------------------------ */
 
-/* One Cycles row per budget, at the spp the budget's mis run (seed 0) reached
- * (the first method's when mis is not benched). Its time is Blender's render
- * time as the exported script prints it, start-up and scene build excluded. */
+/* One Cycles row per budget and seed s, at the spp the budget's mis run with
+ * seed s reached (the first method's when mis is not benched), with Cycles'
+ * seed s: the table averages Cycles over the same seeds as iris, so that one
+ * lucky or unlucky Cycles image does not decide a comparison. Its time is
+ * Blender's render time as the exported script prints it, start-up and scene
+ * build excluded. */
 static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_scene *bs,
                               iris_bench_scene *sc, iris_bench_result *res, float exposure,
                               iris_error *err) {
@@ -508,27 +511,29 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
     if (p->methods[k] == IRIS_METHOD_MIS) kb = k;
   iris_bench_method_label(p, kb, base, sizeof base);
   int threads = p->threads > 0 ? p->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
-  for (int t = 0; t < p->time_count; t++) {
+  for (int run = 0; run < p->time_count * p->seeds; run++) {
+    const int t = run / p->seeds, seed = run % p->seeds;
     int spp = 0;
     for (size_t i = 0; i < res->row_count; i++) {
       const iris_bench_row *r = &res->rows[i];
-      if (strcmp(r->scene, sc->name) == 0 && strcmp(r->method, base) == 0 && r->seed == 0 &&
+      if (strcmp(r->scene, sc->name) == 0 && strcmp(r->method, base) == 0 && r->seed == (uint64_t)seed &&
           r->budget_s == p->times[t])
         spp = r->spp;
     }
     if (spp <= 0) continue;
     if (p->cancel && *p->cancel)
       return iris_error_set(err, IRIS_ERR_INTERRUPTED, NULL, 0, NULL, "interrupted");
-    begin_run(ctx, sc->name, "cycles", 0.0, 0, p->times[t]);
-    snprintf(exr, sizeof exr, "%s/%gs.exr", dir, p->times[t]);
-    snprintf(log, sizeof log, "%s/%gs.log", dir, p->times[t]);
-    char a_spp[32], a_threads[32], a_w[32], a_h[32], a_b[32];
+    begin_run(ctx, sc->name, "cycles", 0.0, (uint64_t)seed, p->times[t]);
+    snprintf(exr, sizeof exr, "%s/%gs-seed%d.exr", dir, p->times[t], seed);
+    snprintf(log, sizeof log, "%s/%gs-seed%d.log", dir, p->times[t], seed);
+    char a_spp[32], a_threads[32], a_w[32], a_h[32], a_b[32], a_seed[32];
+    snprintf(a_seed, sizeof a_seed, "%d", seed);
     snprintf(a_spp, sizeof a_spp, "%d", spp);
     snprintf(a_threads, sizeof a_threads, "%d", threads);
     snprintf(a_w, sizeof a_w, "%d", sc->width);
     snprintf(a_h, sizeof a_h, "%d", sc->height);
     snprintf(a_b, sizeof a_b, "%d", bs->max_depth);
-    const char *args[] = {"--output", exr, "--spp", a_spp, "--threads", a_threads, "--seed", "0",
+    const char *args[] = {"--output", exr, "--spp", a_spp, "--threads", a_threads, "--seed", a_seed,
                           "--width", a_w, "--height", a_h, "--max-bounces", a_b, NULL};
     iris_blender_run_info info;
     st = iris_blender_run(p->blender, script, args, log, &info, err);
@@ -547,12 +552,13 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
     snprintf(row.scene, sizeof row.scene, "%s", sc->name);
     snprintf(row.method, sizeof row.method, "cycles");
     row.budget_s = p->times[t];
+    row.seed = (uint64_t)seed;
     row.seconds = info.render_seconds;
     row.setup_seconds = info.build_seconds;
     row.spp = spp;
     fill_metrics(&img, &bs->ref, &row);
     st = add_row(res, &row, err);
-    if (st == IRIS_OK && t == p->time_count - 1)
+    if (st == IRIS_OK && t == p->time_count - 1 && seed == 0)
       st = write_preview(p->out_dir, sc, "cycles", &img, &bs->ref, exposure, err);
     iris_image_destroy(&img);
     if (st != IRIS_OK) return st;
@@ -692,9 +698,9 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
     for (int t = 0; t < p.time_count; t++) per_scene += p.times[t];
     ctx.runs = p.input_count * p.method_count * p.time_count * p.seeds;
     ctx.planned_left = per_scene * p.method_count * p.seeds * p.input_count;
-    if (p.cycles) {
-      ctx.runs += p.input_count * p.time_count;
-      ctx.planned_left += per_scene * p.input_count;
+    if (p.cycles) { /* one Cycles run per budget and seed */
+      ctx.runs += p.input_count * p.time_count * p.seeds;
+      ctx.planned_left += per_scene * p.input_count * p.seeds;
     }
     if (!p.references) ctx.runs += p.input_count;
   }
