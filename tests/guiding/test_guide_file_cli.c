@@ -93,6 +93,22 @@ int main(int argc, char **argv) {
                          sizeof out, err, sizeof err);
   iris_check_record(rc == 0 && strstr(err, "auto: guided-nee") && same_pixels(dir, "AA.exr", "AB.exr"), __FILE__,
                     __LINE__, "auto on door through a guide file: exit %d: %s", rc, err);
+  /* under a sky the reading render probes the map again from the caches read
+   * (docs/guiding.md, "Sky visibility"): the same tables, the same image */
+  rc = iris_test_run_cli(dir, bin,
+                         "render sky-room --method guided-nee --spp 8 --height 32 --train-spp 3 --discard-training "
+                         "--guide-out GS -o SA.exr --quiet",
+                         out, sizeof out, err, sizeof err);
+  CHECK(rc == 0);
+  rc = iris_test_run_cli(dir, bin, "render sky-room --method guided-nee --spp 8 --height 32 --train-spp 3 --guide-in GS -o SB.exr",
+                         out, sizeof out, err, sizeof err);
+  iris_check_record(rc == 0 && strstr(err, "sky seen from the caches") && same_pixels(dir, "SA.exr", "SB.exr"),
+                    __FILE__, __LINE__, "sky-room through a guide file: exit %d: %s", rc, err);
+  rc = iris_test_run_cli(dir, bin,
+                         "render sky-room --method guided-nee --spp 8 --height 32 --train-spp 3 --guide-in GS "
+                         "--sky-beta 0.5 -o X.exr",
+                         out, sizeof out, err, sizeof err);
+  CHECK(rc == 2 && lines(err) == 1 && !iris_test_file_exists(dir, "X.exr")); /* other sky settings */
   rc = iris_test_run_cli(dir, bin, "render cornell-box --spp 4 --height 32 --guide-out GC -o CA.exr --quiet", out,
                          sizeof out, err, sizeof err);
   CHECK(rc == 0 && iris_test_file_exists(dir, "GC"));
