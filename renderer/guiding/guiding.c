@@ -929,14 +929,14 @@ static int guided_sample_environment(void *ctx, const iris_envmap *env, const ir
                                      float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return -1;
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
   return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
 }
 
 static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, iris_vec3 wi) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return 1.0f;
   float s, t;
   iris_envmap_dir_to_st(env, wi, &s, &t);
   return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
@@ -981,11 +981,12 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              asum / (double)learned, (double)g->params.alpha_max);
   else
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
-  char sky[128] = "";
-  if (g->sky.built)
-    snprintf(sky, sizeof sky, "; sky seen from the caches: %llu probes, %.0f%% escaped, %.2f s",
+  char sky[160] = "";
+  if (g->sky.probed)
+    snprintf(sky, sizeof sky, "; sky seen from the caches: %llu probes, %.0f%% escaped, %zu caches see part of it%s, %.2f s",
              (unsigned long long)g->sky.probes,
-             g->sky.probes ? 100.0 * (double)g->sky.escaped / (double)g->sky.probes : 0.0, g->sky.seconds);
+             g->sky.probes ? 100.0 * (double)g->sky.escaped / (double)g->sky.probes : 0.0, g->sky.part_caches,
+             g->sky.built ? "" : " (too few: the map's own sampling)", g->sky.seconds);
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, %s; "

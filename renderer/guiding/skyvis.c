@@ -11,6 +11,13 @@
 #include "renderer/guiding/guiding.h"
 
 #define SKYVIS_STREAM 0x736b7976697355ULL /* the probes' hash stream */
+/* Share of the sky a cache faces (weighted by the map and the cosine) that it
+ * must see for the map's own sampling to serve it: then at most half of the
+ * map's light samples there are lost, and the mixture's cost is not worth it
+ * (docs/guiding.md, "Sky visibility"). */
+#define SKYVIS_OPEN 0.5
+/* Share of the caches that must see part of the sky for the mixture to be used. */
+#define SKYVIS_MIN_PART 0.1
 
 void iris_skyvis_destroy(iris_skyvis *sv) {
   iris_envmap_regions_destroy(&sv->regions);
@@ -42,13 +49,13 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
     const iris_cache *cache = &c->caches[i];
     const iris_vec3 n = cache->frame.n;
     float *row = &sv->cdf[i * (size_t)sv->region_count];
-    double acc = 0.0;
+    double acc = 0.0, open = 0.0; /* open: the same weights as if nothing blocked the probes */
     for (int b = 0; b < sv->region_count; ++b) {
       double w = 0.0;
       if (R->prob[b] > 0.0f) {
         uint64_t h = iris_hash4(c->seed, SKYVIS_STREAM ^ i, (uint64_t)b, 0);
         const float jitter = iris_u64_to_unit(h);
-        double seen = 0.0;
+        double seen = 0.0, facing = 0.0;
         for (int k = 0; k < c->probes; ++k) {
           h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
           float u0 = ((float)k + jitter) / (float)c->probes, u1 = iris_u64_to_unit(h);
@@ -58,6 +65,7 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
           if (!iris_envmap_sample_region(c->env, R, b, u0, u1, &d, &pdf, &s, &t)) continue;
           float cosv = iris_dot(d, n);
           if (!cache->sphere && !(cosv > 0.0f)) continue;
+          facing += fabs((double)cosv);
           iris_ray ray;
           ray.o = iris_offset_origin(cache->p, n, d);
           ray.d = d;
@@ -69,11 +77,15 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
           seen += fabs((double)cosv);
         }
         w = (double)R->prob[b] * seen / (double)c->probes;
+        open += (double)R->prob[b] * facing / (double)c->probes;
       }
       acc += w;
       row[b] = (float)acc;
     }
-    sv->sees[i] = acc > 0.0;
+    /* A cache that saw at least half of the sky its side of the surface
+     * faces adds little to the map's own sampling but its cost: it takes the
+     * map, as one that saw nothing does. */
+    sv->sees[i] = acc > 0.0 ? (acc < SKYVIS_OPEN * open ? IRIS_SKYVIS_PART : IRIS_SKYVIS_OPEN) : IRIS_SKYVIS_NONE;
     if (acc > 0.0) {
       for (int b = 0; b < sv->region_count; ++b) row[b] = (float)((double)row[b] / acc);
       /* the last region with weight ends at exactly 1 */
@@ -113,6 +125,7 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
     sv->escaped += counts[8 * (size_t)(nt + t)];
   }
   free(counts);
+  for (size_t i = 0; i < cache_count; ++i) sv->part_caches += sv->sees[i] == IRIS_SKYVIS_PART;
   if (iris_cancel_requested()) {
     iris_skyvis_destroy(sv);
     return iris_cancel_error(err);
@@ -120,6 +133,19 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
   sv->memory_bytes = sizeof(float) * cache_count * (size_t)sv->region_count + cache_count +
                      sizeof(float) * (size_t)bx * ((size_t)env->height + (size_t)by + (size_t)by);
   sv->seconds = iris_time_now() - t0;
+  sv->probed = true;
+  if ((double)sv->part_caches < SKYVIS_MIN_PART * (double)cache_count) {
+    /* Nearly every cache sees all its sky or none: the map's own sampling
+     * does as well, without the cost of the mixture (an open scene). */
+    uint64_t probes = sv->probes, escaped = sv->escaped;
+    size_t part = sv->part_caches;
+    double seconds = sv->seconds;
+    iris_skyvis_destroy(sv);
+    sv->probed = true;
+    sv->probes = probes, sv->escaped = escaped, sv->part_caches = part, sv->seconds = seconds;
+    sv->cache_count = cache_count;
+    return IRIS_OK;
+  }
   sv->built = true;
   sv->map_width = env->width;
   sv->map_height = env->height;
@@ -140,12 +166,19 @@ static inline float region_ratio(const iris_skyvis *sv, const float *row, int re
   return pc / pm;
 }
 
+bool iris_skyvis_guides(const iris_skyvis *sv, const uint32_t *ids, int m) {
+  if (!sv->built) return false;
+  for (int i = 0; i < m; ++i)
+    if (sv->sees[ids[i]] == IRIS_SKYVIS_PART) return true;
+  return false;
+}
+
 float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float s, float t) {
-  if (!sv->built || m <= 0) return 1.0f;
+  if (!iris_skyvis_guides(sv, ids, m)) return 1.0f;
   const int region = iris_envmap_region_of(env, &sv->regions, s, t);
   float sum = 0.0f;
   for (int i = 0; i < m; ++i) {
-    if (!sv->sees[ids[i]]) {
+    if (sv->sees[ids[i]] != IRIS_SKYVIS_PART) {
       sum += 1.0f;
       continue;
     }
@@ -175,7 +208,7 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
   float ub = um - (float)j; /* the rest of u, uniform in [0, 1) */
   const uint32_t id = ids[j];
   float pdf_map;
-  if (sv->sees[id] && ub < sv->beta) {
+  if (sv->sees[id] == IRIS_SKYVIS_PART && ub < sv->beta) {
     const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
     int region = search_row(row, sv->region_count, ub / sv->beta);
     if (!iris_envmap_sample_region(env, &sv->regions, region, u0, u1, d, &pdf_map, s, t)) return false;

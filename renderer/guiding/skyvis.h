@@ -10,8 +10,8 @@
  * escaped. Light sampling of the map at a vertex then picks one of the
  * vertex's tied caches uniformly (as the directional guide does) and, with
  * probability beta, a region from that cache's distribution and a direction
- * in it by the map; otherwise (and always for a cache that saw nothing) the
- * map as before. The density is the map's times the average over the tied
+ * in it by the map; otherwise (and always for a cache that saw nothing, or
+ * at least half of the sky it faces) the map as before. The density is the map's times the average over the tied
  * caches of (1 - beta) + beta P_cache(region) / P_map(region), which the
  * integrator also applies to escaping rays' MIS weights. */
 #ifndef IRIS_RENDERER_GUIDING_SKYVIS_H
@@ -31,20 +31,28 @@ extern "C" {
 
 struct iris_cache;
 
+/* What a cache's probes saw: nothing; less than half of the sky its side
+ * faces (weighted by the map and the cosine); at least half of it. */
+enum { IRIS_SKYVIS_NONE = 0, IRIS_SKYVIS_PART = 1, IRIS_SKYVIS_OPEN = 2 };
+
 /* Built from one map, used with it: the guide keeps no pointer to the map
  * (the lights own it and may be built again around a guide that is kept);
  * sampling checks that the map it is given is the one it was built for. */
 typedef struct iris_skyvis {
   bool built;                   /* false: no sky guiding (the map's own sampling) */
+  bool probed;                  /* the probes ran (built false: fewer than 10% of the
+                                   caches saw part of the sky; the counts stay) */
   int map_width, map_height;    /* the map it was built for ... */
   double map_mean;              /* ... and its mean luminance */
   iris_envmap_regions regions;
   int region_count;
   float beta;                   /* probability of a seeing cache's regions */
   float *cdf;                   /* cache_count rows of region_count floats: the CDF's upper ends */
-  uint8_t *sees;                /* per cache: some probe escaped (else the map alone) */
+  uint8_t *sees;                /* per cache, IRIS_SKYVIS_*: only a cache that saw part of
+                                   the sky samples its regions; the others take the map */
   size_t cache_count;
   uint64_t probes, escaped;     /* shadow rays traced and not blocked */
+  size_t part_caches;           /* caches that saw less than half of their sky (the ones that guide) */
   double seconds;
   size_t memory_bytes;
 } iris_skyvis;
@@ -58,7 +66,9 @@ typedef struct iris_skyvis_params {
 
 /* Probes the map from every cache (in parallel; the same result for any
  * thread count: each cache's rays come from a hash of its index). With no
- * map, beta <= 0 or probes <= 0 it builds nothing (built false). */
+ * map, beta <= 0 or probes <= 0 it builds nothing (built false); when fewer
+ * than 10% of the caches see part of the sky (the rest all of it, or none)
+ * it keeps only the counts (built false, probed true). */
 iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, size_t cache_count, const iris_accel *accel,
                               const iris_envmap *env, const iris_skyvis_params *p, uint64_t seed, int threads,
                               iris_error *err);
@@ -72,6 +82,9 @@ bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
  * density (not the light choice's probability); *s, *t the map coordinates. */
 bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u, float u0, float u1, iris_vec3 *d,
                         float *pdf, float *s, float *t);
+/* Whether any of the tied caches ids[0..m) samples its own regions (else the
+ * density is the map's: iris_skyvis_scale is 1 whatever the direction). */
+bool iris_skyvis_guides(const iris_skyvis *sv, const uint32_t *ids, int m);
 /* That density over the map's own (1 without a sky guide or caches) for the
  * direction at map coordinates (s, t). */
 float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float s, float t);

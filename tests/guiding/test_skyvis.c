@@ -7,8 +7,11 @@
  *  - the mixture (tied caches picked uniformly, repeated ones, a cache that saw
  *    nothing, beta < 1 and beta = 1) passes chi-square against
  *    iris_skyvis_scale x the map's pdf, which integrates to 1;
- *  - built from sky-room's real caches: probes are traced and most are blocked
- *    by the room; the tables are bit-identical for 1 and 2 threads. */
+ *  - built from sky-room's real caches: roof caches see all the sky (and take
+ *    the map), back-floor caches see only the window's side; the tables are
+ *    bit-identical for 1 and 2 threads; on env-objects (open sky) fewer than
+ *    10% of the caches see less than half of their sky, and the map's own
+ *    sampling is kept. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -164,7 +167,7 @@ static void test_regions_and_mixture(const char *path) {
     sv.cdf[2 * 21 + b] = b >= regions[1] ? 1.0f : 0.0f;
   }
   sv.cdf[20] = 1.0f;
-  sv.sees[0] = 1, sv.sees[1] = 0, sv.sees[2] = 1;
+  sv.sees[0] = IRIS_SKYVIS_PART, sv.sees[1] = IRIS_SKYVIS_NONE, sv.sees[2] = IRIS_SKYVIS_PART;
   CHECK(iris_skyvis_serves(&sv, &env));
   const uint32_t ids_a[4] = {0, 1, 2, 0}, ids_b[1] = {2};
   const float betas[2] = {0.75f, 1.0f};
@@ -197,9 +200,10 @@ static void test_built_from_scene(void) {
            (unsigned long long)a->probes, 100.0 * (double)a->escaped / (double)a->probes, a->seconds);
     CHECK(a->probes > 0 && a->escaped > 0 && a->escaped < a->probes);
     /* What the caches saw is the room's geometry: every cache on the roof
-     * (y = 2.5, facing up) sees the sky; one on the floor in the back half
-     * (x < -0.5, facing up) sees it only through the window in the +x wall,
-     * so no region whose centre lies towards -x has any probability. */
+     * (y = 2.5, facing up) sees the sky above it (and takes the map); one
+     * on the floor in the back half (x < -0.5, facing up) sees it only through
+     * the window in the +x wall, so no region whose centre lies towards -x has
+     * any probability. */
     iris_environment_map m = {(char *)iris_sky_map_path(), 1.0f, 0.0f};
     iris_envmap env;
     iris_status st = iris_envmap_load(&m, &env, &err);
@@ -210,10 +214,11 @@ static void test_built_from_scene(void) {
       for (size_t i = 0; i < a->cache_count; i++) {
         const iris_cache *c = &g[0]->caches[i];
         if (c->frame.n.y < 0.99f) continue;
-        if (c->p.y > 2.49f) roof++, roof_seeing += a->sees[i]; /* on the ceiling, facing up: its top */
+        if (c->p.y > 2.49f) roof++, roof_seeing += a->sees[i] == IRIS_SKYVIS_OPEN; /* the ceiling's top */
         if (c->p.y < 0.01f && c->p.x < -0.5f && c->p.x > -1.99f && fabsf(c->p.z) < 1.99f) {
           back++;
-          back_seeing += a->sees[i];
+          back_seeing += a->sees[i] == IRIS_SKYVIS_PART;
+          CHECK(a->sees[i] != IRIS_SKYVIS_OPEN);
           const float *row = &a->cdf[i * (size_t)a->region_count];
           for (int r = 0; r < a->region_count; r++) {
             const iris_envmap_regions *R = &a->regions;
@@ -221,11 +226,11 @@ static void test_built_from_scene(void) {
             float sc = 0.5f * (float)(R->col0[ci] + R->col0[ci + 1]) / (float)env.width;
             float tc = 0.5f * (float)(R->row0[rj] + R->row0[rj + 1]) / (float)env.height;
             float pr = row[r] - (r > 0 ? row[r - 1] : 0.0f);
-            if (a->sees[i] && iris_envmap_st_to_dir(&env, sc, tc).x < -0.5f && pr > 0.0f) back_wrong++;
+            if (a->sees[i] == IRIS_SKYVIS_PART && iris_envmap_st_to_dir(&env, sc, tc).x < -0.5f && pr > 0.0f) back_wrong++;
           }
         }
       }
-      printf("roof caches %zu (%zu see the sky), back floor caches %zu (%zu see it), %zu wrong regions\n", roof,
+      printf("roof caches %zu (%zu see all the sky), back floor caches %zu (%zu see part of it), %zu wrong regions\n", roof,
              roof_seeing, back, back_seeing, back_wrong);
       CHECK(roof > 0 && roof_seeing == roof);
       CHECK(back > 0 && back_seeing > 0 && back_wrong == 0);
@@ -237,6 +242,24 @@ static void test_built_from_scene(void) {
   }
   iris_guiding_destroy(g[0]);
   iris_guiding_destroy(g[1]);
+  iris_scene_destroy(s);
+  /* Under the open sky nearly every cache sees most of it: the map's own
+   * sampling is kept (probed, not built). */
+  s = NULL;
+  if (!CHECK(iris_builtin_create("env-objects", &s, &err) == IRIS_OK)) return;
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.train_spp = 0;
+  gp.force = true;
+  iris_guiding *o = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, 2, 16);
+  if (CHECK(o)) {
+    printf("env-objects: %zu caches, %zu see part of the sky, built %d\n", o->sky.cache_count, o->sky.part_caches,
+           o->sky.built);
+    CHECK(o->sky.probed && !o->sky.built && !o->sky.cdf);
+    CHECK(o->sky.part_caches * 10 < o->sky.cache_count);
+    iris_direction_sampler ds = iris_guiding_sampler(o);
+    CHECK(!ds.sample_environment && !ds.environment_scale);
+  }
+  iris_guiding_destroy(o);
   iris_scene_destroy(s);
 }
 
