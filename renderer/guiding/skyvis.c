@@ -210,7 +210,7 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
   float pdf_map;
   if (sv->sees[id] == IRIS_SKYVIS_PART && ub < sv->beta) {
     const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
-    int region = search_row(row, sv->region_count, ub / sv->beta);
+    int region = search_row(row, sv->region_count, fminf(ub / sv->beta, 0x1.fffffep-1f)); /* rounding: below 1 */
     if (!iris_envmap_sample_region(env, &sv->regions, region, u0, u1, d, &pdf_map, s, t)) return false;
   } else {
     if (!iris_envmap_sample_st(env, u0, u1, d, &pdf_map, s, t)) return false;

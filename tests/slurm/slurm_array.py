@@ -7,7 +7,8 @@ writes the guide every task reads (afterok).
 Then `iris-slurm sweep` runs a 6-command array + report job, and a sweep with a
 failing task must end without its report job (afterok).
 
-Brings up munged (as the munge user, key and socket in the test dir),
+Brings up munged (as the munge user, key and socket in a temporary folder it
+can reach, removed on exit),
 slurmctld and slurmd (no systemd; SLURM_CONF points at a generated slurm.conf
 with proctrack/linuxproc and select/cons_tres) and tears everything down on
 exit, failure or signal. Exits 77 (CTest SKIP_RETURN_CODE) with the reason
@@ -23,6 +24,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 
 SKIP = 77
@@ -41,6 +43,7 @@ def skip(reason):
 class Cluster:
     def __init__(self, root):
         self.root = root
+        self.munge_dir = None  # munged's folder (setup_munge), removed by stop()
         self.procs = []  # (name, Popen) started here, stopped in reverse order
         self.env = dict(os.environ)
 
@@ -91,6 +94,13 @@ class Cluster:
                     p.wait()
             log(f"stopped {name} (exit {p.returncode})")
         self.procs = []
+        if self.munge_dir:
+            try:  # its log beside the others, then the folder away
+                shutil.copy(os.path.join(self.munge_dir, "munged.log"), self.path("log", "munged.log"))
+            except OSError:
+                pass
+            shutil.rmtree(self.munge_dir, ignore_errors=True)
+            self.munge_dir = None
 
 
 def free_port():
@@ -110,8 +120,12 @@ def node_line():
 
 def setup_munge(c):
     mu = pwd.getpwnam("munge")
-    d = c.path("munge")
-    os.makedirs(d, exist_ok=True)
+    # munged runs as the munge user: its key, socket and log live in a folder
+    # of their own under the system's temporary folder, which that user can
+    # reach whatever the permissions of the build tree (a clone in a private
+    # 0700 folder made munged fail to create its socket)
+    d = tempfile.mkdtemp(prefix="iris-slurm-munge-")
+    c.munge_dir = d
     key = os.path.join(d, "munge.key")
     subprocess.run(["mungekey", "--create", "--force", f"--keyfile={key}"], check=True, timeout=30)
     # munged insists: key owned by its user, not readable by others; its dirs
@@ -123,7 +137,7 @@ def setup_munge(c):
     sock = os.path.join(d, "munge.socket")
     c.start("munged", ["munged", "--foreground", f"--key-file={key}", f"--socket={sock}",
                        f"--pid-file={d}/munged.pid", f"--seed-file={d}/munged.seed",
-                       f"--log-file={c.path('log', 'munged.log')}", "--force"],
+                       f"--log-file={os.path.join(d, 'munged.log')}", "--force"],
             user=mu.pw_uid, group=mu.pw_gid, extra_groups=[])
     for _ in range(100):
         if os.path.exists(sock):
