@@ -1035,7 +1035,7 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   iris_guiding *g = NULL;
   iris_status st = provider_guide(setup, &p, &g, err);
   if (st != IRIS_OK) return st;
-  char line[512];
+  char line[768]; /* the describe line at 1080p with the sky: ~470 characters */
   iris_guiding_describe(g, line, sizeof line);
   if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
   else iris_infof("%s", line);
