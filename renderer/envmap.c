@@ -392,10 +392,11 @@ float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d) {
   return pdf_st(env, s, t);
 }
 
-iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf) {
+iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf, float st[2]) {
   float s, t;
   iris_envmap_dir_to_st(env, d, &s, &t);
   if (pdf) *pdf = pdf_st(env, s, t);
+  if (st) st[0] = s, st[1] = t;
   return iris_envmap_radiance_st(env, s, t);
 }
 

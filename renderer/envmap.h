@@ -82,8 +82,9 @@ bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3
 void iris_envmap_prefetch(const iris_envmap *env, float u0, float u1, int stage);
 /* Solid-angle density with which iris_envmap_sample returns d. */
 float iris_envmap_pdf(const iris_envmap *env, iris_vec3 d);
-/* Radiance from d and (optional) that density, with one conversion of d. */
-iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf);
+/* Radiance from d and (optional) that density and d's map coordinates, with
+ * one conversion of d. */
+iris_vec3 iris_envmap_eval(const iris_envmap *env, iris_vec3 d, float *pdf, float st[2]);
 
 /* Regions: the map's cells cut into bx x by rectangles of whole cells
  * (region column i holds the cell columns [col0[i], col0[i+1]), col0[i] =

@@ -290,12 +290,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
-      float env_pdf = 0.0f;
+      float env_pdf = 0.0f, st[2];
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
-                                                 !prev_delta && mis ? &env_pdf : NULL);
+                                                 !prev_delta && mis ? &env_pdf : NULL, st);
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
-        if (env_guided && !prev_delta && mis && bounce > 0)
-          env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, ray.d);
+        if (env_guided && !prev_delta && mis && bounce > 0) /* the map's coordinates of ray.d: st */
+          env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, st[0], st[1]);
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));

@@ -136,10 +136,10 @@ typedef struct iris_direction_sampler {
    * (u0, u1) as the map's sampling uses them. */
   int (*sample_environment)(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u,
                             float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t);
-  /* With sample_environment: its density for direction wi over the map's own,
-   * at the vertex whose prepared state is v (for the MIS weight of a ray that
-   * left that vertex and escaped). */
-  float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, iris_vec3 wi);
+  /* With sample_environment: its density for the direction at map
+   * coordinates (s, t) over the map's own, at the vertex whose prepared state
+   * is v (for the MIS weight of a ray that left that vertex and escaped). */
+  float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

@@ -651,6 +651,11 @@ void iris_lights_sample_radiance(const iris_lights *lights, iris_light_sample *s
   s->L_pending = false;
 }
 
+/* The probability of the light a choice names (its group's times its own in it). */
+static float choice_pmf(const iris_lights *lights, const iris_light_choice *c) {
+  return c->pmf_is_entry ? c->pmf_group : c->pmf_group * pmf_in_group(lights, c->light); /* 1 * pe = pe exactly */
+}
+
 bool iris_lights_choice_is_environment_map(const iris_lights *lights, const iris_light_choice *c) {
   return lights->envmap && lights->environment >= 0 && c->light == (uint32_t)lights->environment &&
          c->pmf_group > 0.0f;
@@ -659,7 +664,7 @@ bool iris_lights_choice_is_environment_map(const iris_lights *lights, const iris
 bool iris_lights_environment_sample_at(const iris_lights *lights, const iris_light_choice *c, iris_vec3 ref,
                                        iris_vec3 wi, float pdf_dir, float s, float t, iris_light_sample *out) {
   if (!iris_lights_choice_is_environment_map(lights, c)) return false;
-  float pmf = c->pmf_is_entry ? c->pmf_group : c->pmf_group * pmf_in_group(lights, c->light);
+  float pmf = choice_pmf(lights, c);
   out->light = c->light;
   out->delta = false;
   out->wi = wi;
@@ -678,7 +683,7 @@ static bool sample_choice(const iris_lights *lights, iris_vec3 ref, const iris_l
   s->L_pending = false;
   if (!(c->pmf_group > 0.0f) || c->light >= lights->count) return false;
   uint32_t i = c->light;
-  float pmf = c->pmf_is_entry ? c->pmf_group : c->pmf_group * pmf_in_group(lights, i); /* 1 * pe = pe exactly */
+  float pmf = choice_pmf(lights, c);
   if (!(pmf > 0.0f)) return false;
   s->light = i;
   if (i < lights->tri_count) { /* a triangle: only its cache line is read */
@@ -816,12 +821,12 @@ float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris
 }
 
 iris_vec3 iris_lights_environment_pdf(const iris_lights *lights, iris_vec3 d, iris_vec3 ref, iris_vec3 n,
-                                      float *pdf) {
+                                      float *pdf, float map_st[2]) {
   if (!pdf) return iris_lights_environment(lights, d);
   *pdf = 0.0f;
   if (lights->environment < 0) return iris_v3(0, 0, 0);
   float map_pdf = iris_sample_uniform_sphere_pdf();
-  iris_vec3 L = lights->envmap ? iris_envmap_eval(lights->envmap, iris_normalize(d), &map_pdf)
+  iris_vec3 L = lights->envmap ? iris_envmap_eval(lights->envmap, iris_normalize(d), &map_pdf, map_st)
                                : lights->entries[lights->environment].radiance;
   if (L.x > 0.0f || L.y > 0.0f || L.z > 0.0f)
     *pdf = iris_lights_select_pmf_at(lights, ref, n, (uint32_t)lights->environment) * map_pdf;

@@ -238,9 +238,10 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref, iris_ve
 iris_vec3 iris_lights_environment(const iris_lights *lights, iris_vec3 d);
 float iris_lights_pdf_environment(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, iris_vec3 d);
 /* Both with one lookup of d: the radiance, and in *pdf (when not NULL) the
- * value of iris_lights_pdf_environment(lights, ref, n, d). */
+ * value of iris_lights_pdf_environment(lights, ref, n, d); with a map and a
+ * pdf asked for, map_st (when not NULL) gets d's map coordinates. */
 iris_vec3 iris_lights_environment_pdf(const iris_lights *lights, iris_vec3 d, iris_vec3 ref, iris_vec3 n,
-                                      float *pdf);
+                                      float *pdf, float map_st[2]);
 /* Whether a light choice is the environment map (which a direction sampler
  * may sample itself: iris_direction_sampler.sample_environment). */
 bool iris_lights_choice_is_environment_map(const iris_lights *lights, const iris_light_choice *c);

@@ -65,7 +65,6 @@ static void print_help(void) {
       IRIS_BENCH_DEFAULT_REFERENCE_SPP);
 }
 
-
 static void draw_progress(void *ctx, const iris_bench_progress *p) {
   (void)ctx;
   int bar = (int)(p->run_fraction * 20.0 + 0.5);

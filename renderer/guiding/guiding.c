@@ -933,12 +933,11 @@ static int guided_sample_environment(void *ctx, const iris_envmap *env, const ir
   return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
 }
 
-static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, iris_vec3 wi) {
+static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, float s,
+                                      float t) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return 1.0f;
-  float s, t;
-  iris_envmap_dir_to_st(env, wi, &s, &t);
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
   return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
 }
 

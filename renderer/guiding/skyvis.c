@@ -19,10 +19,19 @@
 /* Share of the caches that must see part of the sky for the mixture to be used. */
 #define SKYVIS_MIN_PART 0.1
 
-void iris_skyvis_destroy(iris_skyvis *sv) {
+/* Frees the tables; the counts stay. */
+static void drop_tables(iris_skyvis *sv) {
   iris_envmap_regions_destroy(&sv->regions);
   free(sv->cdf);
   free(sv->sees);
+  sv->cdf = NULL;
+  sv->sees = NULL;
+  sv->region_count = 0;
+  sv->memory_bytes = 0;
+}
+
+void iris_skyvis_destroy(iris_skyvis *sv) {
+  drop_tables(sv);
   memset(sv, 0, sizeof *sv);
 }
 
@@ -137,13 +146,7 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
   if ((double)sv->part_caches < SKYVIS_MIN_PART * (double)cache_count) {
     /* Nearly every cache sees all its sky or none: the map's own sampling
      * does as well, without the cost of the mixture (an open scene). */
-    uint64_t probes = sv->probes, escaped = sv->escaped;
-    size_t part = sv->part_caches;
-    double seconds = sv->seconds;
-    iris_skyvis_destroy(sv);
-    sv->probed = true;
-    sv->probes = probes, sv->escaped = escaped, sv->part_caches = part, sv->seconds = seconds;
-    sv->cache_count = cache_count;
+    drop_tables(sv);
     return IRIS_OK;
   }
   sv->built = true;

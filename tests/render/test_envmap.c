@@ -161,7 +161,7 @@ static void test_sampling(const char *path) {
     float pdf2;
     CHECK(iris_envmap_sample_st(&env, u0, u1, &d2, &pdf2, &s_, &t_));
     CHECK(d2.x == d.x && d2.y == d.y && d2.z == d.z && pdf2 == pdf);
-    Ld = iris_envmap_eval(&env, d, &pdf_e);
+    Ld = iris_envmap_eval(&env, d, &pdf_e, NULL);
     samples++;
     bool same_l = fabsf(Ls.x - Ld.x) <= 1e-3f * fmaxf(Ld.x, 1e-3f) && fabsf(Ls.y - Ld.y) <= 1e-3f * fmaxf(Ld.y, 1e-3f);
     bool same_p = fabsf(pdf - pdf_e) <= 1e-4f * pdf || fabsf(pdf - iris_envmap_pdf(&env, d)) <= 1e-4f * pdf;
