@@ -124,6 +124,7 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
     metallic *= t[2];
   }
   sp->si = *si;
+  bool mapped = false;
   if (m->normal_texture >= 0 && si->has_tangent) { /* docs/rendering.md, "Normal maps" */
     float t[4];
     iris_texture_sample(it->textures, m->normal_texture, si->uv, si->uv1, false, t);
@@ -133,6 +134,7 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
     iris_vec3 ngw = back ? iris_neg(si->ng) : si->ng;
     n = iris_normal_make_valid(ngw, wo, back ? iris_neg(n) : n);
     sp->si.ns = back ? iris_neg(n) : n;
+    mapped = true;
   }
   sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
@@ -150,6 +152,8 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   sp->wo_local = iris_frame_to_local(&sp->frame, wo);
   if (m->type == IRIS_MATERIAL_GLTF && (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f))
     shade_layers(it, m, si, sp);
+  mapped = mapped || (m->clearcoat > 0.0f && m->clearcoat_normal_texture >= 0 && si->has_tangent);
+  sp->fold = mapped && !(sp->lobes & IRIS_LOBE_TRANSMISSION);
 }
 
 /* A direction that leaves a non-transmissive surface below its geometric
@@ -160,11 +164,25 @@ static bool direction_allowed(const iris_shading_point *sp, iris_vec3 wi) {
   return iris_dot(wi, sp->si.ng) > 0.0f;
 }
 
+/* The mirror image of w about the geometric plane of the shading point. */
+static iris_vec3 fold_mirror(const iris_shading_point *sp, iris_vec3 w) {
+  return iris_sub(w, iris_scale(sp->si.ng, 2.0f * iris_dot(w, sp->si.ng)));
+}
+
+/* |cos(ns, w)| below which a folded value is not divided by it (a set of
+ * directions of measure ~1e-7 sr, which then get no light). */
+#define FOLD_MIN_COS 1e-7f
+
 bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
                                  iris_direction_sample *out) {
   float u_lobe = iris_sampler_slot(rng, IRIS_SLOT_LOBE);
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u0, &u1);
+  return iris_integrator_sample_bsdf_u(sp, u_lobe, u0, u1, out);
+}
+
+bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, float u0, float u1,
+                                   iris_direction_sample *out) {
   struct iris_bsdf_sample bs;
   if (!iris_bsdf_sample(&sp->bsdf, sp->wo_local, u_lobe, u0, u1, &bs)) return false;
   if (!(bs.pdf > 0.0f)) return false;
@@ -173,10 +191,43 @@ bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng
   out->pdf = bs.pdf;
   out->lobe = bs.lobe;
   out->delta = (bs.lobe & IRIS_LOBE_DELTA) != 0;
+  if (sp->fold) { /* docs/rendering.md, "Normal maps": the folded BSDF */
+    if (iris_dot(out->wi, sp->si.ng) < 0.0f) {
+      iris_vec3 up = iris_normalize(fold_mirror(sp, out->wi));
+      if (out->delta) { /* f holds 1/|cos|: keep f |cos| across the mirror */
+        float c0 = fabsf(bs.wi.z), c1 = fabsf(iris_dot(up, sp->si.ns));
+        if (!(c1 > FOLD_MIN_COS)) return false;
+        out->f = iris_scale(out->f, c0 / c1);
+      }
+      out->wi = up;
+    }
+    if (!out->delta) {
+      out->f = iris_integrator_bsdf_eval(sp, out->wi);
+      out->pdf = iris_integrator_bsdf_pdf(sp, out->wi);
+      if (!(out->pdf > 0.0f)) return false;
+    }
+  }
   return true;
 }
 
+iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) {
+  if (!direction_allowed(sp, wi)) return iris_v3(0, 0, 0);
+  iris_vec3 wl = iris_frame_to_local(&sp->frame, wi);
+  iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
+  if (!sp->fold) return f;
+  float c = fabsf(wl.z);
+  if (!(c > FOLD_MIN_COS)) return iris_v3(0, 0, 0);
+  iris_vec3 ml = iris_frame_to_local(&sp->frame, fold_mirror(sp, wi));
+  iris_vec3 fm = iris_bsdf_eval(&sp->bsdf, sp->wo_local, ml);
+  return iris_add(f, iris_scale(fm, fabsf(ml.z) / c));
+}
+
 float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi) {
+  if (sp->fold) {
+    if (!direction_allowed(sp, wi)) return 0.0f;
+    return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi)) +
+           iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, fold_mirror(sp, wi)));
+  }
   return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
 }
 
@@ -241,10 +292,9 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   }
   if (guided < 0 && !iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls))
     return iris_v3(0, 0, 0);
-  if (!direction_allowed(sp, ls.wi)) return iris_v3(0, 0, 0);
-  iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
-  iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
+  iris_vec3 f = iris_integrator_bsdf_eval(sp, ls.wi);
   if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return iris_v3(0, 0, 0);
+  iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
   iris_ray shadow;
   if (isfinite(ls.dist) && !ls.delta) {
     shadow = iris_spawn_ray_to(sp->si.p, sp->si.ng, ls.p, ls.n);

@@ -91,6 +91,9 @@ typedef struct iris_shading_point {
   uint32_t lobes;     /* iris_bsdf_lobes */
   bool delta;         /* iris_bsdf_is_delta */
   int depth;          /* bounces so far (0 at the first hit from the camera) */
+  bool fold;          /* a normal map bent a reflect-only BSDF: directions below the
+                         geometric surface fold back above it (docs/rendering.md,
+                         "Normal maps"); set by iris_integrator_shade */
   iris_guide_vertex guide; /* direction sampler's per-vertex state (after prepare) */
 } iris_shading_point;
 
@@ -193,6 +196,17 @@ bool iris_integrator_sample_direction(const iris_integrator *it, const iris_shad
  * Draws the slots IRIS_SLOT_LOBE and IRIS_SLOT_DIRECTION of rng's base. */
 bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
                                  iris_direction_sample *out);
+/* The same from three given uniform numbers (lobe choice, direction). */
+bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, float u0, float u1,
+                                   iris_direction_sample *out);
+/* The BSDF as every method sees it, for a world direction wi (unit): the value
+ * f such that f |cos(ns, wi)| is the scattered radiance per unit incident
+ * radiance, and the density of iris_integrator_sample_bsdf. Both are 0 for a
+ * direction a reflect-only BSDF may not take (below the geometric surface). At
+ * a folded point (sp->fold) they are the folded BSDF: f(wi) |cos wi| +
+ * f(M wi) |cos M wi| and p(wi) + p(M wi), M the mirror about the geometric
+ * plane. */
+iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi);
 float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi);
 
 /* THE density of that choice for a given world direction (for MIS weights of

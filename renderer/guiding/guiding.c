@@ -896,9 +896,8 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
   iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
   out->wi = wi;
-  out->f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wi_local);
-  out->pdf = (1.0f - alpha) * iris_bsdf_pdf(&sp->bsdf, sp->wo_local, wi_local) +
-             alpha * iris_guide_vertex_cache_pdf(g, v, wi);
+  out->f = iris_integrator_bsdf_eval(sp, wi);
+  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_cache_pdf(g, v, wi);
   out->delta = false;
   bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
   out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
