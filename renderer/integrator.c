@@ -78,11 +78,18 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
       ccr *= t[1];
     }
     iris_vec3 cn = si->ns;
-    if (m->clearcoat_normal_texture >= 0 && si->has_tangent) {
+    const bool coat_mapped = m->clearcoat_normal_texture >= 0 && si->has_tangent;
+    if (coat_mapped) {
       iris_texture_sample(it->textures, m->clearcoat_normal_texture, si->uv, si->uv1, false, t);
       cn = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->clearcoat_normal_scale);
     }
     if (iris_dot(sp->si.ns, si->ns) < 0.0f) cn = iris_neg(cn); /* flipped with the shading normal */
+    if (coat_mapped) { /* the valid-reflection rule for the coat's own normal too, as Cycles */
+      bool back = iris_dot(sp->wo, sp->si.ng) < 0.0f;
+      iris_vec3 ngw = back ? iris_neg(sp->si.ng) : sp->si.ng;
+      cn = iris_normal_make_valid(ngw, sp->wo, back ? iris_neg(cn) : cn);
+      if (back) cn = iris_neg(cn);
+    }
     sp->bsdf.clearcoat = cc;
     sp->bsdf.clearcoat_roughness = ccr;
     sp->bsdf.coat_n = iris_frame_to_local(&sp->frame, cn);
