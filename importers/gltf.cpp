@@ -9,7 +9,9 @@
 
 #include <climits>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
+#include <deque>
 #include <new>
 #include <string>
 #include <vector>
@@ -149,7 +151,90 @@ struct DocStorage {
   std::vector<iris_gltf_light> lights;
   std::vector<iris_gltf_scene> scenes;
   std::vector<const char *> used, required;
+  // KHR_materials_variants (deques: elements never move, the document points into them)
+  std::deque<std::vector<iris_gltf_variant_mapping>> mappings;
+  std::deque<std::vector<int>> mapping_variants;
+  std::vector<const char *> variant_names;
 };
+
+// A JSON integer as int (values beyond int are clamped, to be reported out of
+// range); false when not an integral number.
+bool int_value(const tinygltf::Value &v, int *out) {
+  if (!v.IsNumber()) return false;
+  double d = v.GetNumberAsDouble();
+  if (!std::isfinite(d) || d != std::floor(d)) return false;
+  *out = d > INT_MAX ? INT_MAX : d < -INT_MAX ? -INT_MAX : (int)d;
+  return true;
+}
+
+// A primitive's KHR_materials_variants mappings, copied without judging the
+// indices (the converter validates them, gltf_variants.c).
+void fill_mappings(const tinygltf::Primitive &p, DocStorage &s, iris_gltf_primitive *o) {
+  o->mappings = nullptr;
+  o->mapping_count = 0;
+  o->variants_bad = nullptr;
+  auto it = p.extensions.find("KHR_materials_variants");
+  if (it == p.extensions.end()) return;
+  const tinygltf::Value &v = it->second;
+  if (!v.IsObject() || !v.Has("mappings") || !v.Get("mappings").IsArray() || v.Get("mappings").ArrayLen() == 0) {
+    o->variants_bad = "is not an object with a non-empty \"mappings\" array";
+    return;
+  }
+  const tinygltf::Value &a = v.Get("mappings");
+  s.mappings.emplace_back(a.ArrayLen());
+  std::vector<iris_gltf_variant_mapping> &ms = s.mappings.back();
+  for (size_t k = 0; k < a.ArrayLen(); k++) {
+    const tinygltf::Value &m = a.Get((int)k);
+    iris_gltf_variant_mapping &om = ms[k];
+    om = {-1, nullptr, 0, nullptr};
+    if (!m.IsObject()) {
+      om.bad = "is not an object";
+      continue;
+    }
+    if (!m.Has("material") || !int_value(m.Get("material"), &om.material))
+      om.bad = "\"material\" is missing or not an integer";
+    else if (m.Has("name") && !m.Get("name").IsString())
+      om.bad = "\"name\" is not a string";
+    if (om.bad) continue;
+    const tinygltf::Value &vs = m.Has("variants") ? m.Get("variants") : tinygltf::Value();
+    if (!vs.IsArray() || vs.ArrayLen() == 0) {
+      om.bad = "\"variants\" is missing or not a non-empty array";
+      continue;
+    }
+    s.mapping_variants.emplace_back(vs.ArrayLen());
+    std::vector<int> &ids = s.mapping_variants.back();
+    for (size_t j = 0; j < vs.ArrayLen() && !om.bad; j++)
+      if (!int_value(vs.Get((int)j), &ids[j])) om.bad = "\"variants\" holds a value that is not an integer";
+    om.variants = ids.data();
+    om.variant_count = ids.size();
+  }
+  o->mappings = ms.data();
+  o->mapping_count = ms.size();
+}
+
+// The root KHR_materials_variants: the variant names (NULL: not a string).
+void fill_variants(const tinygltf::Model &m, DocStorage &s, iris_gltf_doc *d) {
+  d->variant_names = nullptr;
+  d->variant_count = 0;
+  d->has_variants = false;
+  d->variants_bad = nullptr;
+  auto it = m.extensions.find("KHR_materials_variants");
+  if (it == m.extensions.end()) return;
+  d->has_variants = true;
+  const tinygltf::Value &v = it->second;
+  if (!v.IsObject() || !v.Has("variants") || !v.Get("variants").IsArray() || v.Get("variants").ArrayLen() == 0) {
+    d->variants_bad = "is not an object with a non-empty \"variants\" array";
+    return;
+  }
+  const tinygltf::Value &a = v.Get("variants");
+  for (size_t k = 0; k < a.ArrayLen(); k++) {
+    const tinygltf::Value &e = a.Get((int)k);
+    bool named = e.IsObject() && e.Has("name") && e.Get("name").IsString();
+    s.variant_names.push_back(named ? e.Get("name").Get<std::string>().c_str() : nullptr);
+  }
+  d->variant_names = s.variant_names.data();
+  d->variant_count = s.variant_names.size();
+}
 
 // textureInfo (any of tinygltf's three kinds) with its KHR_texture_transform.
 template <class Info>
@@ -373,6 +458,7 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
       o.attributes = s.attributes[i].data() + s.attributes[i].size();
       for (const auto &kv : p.attributes) s.attributes[i].push_back({kv.first.c_str(), kv.second});
       o.target_count = p.targets.size();
+      fill_mappings(p, s, &o);
       s.primitives[i].push_back(o);
     }
     s.meshes.push_back({mesh.name.c_str(), s.primitives[i].data(), s.primitives[i].size()});
@@ -517,6 +603,7 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
   d->light_count = s.lights.size();
   d->scenes = s.scenes.data();
   d->scene_count = s.scenes.size();
+  fill_variants(m, s, d);
 }
 
 iris_status import_memory(const char *data, size_t size, const char *path,
