@@ -5,6 +5,8 @@
 // condensed to one line) and never lets an exception cross into C.
 #include <tiny_gltf.h>
 
+#include <nlohmann/json.hpp>
+
 #include <sys/stat.h>
 
 #include <climits>
@@ -154,14 +156,29 @@ struct DocStorage {
   // KHR_materials_variants (deques: elements never move, the document points into them)
   std::deque<std::vector<iris_gltf_variant_mapping>> mappings;
   std::deque<std::vector<int>> mapping_variants;
+  std::deque<std::string> variant_name_storage;
+  std::vector<bool> variant_named;
   std::vector<const char *> variant_names;
 };
 
+// KHR_materials_variants is read from the original JSON of the extensions
+// (SetStoreOriginalJSONForExtrasAndExtensions), not from tinygltf's Value:
+// that drops nulls, empty objects and empty arrays from arrays, which would
+// renumber variants and mappings ("[{"name":"a"}, {}, ...]") instead of
+// being refused. nlohmann::json is what tinygltf parses with.
+const nlohmann::json *variants_ext(const std::string &extensions_json, nlohmann::json *storage) {
+  if (extensions_json.empty()) return nullptr;
+  *storage = nlohmann::json::parse(extensions_json, nullptr, false);
+  if (!storage->is_object()) return nullptr;
+  auto it = storage->find("KHR_materials_variants");
+  return it == storage->end() ? nullptr : &*it;
+}
+
 // A JSON integer as int (values beyond int are clamped, to be reported out of
 // range); false when not an integral number.
-bool int_value(const tinygltf::Value &v, int *out) {
-  if (!v.IsNumber()) return false;
-  double d = v.GetNumberAsDouble();
+bool int_value(const nlohmann::json &v, int *out) {
+  if (!v.is_number()) return false;
+  double d = v.get<double>();
   if (!std::isfinite(d) || d != std::floor(d)) return false;
   *out = d > INT_MAX ? INT_MAX : d < -INT_MAX ? -INT_MAX : (int)d;
   return true;
@@ -173,38 +190,36 @@ void fill_mappings(const tinygltf::Primitive &p, DocStorage &s, iris_gltf_primit
   o->mappings = nullptr;
   o->mapping_count = 0;
   o->variants_bad = nullptr;
-  auto it = p.extensions.find("KHR_materials_variants");
-  if (it == p.extensions.end()) return;
-  const tinygltf::Value &v = it->second;
-  if (!v.IsObject() || !v.Has("mappings") || !v.Get("mappings").IsArray() || v.Get("mappings").ArrayLen() == 0) {
+  nlohmann::json ext;
+  const nlohmann::json *v = variants_ext(p.extensions_json_string, &ext);
+  if (!v) return;
+  if (!v->is_object() || !v->contains("mappings") || !(*v)["mappings"].is_array() || (*v)["mappings"].empty()) {
     o->variants_bad = "is not an object with a non-empty \"mappings\" array";
     return;
   }
-  const tinygltf::Value &a = v.Get("mappings");
-  s.mappings.emplace_back(a.ArrayLen());
+  const nlohmann::json &a = (*v)["mappings"];
+  s.mappings.emplace_back(a.size());
   std::vector<iris_gltf_variant_mapping> &ms = s.mappings.back();
-  for (size_t k = 0; k < a.ArrayLen(); k++) {
-    const tinygltf::Value &m = a.Get((int)k);
+  for (size_t k = 0; k < a.size(); k++) {
+    const nlohmann::json &m = a[k];
     iris_gltf_variant_mapping &om = ms[k];
     om = {-1, nullptr, 0, nullptr};
-    if (!m.IsObject()) {
+    if (!m.is_object()) {
       om.bad = "is not an object";
       continue;
     }
-    if (!m.Has("material") || !int_value(m.Get("material"), &om.material))
+    if (!m.contains("material") || !int_value(m["material"], &om.material))
       om.bad = "\"material\" is missing or not an integer";
-    else if (m.Has("name") && !m.Get("name").IsString())
+    else if (m.contains("name") && !m["name"].is_string())
       om.bad = "\"name\" is not a string";
-    if (om.bad) continue;
-    const tinygltf::Value &vs = m.Has("variants") ? m.Get("variants") : tinygltf::Value();
-    if (!vs.IsArray() || vs.ArrayLen() == 0) {
+    else if (!m.contains("variants") || !m["variants"].is_array() || m["variants"].empty())
       om.bad = "\"variants\" is missing or not a non-empty array";
-      continue;
-    }
-    s.mapping_variants.emplace_back(vs.ArrayLen());
+    if (om.bad) continue;
+    const nlohmann::json &vs = m["variants"];
+    s.mapping_variants.emplace_back(vs.size());
     std::vector<int> &ids = s.mapping_variants.back();
-    for (size_t j = 0; j < vs.ArrayLen() && !om.bad; j++)
-      if (!int_value(vs.Get((int)j), &ids[j])) om.bad = "\"variants\" holds a value that is not an integer";
+    for (size_t j = 0; j < vs.size() && !om.bad; j++)
+      if (!int_value(vs[j], &ids[j])) om.bad = "\"variants\" holds a value that is not an integer";
     om.variants = ids.data();
     om.variant_count = ids.size();
   }
@@ -218,20 +233,21 @@ void fill_variants(const tinygltf::Model &m, DocStorage &s, iris_gltf_doc *d) {
   d->variant_count = 0;
   d->has_variants = false;
   d->variants_bad = nullptr;
-  auto it = m.extensions.find("KHR_materials_variants");
-  if (it == m.extensions.end()) return;
+  nlohmann::json ext;
+  const nlohmann::json *v = variants_ext(m.extensions_json_string, &ext);
+  if (!v) return;
   d->has_variants = true;
-  const tinygltf::Value &v = it->second;
-  if (!v.IsObject() || !v.Has("variants") || !v.Get("variants").IsArray() || v.Get("variants").ArrayLen() == 0) {
+  if (!v->is_object() || !v->contains("variants") || !(*v)["variants"].is_array() || (*v)["variants"].empty()) {
     d->variants_bad = "is not an object with a non-empty \"variants\" array";
     return;
   }
-  const tinygltf::Value &a = v.Get("variants");
-  for (size_t k = 0; k < a.ArrayLen(); k++) {
-    const tinygltf::Value &e = a.Get((int)k);
-    bool named = e.IsObject() && e.Has("name") && e.Get("name").IsString();
-    s.variant_names.push_back(named ? e.Get("name").Get<std::string>().c_str() : nullptr);
+  for (const nlohmann::json &e : (*v)["variants"]) {
+    bool named = e.is_object() && e.contains("name") && e["name"].is_string();
+    s.variant_name_storage.push_back(named ? e["name"].get<std::string>() : std::string());
+    s.variant_named.push_back(named);
   }
+  for (size_t k = 0; k < s.variant_named.size(); k++)
+    s.variant_names.push_back(s.variant_named[k] ? s.variant_name_storage[k].c_str() : nullptr);
   d->variant_names = s.variant_names.data();
   d->variant_count = s.variant_names.size();
 }
@@ -623,6 +639,11 @@ iris_status import_memory(const char *data, size_t size, const char *path,
   loader.SetFsCallbacks(fs);
   std::vector<ImageState> image_states;
   loader.SetImageLoader(&keep_encoded_image, &image_states);
+  // KHR_materials_variants is read from the original JSON (fill_mappings); only
+  // files that name it pay for keeping it.
+  static const char kVariants[] = "KHR_materials_variants";
+  loader.SetStoreOriginalJSONForExtrasAndExtensions(
+      memmem(data, size, kVariants, sizeof kVariants - 1) != nullptr);
 
   // Draco and meshopt files need a patched JSON before tinygltf sees them
   // (gltf_compressed.h); a GLB gets its JSON chunk replaced.
