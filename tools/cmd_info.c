@@ -180,7 +180,8 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
   if (s->variants.count) { /* as the scene format's "material_variants" */
     cJSON *v = cJSON_AddObjectToObject(o, "material_variants");
     cJSON *names = cJSON_AddArrayToObject(v, "names");
-    for (size_t i = 0; i < s->variants.count; i++) cJSON_AddItemToArray(names, cJSON_CreateString(s->variants.names[i]));
+    for (size_t i = 0; i < s->variants.count; i++)
+      cJSON_AddItemToArray(names, cJSON_CreateString(s->variants.names[i]));
     if (s->variants.applied >= 0)
       cJSON_AddStringToObject(v, "applied", s->variants.names[s->variants.applied]);
     else

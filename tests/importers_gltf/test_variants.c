@@ -299,7 +299,9 @@ static void check_cli(void) {
       {"info '%s' --variant dusk", NULL},
       {"render '%s' --variant dusk --spp 1 --width 8 --height 4 -o refused.exr", "refused.exr"},
       {"export '%s' --variant dusk --to blender -o refused.py", "refused.py"},
-      {"bench '%s' --variant dusk --times 1 --reference auto --reference-spp 1 --no-charts --out refused", "refused"},
+      {"bench '%s' --variant dusk --times 1 --reference auto --reference-spp 1 --cache refused-cache --no-charts "
+       "--out refused",
+       "refused"},
       {"validate '%s' --variant dusk --out refused --reference ref.exr", "refused"},
   };
   /* validate checks its reference before the scene: a good one */
@@ -309,7 +311,8 @@ static void check_cli(void) {
     snprintf(args, sizeof args, refuse[i].args, f);
     int rc = run(dir, "%s", args);
     EXPECT(rc == 2 && strcmp(err_text, want) == 0, "iris %s: exit %d, stderr\n%s", args, rc, err_text);
-    if (refuse[i].output) EXPECT(!iris_test_file_exists(dir, refuse[i].output), "iris %s wrote %s", args, refuse[i].output);
+    if (refuse[i].output)
+      EXPECT(!iris_test_file_exists(dir, refuse[i].output), "iris %s wrote %s", args, refuse[i].output);
     EXPECT(iris_test_count_entries(dir, "refused") == 0, "iris %s left files", args);
   }
   /* A built-in scene and an iris scene refuse --variant. */
