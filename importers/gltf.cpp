@@ -231,12 +231,10 @@ void fill_mappings(const tinygltf::Primitive &p, DocStorage &s, iris_gltf_primit
 void fill_variants(const tinygltf::Model &m, DocStorage &s, iris_gltf_doc *d) {
   d->variant_names = nullptr;
   d->variant_count = 0;
-  d->has_variants = false;
   d->variants_bad = nullptr;
   nlohmann::json ext;
   const nlohmann::json *v = variants_ext(m.extensions_json_string, &ext);
   if (!v) return;
-  d->has_variants = true;
   if (!v->is_object() || !v->contains("variants") || !(*v)["variants"].is_array() || (*v)["variants"].empty()) {
     d->variants_bad = "is not an object with a non-empty \"variants\" array";
     return;

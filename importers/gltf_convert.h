@@ -221,7 +221,6 @@ typedef struct iris_gltf_doc {
    * the extension object itself. */
   const char *const *variant_names;
   size_t variant_count;
-  bool has_variants;
   const char *variants_bad;
 } iris_gltf_doc;
 

@@ -29,10 +29,10 @@ static void print_help(void) {
          "file's material variants (KHR_materials_variants).\n"
          "\n"
          "Options:\n"
-         "      --json   print one JSON object instead of text\n"
+         "      --json          print one JSON object instead of text\n"
          "      --variant NAME  describe the file with its material variant NAME applied\n"
-         "  -q, --quiet  print no warnings while loading\n"
-         "  -h, --help   show this help\n"
+         "  -q, --quiet         print no warnings while loading\n"
+         "  -h, --help          show this help\n"
          "\n"
          "Exit status: 0 success, 2 bad usage or bad input, 1 other failure.\n");
 }
