@@ -1148,6 +1148,11 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
           "# Blender 3.4 scene written by iris %s from ",
           IRIS_VERSION_STRING);
   iris_blender_put_bytes(fp, scene->source_path ? scene->source_path : "(memory)");
+  if (scene->variants.count && scene->variants.applied >= 0) { /* its materials are the scene's */
+    fputs("\n# with the glTF material variant ", fp);
+    iris_blender_put_bytes(fp, scene->variants.names[scene->variants.applied]);
+    fputs(" (KHR_materials_variants) applied", fp);
+  }
   fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
         "# fair-comparison settings of iris's docs/export.md. Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"

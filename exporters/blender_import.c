@@ -93,6 +93,28 @@ static const char *const IMPORT_PRELUDE[] = {
     "    return out",
     "",
     "",
+    "def apply_variant():",
+    "    \"\"\"KHR_materials_variants: show the variant iris imported the file with, as the",
+    "    add-on's Display Variant button does (it stores the file's variants in",
+    "    scene.gltf2_KHR_materials_variants_variants and each mesh's mappings in",
+    "    mesh.gltf2_variant_mesh_data).\"\"\"",
+    "    if VARIANT is None:",
+    "        return",
+    "    index, name = VARIANT[0], VARIANT[1].decode(\"utf-8\", \"replace\")",
+    "    s0 = bpy.data.scenes[0]",
+    "    found = [v for v in getattr(s0, \"gltf2_KHR_materials_variants_variants\", [])",
+    "             if v.variant_idx == index and v.name == name]",
+    "    if not found:",
+    "        print(\"iris-blender: error: Blender's glTF import of %s has no material variant %d %r\"",
+    "              % (os.fsdecode(IMPORT), index, name), file=sys.stderr)",
+    "        sys.exit(1)",
+    "    s0.gltf2_active_variant = index",
+    "    if \"FINISHED\" not in bpy.ops.scene.gltf2_display_variant():",
+    "        print(\"iris-blender: error: Display Variant failed for %r\" % name, file=sys.stderr)",
+    "        sys.exit(1)",
+    "    print(\"iris-blender: material variant %r displayed\" % name, flush=True)",
+    "",
+    "",
     "def main_import():",
     "    a = parse_args()",
     "    t0 = time.perf_counter()",
@@ -110,6 +132,7 @@ static const char *const IMPORT_PRELUDE[] = {
     "    if \"FINISHED\" not in res:",
     "        print(\"iris-blender: error: Blender's glTF importer did not finish on %s\" % path, file=sys.stderr)",
     "        sys.exit(1)",
+    "    apply_variant()",
     "    inventory = describe_import(sc)",
     "    build_world(sc, WORLD, gltf_axes=False)",
     "    build_camera(sc)",
@@ -178,6 +201,15 @@ iris_status iris_export_blender_import(const iris_scene *scene, const char *impo
   iris_blender_put_camera(fp, scene, &bview);
   fputs("BLOB_SIZE = 0\nSIDECAR = None\nBLOB = None\nIMPORT = ", fp);
   iris_blender_put_bytes(fp, abs_import);
+  /* The variant iris applied (the scene's materials are its): Blender's import shows it too. */
+  const iris_material_variants *v = &scene->variants;
+  if (v->count && v->applied >= 0) {
+    fprintf(fp, "\nVARIANT = (%d, ", (int)v->applied);
+    iris_blender_put_bytes(fp, v->names[v->applied]);
+    fputs(")", fp);
+  } else {
+    fputs("\nVARIANT = None", fp);
+  }
   fputs("\n\nmain_import()\n", fp);
   if (ferror(fp)) {
     iris_atomic_abort(&af);

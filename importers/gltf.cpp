@@ -5,11 +5,15 @@
 // condensed to one line) and never lets an exception cross into C.
 #include <tiny_gltf.h>
 
+#include <nlohmann/json.hpp>
+
 #include <sys/stat.h>
 
 #include <climits>
 #include <cstdio>
+#include <cmath>
 #include <cstring>
+#include <deque>
 #include <new>
 #include <string>
 #include <vector>
@@ -149,7 +153,102 @@ struct DocStorage {
   std::vector<iris_gltf_light> lights;
   std::vector<iris_gltf_scene> scenes;
   std::vector<const char *> used, required;
+  // KHR_materials_variants (deques: elements never move, the document points into them)
+  std::deque<std::vector<iris_gltf_variant_mapping>> mappings;
+  std::deque<std::vector<int>> mapping_variants;
+  std::deque<std::string> variant_name_storage;
+  std::vector<bool> variant_named;
+  std::vector<const char *> variant_names;
 };
+
+// KHR_materials_variants is read from the original JSON of the extensions
+// (SetStoreOriginalJSONForExtrasAndExtensions), not from tinygltf's Value:
+// that drops nulls, empty objects and empty arrays from arrays, which would
+// renumber variants and mappings ("[{"name":"a"}, {}, ...]") instead of
+// being refused. nlohmann::json is what tinygltf parses with.
+const nlohmann::json *variants_ext(const std::string &extensions_json, nlohmann::json *storage) {
+  if (extensions_json.empty()) return nullptr;
+  *storage = nlohmann::json::parse(extensions_json, nullptr, false);
+  if (!storage->is_object()) return nullptr;
+  auto it = storage->find("KHR_materials_variants");
+  return it == storage->end() ? nullptr : &*it;
+}
+
+// A JSON integer as int (values beyond int are clamped, to be reported out of
+// range); false when not an integral number.
+bool int_value(const nlohmann::json &v, int *out) {
+  if (!v.is_number()) return false;
+  double d = v.get<double>();
+  if (!std::isfinite(d) || d != std::floor(d)) return false;
+  *out = d > INT_MAX ? INT_MAX : d < -INT_MAX ? -INT_MAX : (int)d;
+  return true;
+}
+
+// A primitive's KHR_materials_variants mappings, copied without judging the
+// indices (the converter validates them, gltf_variants.c).
+void fill_mappings(const tinygltf::Primitive &p, DocStorage &s, iris_gltf_primitive *o) {
+  o->mappings = nullptr;
+  o->mapping_count = 0;
+  o->variants_bad = nullptr;
+  nlohmann::json ext;
+  const nlohmann::json *v = variants_ext(p.extensions_json_string, &ext);
+  if (!v) return;
+  if (!v->is_object() || !v->contains("mappings") || !(*v)["mappings"].is_array() || (*v)["mappings"].empty()) {
+    o->variants_bad = "is not an object with a non-empty \"mappings\" array";
+    return;
+  }
+  const nlohmann::json &a = (*v)["mappings"];
+  s.mappings.emplace_back(a.size());
+  std::vector<iris_gltf_variant_mapping> &ms = s.mappings.back();
+  for (size_t k = 0; k < a.size(); k++) {
+    const nlohmann::json &m = a[k];
+    iris_gltf_variant_mapping &om = ms[k];
+    om = {-1, nullptr, 0, nullptr};
+    if (!m.is_object()) {
+      om.bad = "is not an object";
+      continue;
+    }
+    if (!m.contains("material") || !int_value(m["material"], &om.material))
+      om.bad = "\"material\" is missing or not an integer";
+    else if (m.contains("name") && !m["name"].is_string())
+      om.bad = "\"name\" is not a string";
+    else if (!m.contains("variants") || !m["variants"].is_array() || m["variants"].empty())
+      om.bad = "\"variants\" is missing or not a non-empty array";
+    if (om.bad) continue;
+    const nlohmann::json &vs = m["variants"];
+    s.mapping_variants.emplace_back(vs.size());
+    std::vector<int> &ids = s.mapping_variants.back();
+    for (size_t j = 0; j < vs.size() && !om.bad; j++)
+      if (!int_value(vs[j], &ids[j])) om.bad = "\"variants\" holds a value that is not an integer";
+    om.variants = ids.data();
+    om.variant_count = ids.size();
+  }
+  o->mappings = ms.data();
+  o->mapping_count = ms.size();
+}
+
+// The root KHR_materials_variants: the variant names (NULL: not a string).
+void fill_variants(const tinygltf::Model &m, DocStorage &s, iris_gltf_doc *d) {
+  d->variant_names = nullptr;
+  d->variant_count = 0;
+  d->variants_bad = nullptr;
+  nlohmann::json ext;
+  const nlohmann::json *v = variants_ext(m.extensions_json_string, &ext);
+  if (!v) return;
+  if (!v->is_object() || !v->contains("variants") || !(*v)["variants"].is_array() || (*v)["variants"].empty()) {
+    d->variants_bad = "is not an object with a non-empty \"variants\" array";
+    return;
+  }
+  for (const nlohmann::json &e : (*v)["variants"]) {
+    bool named = e.is_object() && e.contains("name") && e["name"].is_string();
+    s.variant_name_storage.push_back(named ? e["name"].get<std::string>() : std::string());
+    s.variant_named.push_back(named);
+  }
+  for (size_t k = 0; k < s.variant_named.size(); k++)
+    s.variant_names.push_back(s.variant_named[k] ? s.variant_name_storage[k].c_str() : nullptr);
+  d->variant_names = s.variant_names.data();
+  d->variant_count = s.variant_names.size();
+}
 
 // textureInfo (any of tinygltf's three kinds) with its KHR_texture_transform.
 template <class Info>
@@ -373,6 +472,7 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
       o.attributes = s.attributes[i].data() + s.attributes[i].size();
       for (const auto &kv : p.attributes) s.attributes[i].push_back({kv.first.c_str(), kv.second});
       o.target_count = p.targets.size();
+      fill_mappings(p, s, &o);
       s.primitives[i].push_back(o);
     }
     s.meshes.push_back({mesh.name.c_str(), s.primitives[i].data(), s.primitives[i].size()});
@@ -517,6 +617,7 @@ void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_sta
   d->light_count = s.lights.size();
   d->scenes = s.scenes.data();
   d->scene_count = s.scenes.size();
+  fill_variants(m, s, d);
 }
 
 iris_status import_memory(const char *data, size_t size, const char *path,
@@ -536,6 +637,11 @@ iris_status import_memory(const char *data, size_t size, const char *path,
   loader.SetFsCallbacks(fs);
   std::vector<ImageState> image_states;
   loader.SetImageLoader(&keep_encoded_image, &image_states);
+  // KHR_materials_variants is read from the original JSON (fill_mappings); only
+  // files that name it pay for keeping it.
+  static const char kVariants[] = "KHR_materials_variants";
+  loader.SetStoreOriginalJSONForExtrasAndExtensions(
+      memmem(data, size, kVariants, sizeof kVariants - 1) != nullptr);
 
   // Draco and meshopt files need a patched JSON before tinygltf sees them
   // (gltf_compressed.h); a GLB gets its JSON chunk replaced.

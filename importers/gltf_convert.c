@@ -29,7 +29,8 @@ static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
     "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit", "EXT_mesh_gpu_instancing"};
+    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit", "EXT_mesh_gpu_instancing",
+    "KHR_materials_variants"};
 
 /* ---- small helpers ------------------------------------------------------ */
 
@@ -537,7 +538,6 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   ELEMENT(el, "mesh %zu primitive %zu", mi, pi);
   memset(out, 0, sizeof *out);
   out->scene_mesh = -1;
-  out->gltf_material = p->material;
 
   for (size_t i = 0; i < p->attribute_count; i++) {
     int ai = p->attributes[i].accessor;
@@ -555,6 +555,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   if (p->material != -1 && (p->material < 0 || (size_t)p->material >= d->material_count))
     return gltf_fail(c, IRIS_ERR_INVALID, el, "material %d does not exist (%zu materials)", p->material,
                 d->material_count);
+  const int mat = out->gltf_material = gltf_variant_material(c, mi, pi); /* default or the variant's */
   int mode = p->mode < 0 ? MODE_TRIANGLES : p->mode;
   if (mode > MODE_FAN) return gltf_fail(c, IRIS_ERR_INVALID, el, "invalid mode %d", p->mode);
   if (p->target_count) c->warned_morph = true;
@@ -579,7 +580,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     return st;
   /* Tangent frames only for a normal map, and only with NORMAL: "When normals are
    * not specified, [...] the provided tangents (if present) MUST be ignored". */
-  int normal_set = gltf_material_normal_uv_set(c, p->material);
+  int normal_set = gltf_material_normal_uv_set(c, mat);
   if (normal_set >= 0 && !nrm) {
     c->normal_map_no_normal++;
     normal_set = -1;
@@ -590,11 +591,10 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
   if (normal_set < 0) tan = NULL;
   /* The second uv set is kept only when the material reads it (and must then exist:
    * the glTF validator's "material needs TEXCOORD_1" error). */
-  if (!gltf_material_uses_uv1(c, p->material)) uv1 = NULL;
+  if (!gltf_material_uses_uv1(c, mat)) uv1 = NULL;
   else if (!uv1)
     return gltf_fail(c, IRIS_ERR_INVALID, el,
-                     "material %d reads a texture through texCoord 1 but the primitive has no TEXCOORD_1",
-                     p->material);
+                     "material %d reads a texture through texCoord 1 but the primitive has no TEXCOORD_1", mat);
   const iris_gltf_accessor *ia = p->indices >= 0 ? &d->accessors[p->indices] : NULL;
   if (ia && (ia->type != TYPE_SCALAR || ia->normalized ||
              (ia->component_type != CT_UBYTE && ia->component_type != CT_USHORT &&
@@ -727,7 +727,7 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
       for (int k = 0; k < 3; k++) m->colors[3 * i + (size_t)k] = tmp[(size_t)nc * i + (size_t)k];
     /* COLOR_0's alpha is kept only where it matters: a MASK/BLEND material and some alpha < 1 */
     bool alpha = false;
-    if (nc == 4 && gltf_material_alpha_mode(c, p->material) != IRIS_ALPHA_OPAQUE)
+    if (nc == 4 && gltf_material_alpha_mode(c, mat) != IRIS_ALPHA_OPAQUE)
       for (size_t i = 0; i < nv && !alpha; i++) alpha = tmp[4 * i + 3] != 1.0f;
     if (alpha) {
       m->alphas = malloc(nv * sizeof(float));
@@ -1374,8 +1374,9 @@ iris_status iris_gltf_convert(const iris_gltf_doc *doc, const iris_import_option
     c.sparse_left += doc->buffers[i].size > SIZE_MAX / 8 ? SIZE_MAX / 8 : 4 * doc->buffers[i].size;
   /* Validate everything first (even what the scene does not use), then build. */
   if ((st = validate_views(&c)) || (st = validate_accessors(&c)) || (st = gltf_validate_textures(&c)) ||
-      (st = gltf_validate_materials(&c)) || (st = validate_cameras_lights(&c)) ||
-      (st = validate_node_graph(&c)) || (st = convert_meshes(&c)) || (st = traverse(&c)))
+      (st = gltf_validate_materials(&c)) || (st = gltf_validate_variants(&c)) || (st = validate_cameras_lights(&c)) ||
+      (st = validate_node_graph(&c)) || (st = convert_meshes(&c)) || (st = traverse(&c)) ||
+      (st = gltf_store_variants(&c)))
     goto done;
   snprintf(c.scene->units, sizeof c.scene->units, "m"); /* glTF 2.0: metres */
   c.scene->source_path = iris_strdup(doc->file);

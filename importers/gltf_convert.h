@@ -46,12 +46,27 @@ typedef struct iris_gltf_attribute {
   int accessor;
 } iris_gltf_attribute;
 
+/* One KHR_materials_variants mapping of a primitive. Numbers that are not
+ * integers become INT_MIN (rejected by the validation); `bad` names a value
+ * of the wrong JSON type. */
+typedef struct iris_gltf_variant_mapping {
+  int material;
+  const int *variants;
+  size_t variant_count;
+  const char *bad;
+} iris_gltf_variant_mapping;
+
 typedef struct iris_gltf_primitive {
   int mode; /* -1 = absent (TRIANGLES) */
   int indices, material;
   const iris_gltf_attribute *attributes;
   size_t attribute_count;
   size_t target_count; /* morph targets (ignored) */
+  /* KHR_materials_variants; `variants_bad` names what is wrong with the
+   * extension object itself (not an object, "mappings" not an array). */
+  const iris_gltf_variant_mapping *mappings;
+  size_t mapping_count;
+  const char *variants_bad;
 } iris_gltf_primitive;
 
 typedef struct iris_gltf_mesh {
@@ -201,6 +216,12 @@ typedef struct iris_gltf_doc {
   size_t light_count;
   const iris_gltf_scene *scenes;
   size_t scene_count;
+  /* KHR_materials_variants at the root: the variant names (NULL where a
+   * variant has no string "name"); `variants_bad` names what is wrong with
+   * the extension object itself. */
+  const char *const *variant_names;
+  size_t variant_count;
+  const char *variants_bad;
 } iris_gltf_doc;
 
 /* Structural checks before tinygltf sees the bytes: the GLB container

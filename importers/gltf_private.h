@@ -66,6 +66,7 @@ typedef struct gltf_ctx {
   iris_material *materials; /* validated, textures still glTF indices */
   int32_t *material_map;    /* glTF material -> scene index, -1 not yet */
   int32_t default_material;
+  int32_t variant; /* KHR_materials_variants variant applied (opts->variant), -1: the defaults */
   struct gltf_slot (*slots)[GLTF_SLOT_COUNT]; /* per glTF material: its texture references */
   struct gltf_tex_key *tex_keys;  /* scene textures made so far (id -2: dropped) */
   size_t tex_key_count, tex_key_cap;
@@ -119,5 +120,17 @@ int gltf_material_normal_uv_set(const gltf_ctx *c, int gi);
 iris_alpha_mode gltf_material_alpha_mode(const gltf_ctx *c, int gi);
 /* Whether (validated) glTF material `gi` reads textures through TEXCOORD_1. */
 bool gltf_material_uses_uv1(const gltf_ctx *c, int gi);
+
+/* ---- gltf_variants.c (KHR_materials_variants) ---------------------------- */
+
+/* The root variants and every primitive's mappings validated (indices in
+ * range, JSON types, a variant at most once per primitive), and
+ * opts->variant resolved into c->variant (IRIS_ERR_USAGE listing the names
+ * when the file has no such variant). */
+iris_status gltf_validate_variants(gltf_ctx *c);
+/* The glTF material (-1: none) that primitive `pi` of mesh `mi` uses under c->variant. */
+int gltf_variant_material(const gltf_ctx *c, size_t mi, size_t pi);
+/* The file's variant names and the applied one recorded in the scene. */
+iris_status gltf_store_variants(gltf_ctx *c);
 
 #endif

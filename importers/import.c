@@ -27,13 +27,19 @@ iris_status iris_import_file(const char *path, const iris_import_options *opts, 
   if (!opts) opts = &defaults;
   char ext[16];
   iris_path_ext(path, ext, sizeof ext);
+  bool gltf = strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0;
+  if (opts->variant && !gltf)
+    return iris_error_set(err, IRIS_ERR_USAGE, path, 0, NULL,
+                          "no material variant \"%s\": material variants (KHR_materials_variants) come from "
+                          "glTF files only%s", opts->variant,
+                          strcmp(ext, "json") == 0 ? "; an iris scene keeps the variant it was imported with" : "");
   if (strcmp(ext, "json") == 0) return iris_scene_load(path, out, err);
   importer_fn fn = NULL;
   if (strcmp(ext, "obj") == 0)
     fn = iris_import_obj;
   else if (strcmp(ext, "ply") == 0)
     fn = iris_import_ply;
-  else if (strcmp(ext, "gltf") == 0 || strcmp(ext, "glb") == 0)
+  else if (gltf)
     fn = iris_import_gltf;
   else
     return iris_error_set(err, IRIS_ERR_UNSUPPORTED, path, 0, NULL,

@@ -25,6 +25,8 @@ typedef struct iris_import_stats {
 
 typedef struct iris_import_options {
   const char *camera_name;  /* glTF: pick this camera (default: the first one) */
+  const char *variant;      /* glTF: apply this KHR_materials_variants variant (default: none, the
+                               default materials); IRIS_ERR_USAGE for other inputs or an unknown name */
   bool weld;                /* weld coincident vertices (OpenMesh) */
   bool compute_normals;     /* OBJ, PLY: angle-weighted normals where absent (default true);
                                glTF is always shaded flat where NORMAL is absent (its spec) */

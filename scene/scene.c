@@ -18,6 +18,7 @@ iris_scene *iris_scene_create(void) {
   if (!scene) return NULL;
   memcpy(scene->units, "m", 2);
   scene->render.max_depth = -1;
+  scene->variants.applied = -1;
   return scene;
 }
 
@@ -47,6 +48,8 @@ void iris_scene_destroy(iris_scene *scene) {
   for (size_t i = 0; i < scene->camera_count; i++) free(scene->cameras[i].name);
   for (size_t i = 0; i < scene->light_count; i++) free(scene->lights[i].name);
   free(scene->environment_map.path);
+  for (size_t i = 0; i < scene->variants.count; i++) free(scene->variants.names[i]);
+  free(scene->variants.names);
   iris_file_map *maps = scene->maps;
   for (size_t i = 0; i < scene->map_count; i++) iris_file_map_close(&maps[i]);
   free(scene->maps);
@@ -263,6 +266,12 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     dst->environment_map = src->environment_map; /* taken over */
     src->environment_map.path = NULL;
   }
+  /* The first input's material variants are the record (docs/format.md). */
+  if (!dst->variants.count && src->variants.count) {
+    dst->variants = src->variants; /* taken over */
+    src->variants.names = NULL;
+    src->variants.count = 0;
+  }
   /* dst's render settings win; src fills only what dst leaves at its default. */
   iris_render_settings *r = &dst->render;
   const iris_render_settings *s = &src->render;
@@ -435,6 +444,13 @@ iris_status iris_scene_validate(const iris_scene *s, const char *file, iris_erro
   if (!s->units[0] || !memchr(s->units, '\0', sizeof s->units)) {
     snprintf(element, sizeof element, "units");
     FAIL("units must be a non-empty string");
+  }
+  if (s->variants.count) {
+    snprintf(element, sizeof element, "material_variants");
+    for (size_t i = 0; i < s->variants.count; i++)
+      if (!s->variants.names || !s->variants.names[i]) FAIL("variant %zu has no name", i);
+    if (s->variants.applied < -1 || s->variants.applied >= (int32_t)s->variants.count)
+      FAIL("applied variant %d out of range (%zu variants)", (int)s->variants.applied, s->variants.count);
   }
   for (size_t i = 0; i < s->texture_count; i++) {
     const iris_texture *t = &s->textures[i];

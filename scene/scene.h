@@ -182,6 +182,15 @@ typedef struct iris_render_settings {
   bool has_seed;
 } iris_render_settings;
 
+/* The KHR_materials_variants of the glTF file a scene was imported from: the
+ * variant names the file offers, and which one's materials the scene holds
+ * (docs/format.md, "material_variants"). count 0: none. */
+typedef struct iris_material_variants {
+  char **names;    /* count names (owned) */
+  size_t count;
+  int32_t applied; /* index into names, -1: the file's default materials */
+} iris_material_variants;
+
 typedef struct iris_scene {
   char units[16]; /* "m" unless the source says otherwise */
 
@@ -203,6 +212,7 @@ typedef struct iris_scene {
   iris_environment_map environment_map; /* path != NULL: the world is this map */
 
   iris_render_settings render;
+  iris_material_variants variants;
 
   /* Source path (for messages) and memory maps that borrowed arrays point into. */
   char *source_path;

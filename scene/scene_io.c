@@ -408,6 +408,14 @@ iris_status iris_scene_write(const iris_scene *scene, const char *json_path, iri
   }
   cJSON *render = write_render(&scene->render);
   if (render) cJSON_AddItemToObject(root, "render", render);
+  if (scene->variants.count) {
+    cJSON *o = cJSON_AddObjectToObject(root, "material_variants");
+    cJSON *names = cJSON_AddArrayToObject(o, "names");
+    for (size_t i = 0; i < scene->variants.count; i++)
+      cJSON_AddItemToArray(names, cJSON_CreateString(scene->variants.names[i]));
+    if (scene->variants.applied >= 0)
+      cJSON_AddStringToObject(o, "applied", scene->variants.names[scene->variants.applied]);
+  }
   free(dir_abs);
 
   if (st == IRIS_OK) {
@@ -946,9 +954,34 @@ static void *alloc_array(jctx *c, size_t n, size_t size, iris_status *st) {
   return p;
 }
 
+/* "material_variants": {"names": [...], "applied": NAME} (applied absent: the defaults). */
+static iris_status load_variants(jctx *c, const cJSON *o, iris_material_variants *v) {
+  static const char *const keys[] = {"names", "applied"};
+  snprintf(c->element, sizeof c->element, "material_variants");
+  TRY(check_keys(c, o, keys, 2));
+  TRY(require(c, o, "names"));
+  const cJSON *names = item(o, "names");
+  if (!cJSON_IsArray(names) || cJSON_GetArraySize(names) < 1)
+    return jfail(c, IRIS_ERR_INVALID, "'names' must be a non-empty array of strings");
+  size_t n = (size_t)cJSON_GetArraySize(names);
+  if (!(v->names = calloc(n, sizeof *v->names))) return jfail(c, IRIS_ERR_NOMEM, "out of memory");
+  for (const cJSON *e = names->child; e; e = e->next) {
+    if (!cJSON_IsString(e)) return jfail(c, IRIS_ERR_INVALID, "'names' must be a non-empty array of strings");
+    if (!(v->names[v->count++] = iris_strdup(e->valuestring))) return jfail(c, IRIS_ERR_NOMEM, "out of memory");
+  }
+  const char *applied = NULL;
+  TRY(get_string(c, o, "applied", &applied));
+  v->applied = -1;
+  for (size_t i = 0; applied && i < v->count && v->applied < 0; i++)
+    if (strcmp(v->names[i], applied) == 0) v->applied = (int32_t)i;
+  if (applied && v->applied < 0) return jfail(c, IRIS_ERR_INVALID, "'applied' variant '%s' is not in 'names'", applied);
+  return IRIS_OK;
+}
+
 static iris_status parse_scene(jctx *c, const cJSON *root, const char *dir, iris_scene *s) {
-  static const char *const keys[] = {"format", "version", "units", "cameras", "textures", "materials",
-                                     "meshes", "instances", "lights", "environment", "render"};
+  static const char *const keys[] = {"format",    "version", "units",  "cameras",     "textures",
+                                     "materials", "meshes",  "instances", "lights", "environment",
+                                     "render",    "material_variants"};
   c->element[0] = '\0';
   if (!cJSON_IsObject(root)) return jfail(c, IRIS_ERR_INVALID, "the top level must be a JSON object");
   TRY(check_keys(c, root, keys, sizeof keys / sizeof *keys));
@@ -1050,6 +1083,8 @@ static iris_status parse_scene(jctx *c, const cJSON *root, const char *dir, iris
     snprintf(c->element, sizeof c->element, "render");
     TRY(load_render(c, render, &s->render));
   }
+  const cJSON *variants = item(root, "material_variants");
+  if (variants) TRY(load_variants(c, variants, &s->variants));
 
   /* Meshes last: their JSON is checked completely before any file is mapped. */
   n = (size_t)cJSON_GetArraySize(meshes);

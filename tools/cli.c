@@ -175,7 +175,7 @@ bool iris_cli_same_file(const char *a, const char *b) {
   return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
-int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_name,
+int iris_cli_load_scene(const char *cmd, const char *input, const iris_import_options *opts,
                         const char *builtin_list, iris_scene **out) {
   iris_error err;
   iris_error_clear(&err);
@@ -183,9 +183,11 @@ int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_n
   iris_status st;
   iris_phase_begin("loading", "loading the scene");
   if (iris_path_exists(input)) {
-    iris_import_options opts = iris_import_options_default();
-    opts.camera_name = camera_name;
-    st = iris_import_file(input, &opts, out, &err);
+    st = iris_import_file(input, opts, out, &err);
+  } else if (iris_builtin_exists(input) && opts && opts->variant) {
+    st = iris_error_set(&err, IRIS_ERR_USAGE, input, 0, NULL,
+                        "no material variant \"%s\": a built-in scene has no material variants (they come "
+                        "from glTF files)", opts->variant);
   } else if (iris_builtin_exists(input)) {
     st = iris_builtin_create(input, out, &err);
   } else {

@@ -61,12 +61,13 @@ bool iris_cli_set_once(const char *cmd, const char *opt, const char **slot, cons
 bool iris_cli_output_folder_ok(const char *cmd, const char *output);
 /* True when paths `a` and `b` name the same file (same string or inode). */
 bool iris_cli_same_file(const char *a, const char *b);
-/* Loads INPUT: an existing file is imported (`camera_name` handed to the
- * importer), else it must be a built-in scene name. Returns IRIS_EXIT_OK with
- * *out set, or prints the error and returns the exit code. An INPUT that is
- * neither is a usage error naming `builtin_list`, or all built-in scenes when
- * NULL. */
-int iris_cli_load_scene(const char *cmd, const char *input, const char *camera_name,
+/* Loads INPUT: an existing file is imported with `opts` (NULL: the
+ * defaults), else it must be a built-in scene name (refused with a material
+ * variant). Returns IRIS_EXIT_OK with *out set, or prints the error and
+ * returns the exit code. An INPUT that is neither is a usage error naming
+ * `builtin_list`, or all built-in scenes when NULL. */
+struct iris_import_options;
+int iris_cli_load_scene(const char *cmd, const char *input, const struct iris_import_options *opts,
                         const char *builtin_list, iris_scene **out);
 
 /* Subcommand entry points: argv[0] is the subcommand name. */

@@ -110,6 +110,8 @@ int iris_cmd_bench(int argc, char **argv) {
   iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
                             iris_options_rows(&IRIS_RENDER_OPTIONS,
                                              "threads,width,height,max-depth,sampler,light-sampling,light-sampler")};
+  iris_gltf_input_options go = {NULL};
+  iris_option_binding gb = {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0};
   for (int i = 1; i < argc; i++) {
     char name[64];
     const char *val;
@@ -128,10 +130,11 @@ int iris_cmd_bench(int argc, char **argv) {
     if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       print_help();
       printf("\n");
-      iris_option_binding shared[2] = {rb, envb};
-      iris_options_help(shared, 2);
+      iris_option_binding shared[3] = {rb, envb, gb};
+      iris_options_help(shared, 3);
       return IRIS_EXIT_OK;
-    } else if (iris_options_take(CMD, &envb, a, val, argc, argv, &i, &erc)) {
+    } else if (iris_options_take(CMD, &envb, a, val, argc, argv, &i, &erc) ||
+               iris_options_take(CMD, &gb, a, val, argc, argv, &i, &erc)) {
       if (erc) return erc;
     } else if (strcmp(a, "--methods") == 0) {
       NEED_VALUE();
@@ -194,6 +197,7 @@ int iris_cmd_bench(int argc, char **argv) {
   }
   /* Everything that can be checked is checked before any work starts. */
   if (input_count == 0) return iris_cli_usage_error(CMD, "no input scene given");
+  p.variant = go.variant;
   if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
   /* what a method named without @variant uses */
   iris_sampler_kind sampler = (iris_sampler_kind)ro.sampler;

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "exporters/blender.h"
 #include "exporters/pov.h"
+#include "importers/import.h"
 #include "tools/cli.h"
 #include "tools/options.h"
 
@@ -68,11 +69,12 @@ int iris_cmd_export(int argc, char **argv) {
   iris_env_options eo = iris_env_options_default();
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
+  iris_gltf_input_options go = {NULL};
   /* the shared sampling/camera rows export means something by: the script's defaults */
   iris_option_binding bind[] = {
       {&EXPORT_OPTIONS, &ec, 0, 0},
       {&IRIS_RENDER_OPTIONS, &ro, 0, iris_options_rows(&IRIS_RENDER_OPTIONS, "spp,seed,max-depth,camera,width,height")},
-      {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
+      {&IRIS_ENV_OPTIONS, &eo, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0}};
   const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int ninputs = 0;
@@ -133,7 +135,10 @@ int iris_cmd_export(int argc, char **argv) {
   int rc = iris_env_options_check(CMD, &bind[2], true);
   if (rc != IRIS_EXIT_OK) return rc;
   iris_scene *scene = NULL;
-  rc = iris_cli_load_scene(CMD, input, params.camera_name, NULL, &scene);
+  iris_import_options io = iris_import_options_default();
+  io.camera_name = params.camera_name;
+  io.variant = go.variant;
+  rc = iris_cli_load_scene(CMD, input, &io, NULL, &scene);
   if (rc != IRIS_EXIT_OK) return rc;
   if ((rc = iris_env_options_apply(CMD, &bind[2], scene)) != IRIS_EXIT_OK) {
     iris_scene_destroy(scene);

@@ -75,12 +75,15 @@ int iris_cmd_import(int argc, char **argv) {
   import_cli ic;
   memset(&ic, 0, sizeof ic);
   iris_env_options eo = iris_env_options_default();
-  iris_option_binding bind[] = {{&IMPORT_OPTIONS, &ic, 0, 0}, {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
+  iris_gltf_input_options go = {NULL};
+  iris_option_binding bind[] = {{&IMPORT_OPTIONS, &ic, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0},
+                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
+  const size_t nbind = sizeof bind / sizeof bind[0];
   const char *inputs[256];
   int ninputs = 0;
-  int prc = iris_options_parse(CMD, argc, argv, bind, 2, inputs, 256, &ninputs);
+  int prc = iris_options_parse(CMD, argc, argv, bind, nbind, inputs, 256, &ninputs);
   if (prc < 0) {
-    print_help(bind, 2);
+    print_help(bind, nbind);
     return IRIS_EXIT_OK;
   }
   if (prc != 0) return prc;
@@ -88,6 +91,7 @@ int iris_cmd_import(int argc, char **argv) {
   bool quiet = ic.quiet;
   opts.camera_name = ic.camera;
   opts.weld = ic.weld;
+  opts.variant = go.variant; /* every glTF input; any other input refuses it */
   if (ic.no_normals) opts.compute_normals = false;
   if (quiet) iris_log_set_level(IRIS_LOG_QUIET);
 
@@ -111,7 +115,7 @@ int iris_cmd_import(int argc, char **argv) {
     if (iris_cli_same_file(inputs[i], output))
       return iris_cli_usage_error(CMD, "output '%s' is also an input", output);
   }
-  int erc = iris_env_options_check(CMD, &bind[1], true);
+  int erc = iris_env_options_check(CMD, &bind[2], true);
   if (erc != IRIS_EXIT_OK) return erc;
 
   iris_error err;
@@ -140,7 +144,7 @@ int iris_cmd_import(int argc, char **argv) {
     iris_scene_destroy(scene);
     return rc;
   }
-  int arc = iris_env_options_apply(CMD, &bind[1], scene);
+  int arc = iris_env_options_apply(CMD, &bind[2], scene);
   if (arc != IRIS_EXIT_OK) {
     iris_scene_destroy(scene);
     return arc;

@@ -21,16 +21,18 @@ static const char *const ATTRIBUTES[] = {"normals", "uvs", "colors", "uvs1", "ta
 static const int ATTRIBUTE_BYTES[] = {12, 8, 12, 8, 16, 4};
 
 static void print_help(void) {
-  printf("Usage: iris info FILE [--json]\n"
+  printf("Usage: iris info FILE [--json] [--variant NAME]\n"
          "\n"
          "Describes an iris scene (.json) or any file iris imports (.obj, .ply, .gltf,\n"
          ".glb): meshes, instances, triangles, materials by type, emissive materials,\n"
-         "textures, lights by type, cameras, bounds, attributes and mesh memory.\n"
+         "textures, lights by type, cameras, bounds, attributes, mesh memory and a glTF\n"
+         "file's material variants (KHR_materials_variants).\n"
          "\n"
          "Options:\n"
-         "      --json   print one JSON object instead of text\n"
-         "  -q, --quiet  print no warnings while loading\n"
-         "  -h, --help   show this help\n"
+         "      --json          print one JSON object instead of text\n"
+         "      --variant NAME  describe the file with its material variant NAME applied\n"
+         "  -q, --quiet         print no warnings while loading\n"
+         "  -h, --help          show this help\n"
          "\n"
          "Exit status: 0 success, 2 bad usage or bad input, 1 other failure.\n");
 }
@@ -175,6 +177,18 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
     cJSON_AddNullToObject(o, "environment_map");
   }
   cJSON_AddBoolToObject(o, "has_light", iris_scene_has_emitter(s));
+  if (s->variants.count) { /* as the scene format's "material_variants" */
+    cJSON *v = cJSON_AddObjectToObject(o, "material_variants");
+    cJSON *names = cJSON_AddArrayToObject(v, "names");
+    for (size_t i = 0; i < s->variants.count; i++)
+      cJSON_AddItemToArray(names, cJSON_CreateString(s->variants.names[i]));
+    if (s->variants.applied >= 0)
+      cJSON_AddStringToObject(v, "applied", s->variants.names[s->variants.applied]);
+    else
+      cJSON_AddNullToObject(v, "applied");
+  } else {
+    cJSON_AddNullToObject(o, "material_variants");
+  }
   {
     iris_memory_estimate est;
     int w, h;
@@ -230,6 +244,12 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
            (double)m->emission[0], (double)m->emission[1], (double)m->emission[2],
            m->emission_texture >= 0 ? " x texture" : "");
   }
+  if (s->variants.count) {
+    printf("variants     %zu:", s->variants.count);
+    for (size_t i = 0; i < s->variants.count; i++)
+      printf("%s \"%s\"%s", i ? "," : "", s->variants.names[i], (int32_t)i == s->variants.applied ? " (applied)" : "");
+    printf("%s\n", s->variants.applied < 0 ? "; none applied (the default materials)" : "");
+  }
   printf("textures     %zu (%zu embedded, %llu bytes)\n", s->texture_count, st->embedded_textures,
          (unsigned long long)st->texture_bytes);
   printf("lights       %zu (point %zu, spot %zu, directional %zu)\n", s->light_count,
@@ -273,10 +293,12 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
 
 int iris_cmd_info(int argc, char **argv) {
   static const struct option longopts[] = {{"json", no_argument, NULL, 'j'},
+                                           {"variant", required_argument, NULL, 'v'},
                                            {"quiet", no_argument, NULL, 'q'},
                                            {"help", no_argument, NULL, 'h'},
                                            {NULL, 0, NULL, 0}};
   bool json = false, quiet = false;
+  const char *variant = NULL;
   opterr = 0;
   optind = 1;
   int c;
@@ -284,6 +306,9 @@ int iris_cmd_info(int argc, char **argv) {
     switch (c) {
       case 'j': json = true; break;
       case 'q': quiet = true; break;
+      case 'v':
+        if (!iris_cli_set_once(CMD, "--variant", &variant, optarg)) return IRIS_EXIT_USAGE;
+        break;
       case 'h': print_help(); return IRIS_EXIT_OK;
       default: return iris_cli_getopt_error(CMD, c, argv);
     }
@@ -296,6 +321,7 @@ int iris_cmd_info(int argc, char **argv) {
   iris_error_clear(&err);
   iris_scene *scene = NULL;
   iris_import_options opts = iris_import_options_default();
+  opts.variant = variant;
   if (iris_import_file(path, &opts, &scene, &err) != IRIS_OK) return iris_cli_report(&err);
   scene_stats st = compute_stats(scene);
   iris_warn_if_lightless(scene, path);

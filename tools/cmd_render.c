@@ -14,6 +14,7 @@
 #include "core/image.h"
 #include "core/log.h"
 #include "core/rng.h"
+#include "importers/import.h"
 #include "scenes/builtin.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/guiding/inspect.h"
@@ -213,9 +214,10 @@ int iris_cmd_render(int argc, char **argv) {
   memset(&ro, 0, sizeof ro);
   ro.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
   iris_env_options eo = iris_env_options_default();
+  iris_gltf_input_options go = {NULL};
   iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0, 0},
                                 {&PARTITION_OPTIONS, &rc_opts, 0, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0, 0},
-                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}};
+                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0}};
   const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int operands = 0;
@@ -307,7 +309,10 @@ int iris_cmd_render(int argc, char **argv) {
   /* From here on Ctrl-C stops the work in whatever phase it is (docs/cli.md). */
   iris_cli_catch_signals();
   iris_scene *scene = NULL;
-  int rc = iris_cli_load_scene(CMD, input, camera, NULL, &scene);
+  iris_import_options io = iris_import_options_default();
+  io.camera_name = camera;
+  io.variant = go.variant;
+  int rc = iris_cli_load_scene(CMD, input, &io, NULL, &scene);
   if (rc != IRIS_EXIT_OK) {
     iris_cli_release_signals();
     return rc;

@@ -44,6 +44,8 @@ static void print_help(void) {
       "      --width W --height H  image size (must match a given reference)\n"
       "      --max-depth B         bounces as Cycles counts them (default: scene's, else 64)\n"
       "      --camera NAME         scene camera to use\n"
+      "      --variant NAME        a glTF INPUT's material variant (KHR_materials_variants;\n"
+      "                            --blender-import makes Blender show it too)\n"
       "Environment (replaces the scene's world; docs/format.md):\n"
       "      --env FILE, --env-strength S, --env-rotation DEG, --env-color R,G,B\n"
       "                            as `iris render` (iris render --help)\n"
@@ -108,7 +110,7 @@ int iris_cmd_validate(int argc, char **argv) {
     OPT_METHOD = 256, OPT_SPP, OPT_REFERENCE, OPT_BLENDER, OPT_TOLERANCE, OPT_BLENDER_SPP,
     OPT_THREADS, OPT_SEED, OPT_WIDTH, OPT_HEIGHT, OPT_OUT, OPT_REFRESH, OPT_REFERENCES,
     OPT_DEPTH, OPT_CAMERA, OPT_ALPHA, OPT_BLENDER_EXE, OPT_STRICT, OPT_BLENDER_IMPORT, OPT_ENV = 512,
-    OPT_RENDER = 640
+    OPT_RENDER = 640, OPT_GLTF = 768
   };
   static const struct option own_opts[] = {
       {"method", required_argument, NULL, OPT_METHOD},
@@ -134,12 +136,15 @@ int iris_cmd_validate(int argc, char **argv) {
   iris_option_binding rb = {&IRIS_RENDER_OPTIONS, &ro, 0,
                             iris_options_rows(&IRIS_RENDER_OPTIONS,
                                              "spp,seed,threads,width,height,max-depth,camera,sampler,light-sampler")};
-  struct option longopts[sizeof own_opts / sizeof own_opts[0] + 2 * IRIS_OPTIONS_MAX_ROWS + 1];
+  iris_gltf_input_options go = {NULL};
+  iris_option_binding gb = {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0};
+  struct option longopts[sizeof own_opts / sizeof own_opts[0] + 3 * IRIS_OPTIONS_MAX_ROWS + 1];
   memset(longopts, 0, sizeof longopts);
   memcpy(longopts, own_opts, sizeof own_opts);
   size_t nl = sizeof own_opts / sizeof own_opts[0];
   nl += iris_options_getopt_rows(&rb, OPT_RENDER, longopts + nl);
-  iris_options_getopt_rows(&envb, OPT_ENV, longopts + nl);
+  nl += iris_options_getopt_rows(&envb, OPT_ENV, longopts + nl);
+  iris_options_getopt_rows(&gb, OPT_GLTF, longopts + nl);
   int erc = 0;
   iris_validate_params p = iris_validate_params_default();
   bool blender = false, refresh = false, have_blender_spp = false, blender_import = false;
@@ -188,7 +193,8 @@ int iris_cmd_validate(int argc, char **argv) {
       case 'h': print_help(); return IRIS_EXIT_OK;
       default:
         if (iris_options_getopt_take(CMD, &envb, OPT_ENV, c, optarg, &erc) ||
-            iris_options_getopt_take(CMD, &rb, OPT_RENDER, c, optarg, &erc)) {
+            iris_options_getopt_take(CMD, &rb, OPT_RENDER, c, optarg, &erc) ||
+            iris_options_getopt_take(CMD, &gb, OPT_GLTF, c, optarg, &erc)) {
           if (erc) return erc;
           break;
         }
@@ -203,6 +209,7 @@ int iris_cmd_validate(int argc, char **argv) {
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;
   if (iris_options_seen(&rb, "camera")) p.camera_name = ro.camera;
+  p.variant = go.variant;
   /* Cycles' seed is a non-negative 32-bit int (both renderers get the same);
    * Cycles' bounce counts stop at 1024 */
   if (iris_options_seen(&rb, "seed")) {
@@ -227,7 +234,8 @@ int iris_cmd_validate(int argc, char **argv) {
   iris_error_clear(&err);
   if (refresh) {
     /* Everything checked before the (long) Blender runs. */
-    if (p.reference_path || blender || blender_import || p.out_dir || p.method_count || p.width > 0 || p.height > 0)
+    if (p.reference_path || blender || blender_import || p.out_dir || p.method_count || p.width > 0 || p.height > 0 ||
+        p.variant)
       return iris_cli_usage_error(CMD, "--refresh takes only scene names, --blender-spp, --threads, "
                                        "--seed, --references and --blender-exe");
     for (int i = optind; i < argc; i++)

@@ -77,6 +77,14 @@ static const iris_option RENDER_ROWS[] = {
 };
 const iris_option_group IRIS_RENDER_OPTIONS = {"Sampling and camera", RENDER_ROWS,
                                                sizeof RENDER_ROWS / sizeof RENDER_ROWS[0]};
+static const iris_option GLTF_INPUT_ROWS[] = {
+    OPT("variant", 0, IRIS_OPT_STRING, "NAME", 0, 0, iris_gltf_input_options, variant,
+        "apply the glTF file's material variant NAME (KHR_materials_variants;\n"
+        "default: its default materials; `iris info FILE` lists the names)"),
+};
+const iris_option_group IRIS_GLTF_INPUT_OPTIONS = {"glTF input", GLTF_INPUT_ROWS,
+                                                   sizeof GLTF_INPUT_ROWS / sizeof GLTF_INPUT_ROWS[0]};
+
 static const char *const SPLAT_CHOICES[] = {"nearest", "bilinear", NULL};
 static const char *const PHOTON_LIGHT_CHOICES[] = {"power", "area", NULL};
 static const iris_option GUIDING_ROWS[] = {

@@ -120,6 +120,14 @@ typedef struct iris_render_options {
 } iris_render_options;
 extern const iris_option_group IRIS_RENDER_OPTIONS;
 
+/* glTF input: --variant NAME, the KHR_materials_variants variant the glTF
+ * importer applies (iris_import_options.variant), for every command that
+ * imports a file (import, info, render, export, validate, bench). */
+typedef struct iris_gltf_input_options {
+  const char *variant;
+} iris_gltf_input_options;
+extern const iris_option_group IRIS_GLTF_INPUT_OPTIONS;
+
 /* Guiding (--method guided | guided-nee): fills iris_guiding_params directly. */
 extern const iris_option_group IRIS_GUIDING_OPTIONS;
 

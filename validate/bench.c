@@ -654,7 +654,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
     iris_bench_scene *sc = &res->scenes[i];
     snprintf(sc->input, sizeof sc->input, "%s", p.inputs[i]);
     sc->reference_relmse = -1.0;
-    st = iris_validate_load_scene(p.inputs[i], NULL, &bs[i].scene, err);
+    st = iris_validate_load_scene(p.inputs[i], NULL, p.variant, &bs[i].scene, err);
     if (st == IRIS_OK && !iris_world_override_apply(&p.world, bs[i].scene))
       st = iris_error_set(err, IRIS_ERR_NOMEM, p.inputs[i], 0, NULL, "out of memory");
     if (st != IRIS_OK) break;

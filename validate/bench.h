@@ -43,6 +43,7 @@ typedef struct iris_bench_params {
   const char *const *inputs;  /* files or built-in scene names (validate.h's loader) */
   int input_count;
   iris_world_override world;  /* zeroed: each scene's own world (validate.h) */
+  const char *variant;        /* glTF material variant of every input (NULL: the defaults) */
   /* The timed iris runs: method k with sampler samplers[k] and emitter
    * triangle sampling light_samplings[k] (variants such as mis@independent
    * compare samplers in one run; iris_bench_method_label names them). */

@@ -69,14 +69,19 @@ bool iris_world_override_apply(const iris_world_override *w, iris_scene *scene) 
   return true;
 }
 
-iris_status iris_validate_load_scene(const char *input, const char *camera_name, iris_scene **out,
-                                     iris_error *err) {
+iris_status iris_validate_load_scene(const char *input, const char *camera_name, const char *variant,
+                                     iris_scene **out, iris_error *err) {
   *out = NULL;
   if (iris_path_exists(input)) {
     iris_import_options opts = iris_import_options_default();
     opts.camera_name = camera_name;
+    opts.variant = variant;
     return iris_import_file(input, &opts, out, err);
   }
+  if (iris_builtin_exists(input) && variant)
+    return iris_error_set(err, IRIS_ERR_USAGE, input, 0, NULL,
+                          "no material variant \"%s\": a built-in scene has no material variants (they come "
+                          "from glTF files)", variant);
   if (iris_builtin_exists(input)) return iris_builtin_create(input, out, err);
   return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
                         "'%s' is neither a file nor a built-in scene (cornell-box, veach-mis, door, ...)", input);
@@ -536,7 +541,7 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     }
   }
   iris_scene *scene = NULL;
-  st = iris_validate_load_scene(p.input, p.camera_name, &scene, err);
+  st = iris_validate_load_scene(p.input, p.camera_name, p.variant, &scene, err);
   if (st == IRIS_OK && !iris_world_override_apply(&p.world, scene))
     st = iris_error_set(err, IRIS_ERR_NOMEM, p.input, 0, NULL, "out of memory");
   if (st == IRIS_OK) iris_scene_warn_if_lightless(scene, p.input);
@@ -695,7 +700,7 @@ iris_status iris_validate_refresh(const iris_refresh_params *params, iris_error 
                           "'%s' has no stored reference (cornell-box, veach-mis, door)", params->scene);
   if (params->spp > 0) spp = params->spp;
   iris_scene *scene = NULL;
-  iris_status st = iris_validate_load_scene(params->scene, NULL, &scene, err);
+  iris_status st = iris_validate_load_scene(params->scene, NULL, NULL, &scene, err);
   if (st != IRIS_OK) return st;
   st = iris_mkdir_p(params->dir, err);
   if (st != IRIS_OK) {

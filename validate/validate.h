@@ -35,9 +35,11 @@ extern "C" {
 /* Scenes with stored references, NULL-terminated: cornell-box, veach-mis, door. */
 const char *const *iris_validate_reference_scenes(void);
 
-/* Loads INPUT: an existing file (iris scene or importable) or a built-in scene name. */
-iris_status iris_validate_load_scene(const char *input, const char *camera_name, iris_scene **out,
-                                     iris_error *err);
+/* Loads INPUT: an existing file (iris scene or importable) or a built-in scene
+ * name; `variant` (NULL: none) is the glTF material variant to apply
+ * (IRIS_ERR_USAGE for a built-in scene or a file without it). */
+iris_status iris_validate_load_scene(const char *input, const char *camera_name, const char *variant,
+                                     iris_scene **out, iris_error *err);
 
 typedef enum iris_reference_source {
   IRIS_REFERENCE_FILE = 0, /* --reference REF.exr (or the stored one of a built-in scene) */
@@ -68,6 +70,8 @@ typedef struct iris_validate_params {
   int width, height;        /* <= 0: the reference's size (file) or the scene's (Blender) */
   int max_depth;            /* < 0: the scene's, else 64 */
   const char *camera_name;
+  const char *variant;      /* glTF material variant applied on import (NULL: the defaults); with
+                               blender_import, Blender's importer is made to show it too */
   iris_reference_source source;
   const char *reference_path; /* IRIS_REFERENCE_FILE */
   int blender_spp;          /* IRIS_REFERENCE_BLENDER (0: default) */
