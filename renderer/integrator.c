@@ -180,6 +180,16 @@ static iris_vec3 fold_mirror(const iris_shading_point *sp, iris_vec3 w) {
  * directions of measure ~1e-7 sr, which then get no light). */
 #define FOLD_MIN_COS 1e-7f
 
+/* The mirror term of the folded BSDF at a world direction wi above Ng: the
+ * local M wi, and whether the BSDF can be non-zero there (a reflect-only BSDF
+ * is zero below its shading plane and, with a coat, below the coat's plane),
+ * so that the common case -- M wi below both -- costs no evaluation. */
+static bool fold_term(const iris_shading_point *sp, iris_vec3 wi, iris_vec3 *ml) {
+  *ml = iris_frame_to_local(&sp->frame, fold_mirror(sp, wi));
+  if (ml->z > 0.0f) return true;
+  return sp->bsdf.clearcoat > 0.0f && iris_dot(*ml, sp->bsdf.coat_n) > 0.0f;
+}
+
 bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
                                  iris_direction_sample *out) {
   float u_lobe = iris_sampler_slot(rng, IRIS_SLOT_LOBE);
@@ -198,20 +208,28 @@ bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, f
   out->pdf = bs.pdf;
   out->lobe = bs.lobe;
   out->delta = (bs.lobe & IRIS_LOBE_DELTA) != 0;
-  if (sp->fold) { /* docs/rendering.md, "Normal maps": the folded BSDF */
-    if (iris_dot(out->wi, sp->si.ng) < 0.0f) {
-      iris_vec3 up = iris_normalize(fold_mirror(sp, out->wi));
-      if (out->delta) { /* f holds 1/|cos|: keep f |cos| across the mirror */
-        float c0 = fabsf(bs.wi.z), c1 = fabsf(iris_dot(up, sp->si.ns));
-        if (!(c1 > FOLD_MIN_COS)) return false;
-        out->f = iris_scale(out->f, c0 / c1);
-      }
-      out->wi = up;
-    }
+  if (!sp->fold) return true;
+  /* docs/rendering.md, "Normal maps": the folded BSDF. A non-delta sample's
+   * f and pdf are the BSDF's value and density at bs.wi (iris_bsdf_sample's
+   * contract), so only the other term of each sum is evaluated. */
+  if (iris_dot(out->wi, sp->si.ng) < 0.0f) { /* mirrored: bs.wi is the mirror term */
+    iris_vec3 up = iris_normalize(fold_mirror(sp, out->wi));
+    iris_vec3 ul = iris_frame_to_local(&sp->frame, up);
+    float c0 = fabsf(bs.wi.z), c1 = fabsf(ul.z);
+    if (!(c1 > FOLD_MIN_COS)) return false;
+    out->wi = up;
+    out->f = iris_scale(bs.f, c0 / c1); /* a delta lobe's f holds 1/|cos|: the same rule */
     if (!out->delta) {
-      out->f = iris_integrator_bsdf_eval(sp, out->wi);
-      out->pdf = iris_integrator_bsdf_pdf(sp, out->wi);
-      if (!(out->pdf > 0.0f)) return false;
+      out->f = iris_add(out->f, iris_bsdf_eval(&sp->bsdf, sp->wo_local, ul));
+      out->pdf = bs.pdf + iris_bsdf_pdf(&sp->bsdf, sp->wo_local, ul);
+    }
+  } else if (!out->delta) {
+    iris_vec3 ml;
+    if (fold_term(sp, out->wi, &ml)) {
+      float c = fabsf(bs.wi.z);
+      if (!(c > FOLD_MIN_COS)) return false;
+      out->f = iris_add(out->f, iris_scale(iris_bsdf_eval(&sp->bsdf, sp->wo_local, ml), fabsf(ml.z) / c));
+      out->pdf += iris_bsdf_pdf(&sp->bsdf, sp->wo_local, ml);
     }
   }
   return true;
@@ -221,21 +239,20 @@ iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) 
   if (!direction_allowed(sp, wi)) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, wi);
   iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
-  if (!sp->fold) return f;
+  iris_vec3 ml;
+  if (!sp->fold || !fold_term(sp, wi, &ml)) return f;
   float c = fabsf(wl.z);
   if (!(c > FOLD_MIN_COS)) return iris_v3(0, 0, 0);
-  iris_vec3 ml = iris_frame_to_local(&sp->frame, fold_mirror(sp, wi));
-  iris_vec3 fm = iris_bsdf_eval(&sp->bsdf, sp->wo_local, ml);
-  return iris_add(f, iris_scale(fm, fabsf(ml.z) / c));
+  return iris_add(f, iris_scale(iris_bsdf_eval(&sp->bsdf, sp->wo_local, ml), fabsf(ml.z) / c));
 }
 
 float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi) {
-  if (sp->fold) {
-    if (!direction_allowed(sp, wi)) return 0.0f;
-    return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi)) +
-           iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, fold_mirror(sp, wi)));
-  }
-  return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
+  if (!sp->fold) return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
+  if (!direction_allowed(sp, wi)) return 0.0f;
+  float p = iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
+  iris_vec3 ml;
+  if (fold_term(sp, wi, &ml)) p += iris_bsdf_pdf(&sp->bsdf, sp->wo_local, ml);
+  return p;
 }
 
 void iris_integrator_prepare_direction(const iris_integrator *it, iris_shading_point *sp) {
