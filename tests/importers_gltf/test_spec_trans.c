@@ -127,6 +127,24 @@ static void shade_at(const iris_scene *s, const iris_textures *tex, const float 
   iris_integrator_shade(&it, &si, wo, 0, sp);
 }
 
+/* The scene format keeps the three fields (written, read back equal) and
+ * rejects an index past the textures on load. */
+static void check_format(const iris_scene *s, const char *dir) {
+  char json[1200];
+  snprintf(json, sizeof json, "%s/scene.json", dir);
+  iris_error err;
+  iris_error_clear(&err);
+  iris_scene *back = NULL;
+  if (!ok_call(iris_scene_write(s, json, &err), &err) || !ok_call(iris_scene_load(json, &back, &err), &err)) return;
+  const iris_material *a = &s->materials[0], *b = &back->materials[0];
+  CHECK(a->transmission_texture == b->transmission_texture && a->specular_texture == b->specular_texture &&
+        a->specular_color_texture == b->specular_color_texture);
+  back->materials[0].specular_texture = (int32_t)back->texture_count;
+  iris_error_clear(&err);
+  CHECK(iris_scene_validate(back, json, &err) != IRIS_OK && strstr(err.message, "specular_texture"));
+  iris_scene_destroy(back);
+}
+
 static int check_shade(const iris_scene *s) {
   const iris_material *m = &s->materials[0];
   if (!CHECK(m->type == IRIS_MATERIAL_GLTF && m->transmission_texture >= 0 && m->specular_texture >= 0 &&
@@ -299,6 +317,7 @@ int main(int argc, char **argv) {
   if (!ok_call(iris_import_file(path, &opts, &s, &e), &e) || !s) {
     rc = TEST_SUMMARY();
   } else {
+    if (!blender) check_format(s, dir);
     rc = blender ? check_blender(s, dir) : check_shade(s);
     iris_scene_destroy(s);
   }
