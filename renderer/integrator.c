@@ -107,22 +107,31 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
 
 /* KHR_materials_transmission / _specular textures at the point, into the BSDF
  * before its lobes are decided: transmission x R, specular x A (linear),
- * specular colour x RGB (sRGB). A factor of 0 needs no lookup. Only for
- * materials that have one of these textures. */
+ * specular colour x RGB (sRGB). A factor of 0 needs no lookup; the specular
+ * pair packed in one image with one placement (the extension's intended
+ * layout: one scene texture) is one lookup, as sRGB decoding leaves alpha
+ * linear. Only for materials that have one of these textures. */
 static void shade_spec_trans(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
                              iris_bsdf *b) {
-  float t[4];
+  float t[4], c[4];
+  bool have_c = false;
   if (m->transmission_texture >= 0 && b->transmission > 0.0f) {
     iris_texture_sample(it->textures, m->transmission_texture, si->uv, si->uv1, false, t);
     b->transmission *= iris_clampf(t[0], 0.0f, 1.0f);
   }
   if (m->specular_texture >= 0 && b->specular > 0.0f) {
-    iris_texture_sample(it->textures, m->specular_texture, si->uv, si->uv1, false, t);
-    b->specular *= fmaxf(t[3], 0.0f);
+    if (m->specular_texture == m->specular_color_texture) {
+      iris_texture_sample(it->textures, m->specular_color_texture, si->uv, si->uv1, true, c);
+      have_c = true;
+      b->specular *= fmaxf(c[3], 0.0f);
+    } else {
+      iris_texture_sample(it->textures, m->specular_texture, si->uv, si->uv1, false, t);
+      b->specular *= fmaxf(t[3], 0.0f);
+    }
   }
   if (m->specular_color_texture >= 0 && iris_max3(b->specular_color) > 0.0f) {
-    iris_texture_sample(it->textures, m->specular_color_texture, si->uv, si->uv1, true, t);
-    b->specular_color = iris_mul(b->specular_color, iris_v3(fmaxf(t[0], 0.0f), fmaxf(t[1], 0.0f), fmaxf(t[2], 0.0f)));
+    if (!have_c) iris_texture_sample(it->textures, m->specular_color_texture, si->uv, si->uv1, true, c);
+    b->specular_color = iris_mul(b->specular_color, iris_v3(fmaxf(c[0], 0.0f), fmaxf(c[1], 0.0f), fmaxf(c[2], 0.0f)));
   }
 }
 

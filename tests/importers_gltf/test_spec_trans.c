@@ -223,6 +223,18 @@ static int check_shade(const iris_scene *s) {
   /* ... and where it is not 0, seen from below keeps the outward normal (inside). */
   shade_at(s, &tex, uv, uv1, iris_v3(0.0f, 0.3f, -0.95f), &sp);
   CHECK((sp.lobes & IRIS_LOBE_TRANSMISSION) && sp.si.ng.z > 0.0f && sp.wo_local.z < 0.0f);
+
+  /* The specular pair packed in one image with one placement (one scene texture,
+   * read once): A still linear, RGB still sRGB-decoded. */
+  iris_material *mm = &((iris_scene *)s)->materials[0];
+  const int32_t keep = mm->specular_texture;
+  mm->specular_texture = mm->specular_color_texture;
+  shade_at(s, &tex, uv, uv1, iris_v3(0.3f, 0.0f, 0.95f), &sp);
+  mm->specular_texture = keep;
+  EXPECT(fabsf(sp.bsdf.specular - 0.8f * P[3] / 255.0f) < 1e-4f, "packed: specular %g, expected 0.8 x A of P = %g",
+         sp.bsdf.specular, 0.8f * P[3] / 255.0f);
+  EXPECT(fabsf(sp.bsdf.specular_color.z - c_exp[2]) < 1e-3f * c_exp[2], "packed: specular colour %g, expected %g",
+         sp.bsdf.specular_color.z, c_exp[2]);
   iris_textures_destroy(&tex);
   return TEST_SUMMARY();
 }
