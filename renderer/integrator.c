@@ -111,6 +111,7 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
  * pair packed in one image with one placement (the extension's intended
  * layout: one scene texture) is one lookup, as sRGB decoding leaves alpha
  * linear. Only for materials that have one of these textures. */
+__attribute__((noinline)) /* kept out of iris_integrator_shade: materials without them pay one branch */
 static void shade_spec_trans(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
                              iris_bsdf *b) {
   float t[4], c[4];
@@ -165,8 +166,9 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
     sp->si.ns = back ? iris_neg(n) : n;
   }
   sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
-  if (m->type == IRIS_MATERIAL_GLTF &&
-      (m->transmission_texture >= 0 || m->specular_texture >= 0 || m->specular_color_texture >= 0))
+  /* any of the three >= 0 (-1 = none): their AND is negative only when all are */
+  if ((m->transmission_texture & m->specular_texture & m->specular_color_texture) >= 0 &&
+      m->type == IRIS_MATERIAL_GLTF)
     shade_spec_trans(it, m, si, &sp->bsdf);
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);
