@@ -539,6 +539,23 @@ iris_status iris_export_pov(const iris_scene *scene, const char *pov_path,
       iris_warnf("light '%s': range ignored by the POV-Ray export",
                  scene->lights[i].name ? scene->lights[i].name : "(unnamed)");
   if (!params->coverage) {
+    /* POV-Ray's filter and reflection are one value per finish: the glTF
+     * transmission and specular textures cannot drive them (docs/export.md). */
+    size_t trans_tex = 0, spec_tex = 0;
+    for (size_t i = 0; i < scene->material_count; i++) {
+      const iris_material *m = &scene->materials[i];
+      if (m->type != IRIS_MATERIAL_GLTF) continue;
+      trans_tex += m->transmission_texture >= 0 && m->transmission > 0.0f;
+      spec_tex += m->specular_texture >= 0 || m->specular_color_texture >= 0;
+    }
+    if (trans_tex)
+      iris_warnf("%s: %zu material(s) with a transmission texture: the POV-Ray export uses the transmission "
+                 "factor alone",
+                 pov_path, trans_tex);
+    if (spec_tex)
+      iris_warnf("%s: %zu material(s) with a specular or specular colour texture: the POV-Ray export uses "
+                 "the specular factors alone",
+                 pov_path, spec_tex);
     st = iris_export_write_textures(scene, pov_path, err);
     if (st != IRIS_OK) return st;
   }

@@ -132,10 +132,6 @@ bool get_number(const tinygltf::Value &obj, const char *key, double *out, bool *
   return true;
 }
 
-bool has_texture(const tinygltf::Value &obj, const char *key) {
-  return obj.IsObject() && obj.Has(key);
-}
-
 // Everything the plain document points into.
 struct DocStorage {
   std::vector<iris_gltf_buffer> buffers;
@@ -335,6 +331,8 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   o->specular = 1.0;
   o->specular_color[0] = o->specular_color[1] = o->specular_color[2] = 1.0;
   o->ior = 1.5;
+  o->specular_texture = o->specular_color_texture = o->transmission_texture =
+      texture_ref(tinygltf::TextureInfo(), 1.0);
 
   auto ext = [&](const char *name) -> const tinygltf::Value * {
     auto it = m.extensions.find(name);
@@ -360,14 +358,16 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
         }
       }
     }
-    o->has_specular_textures =
-        has_texture(*v, "specularTexture") || has_texture(*v, "specularColorTexture");
+    if (!texture_ref_value(*v, "specularTexture", &o->specular_texture) ||
+        !texture_ref_value(*v, "specularColorTexture", &o->specular_color_texture))
+      o->bad_extension = "KHR_materials_specular";
   }
   if (const tinygltf::Value *v = ext("KHR_materials_transmission")) {
     o->has_transmission = true;
     if (!get_number(*v, "transmissionFactor", &o->transmission, nullptr))
       o->bad_extension = "KHR_materials_transmission";
-    o->has_transmission_texture = has_texture(*v, "transmissionTexture");
+    if (!texture_ref_value(*v, "transmissionTexture", &o->transmission_texture))
+      o->bad_extension = "KHR_materials_transmission";
   }
   if (ext("KHR_materials_unlit")) o->unlit = true;
   if (const tinygltf::Value *v = ext("KHR_materials_ior")) {

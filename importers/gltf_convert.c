@@ -1314,8 +1314,6 @@ static void report_ignored(gltf_ctx *c) {
   if (c->normal_map_no_uv)
     iris_warnf("%s: %zu primitive(s) lack the uv set of their normal map, which is not applied", f,
                c->normal_map_no_uv);
-  if (c->warned_spec_tex) iris_warnf("%s: KHR_materials_specular textures are ignored", f);
-  if (c->warned_trans_tex) iris_warnf("%s: KHR_materials_transmission texture is ignored", f);
   if (c->warned_morph) iris_warnf("%s: morph targets ignored (base shape used)", f);
   if (c->warned_skin) iris_warnf("%s: skins ignored (bind pose used)", f);
   if (c->warned_ortho) iris_warnf("%s: orthographic cameras skipped", f);

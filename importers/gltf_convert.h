@@ -123,10 +123,10 @@ typedef struct iris_gltf_material {
   double emissive_strength;
   bool has_specular;
   double specular, specular_color[3];
-  bool has_specular_textures;
+  iris_gltf_texture_ref specular_texture, specular_color_texture;
   bool has_transmission;
   double transmission;
-  bool has_transmission_texture;
+  iris_gltf_texture_ref transmission_texture;
   bool has_ior;
   double ior;
   bool has_clearcoat;

@@ -391,6 +391,14 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
     if ((st = texture_ref(c, el, "normalTexture", g->normal_texture, &slots[GLTF_SLOT_NORMAL],
                           &m->normal_texture)))
       return st;
+    /* KHR_materials_transmission: factor x R; KHR_materials_specular: factor x A, colour x RGB */
+    if ((st = texture_ref(c, el, "transmissionTexture", g->transmission_texture, &slots[GLTF_SLOT_TRANSMISSION],
+                          &m->transmission_texture)) ||
+        (st = texture_ref(c, el, "specularTexture", g->specular_texture, &slots[GLTF_SLOT_SPECULAR],
+                          &m->specular_texture)) ||
+        (st = texture_ref(c, el, "specularColorTexture", g->specular_color_texture,
+                          &slots[GLTF_SLOT_SPECULAR_COLOR], &m->specular_color_texture)))
+      return st;
     if (g->has_clearcoat) { /* KHR_materials_clearcoat */
       if ((st = gltf_check_range(c, el, "KHR_materials_clearcoat clearcoatFactor", g->clearcoat, 0, 1)) ||
           (st = gltf_check_range(c, el, "KHR_materials_clearcoat clearcoatRoughnessFactor",
@@ -471,8 +479,6 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
       continue;
     }
     if (g->has_occlusion_texture) c->warned_occlusion = true;
-    if (g->has_specular_textures) c->warned_spec_tex = true;
-    if (g->has_transmission_texture) c->warned_trans_tex = true;
   }
   return IRIS_OK;
 }
@@ -507,7 +513,8 @@ iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out) {
                                       &m.emission_texture, &m.normal_texture,
                                       &m.clearcoat_texture, &m.clearcoat_roughness_texture,
                                       &m.clearcoat_normal_texture, &m.sheen_color_texture,
-                                      &m.sheen_roughness_texture};
+                                      &m.sheen_roughness_texture, &m.transmission_texture,
+                                      &m.specular_texture, &m.specular_color_texture};
   for (int k = 0; k < GLTF_SLOT_COUNT; k++) {
     if (!fields[k] || c->slots[gi][k].texture < 0) continue;
     int32_t id;

@@ -29,7 +29,8 @@ typedef struct dmat4 {
 enum {
   GLTF_SLOT_COLOR, GLTF_SLOT_METALLIC_ROUGHNESS, GLTF_SLOT_EMISSION, GLTF_SLOT_NORMAL,
   GLTF_SLOT_CLEARCOAT, GLTF_SLOT_CLEARCOAT_ROUGHNESS, GLTF_SLOT_CLEARCOAT_NORMAL, GLTF_SLOT_SHEEN_COLOR,
-  GLTF_SLOT_SHEEN_ROUGHNESS, GLTF_SLOT_COUNT
+  GLTF_SLOT_SHEEN_ROUGHNESS, GLTF_SLOT_TRANSMISSION, GLTF_SLOT_SPECULAR, GLTF_SLOT_SPECULAR_COLOR,
+  GLTF_SLOT_COUNT
 };
 
 /* How a material slot places a texture: the glTF texture, the uv set and
@@ -77,7 +78,7 @@ typedef struct gltf_ctx {
   /* Present-but-ignored features, reported once each at the end. */
   char ignored_attributes[256];
   size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
-  bool warned_texcoord, warned_alpha_emission, warned_occlusion, warned_spec_tex, warned_trans_tex;
+  bool warned_texcoord, warned_alpha_emission, warned_occlusion;
   size_t normal_map_no_normal, normal_map_no_uv; /* primitives whose normal map is not applied */
   size_t tangents_generated, tangents_split;
   bool noticed_basisu;

@@ -112,6 +112,37 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);
 }
 
+/* KHR_materials_transmission / _specular textures at the point, into the BSDF
+ * before its lobes are decided: transmission x R, specular x A (linear),
+ * specular colour x RGB (sRGB). A factor of 0 needs no lookup; the specular
+ * pair packed in one image with one placement (the extension's intended
+ * layout: one scene texture) is one lookup, as sRGB decoding leaves alpha
+ * linear. Only for materials that have one of these textures. */
+__attribute__((noinline)) /* kept out of iris_integrator_shade: materials without them pay one branch */
+static void shade_spec_trans(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
+                             iris_bsdf *b) {
+  float t[4], c[4];
+  bool have_c = false;
+  if (m->transmission_texture >= 0 && b->transmission > 0.0f) {
+    iris_texture_sample(it->textures, m->transmission_texture, si->uv, si->uv1, false, t);
+    b->transmission *= iris_clampf(t[0], 0.0f, 1.0f);
+  }
+  if (m->specular_texture >= 0 && b->specular > 0.0f) {
+    if (m->specular_texture == m->specular_color_texture) {
+      iris_texture_sample(it->textures, m->specular_color_texture, si->uv, si->uv1, true, c);
+      have_c = true;
+      b->specular *= fmaxf(c[3], 0.0f);
+    } else {
+      iris_texture_sample(it->textures, m->specular_texture, si->uv, si->uv1, false, t);
+      b->specular *= fmaxf(t[3], 0.0f);
+    }
+  }
+  if (m->specular_color_texture >= 0 && iris_max3(b->specular_color) > 0.0f) {
+    if (!have_c) iris_texture_sample(it->textures, m->specular_color_texture, si->uv, si->uv1, true, c);
+    b->specular_color = iris_mul(b->specular_color, iris_v3(fmaxf(c[0], 0.0f), fmaxf(c[1], 0.0f), fmaxf(c[2], 0.0f)));
+  }
+}
+
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp) {
   const iris_material *m = si->material >= 0 && (size_t)si->material < it->scene->material_count
@@ -144,6 +175,10 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
     mapped = true;
   }
   sp->bsdf = iris_bsdf_from_material(m, color, roughness, metallic);
+  /* any of the three >= 0 (-1 = none): their AND is negative only when all are */
+  if ((m->transmission_texture & m->specular_texture & m->specular_color_texture) >= 0 &&
+      m->type == IRIS_MATERIAL_GLTF)
+    shade_spec_trans(it, m, si, &sp->bsdf);
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);
   sp->depth = depth;

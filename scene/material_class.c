@@ -18,9 +18,11 @@ iris_gltf_class iris_material_gltf_class(const iris_material *m) {
   bool metal1 = m->metallic == 1.0f && m->metallic_roughness_texture < 0;
   if (metal1) return IRIS_GLTF_CONDUCTOR;
   /* Schlick's Fr(c) -> 1 at grazing even for f0 = 0, so only specularFactor 0
-   * removes the specular lobe and leaves the base weight at exactly 1. */
+   * removes the specular lobe and leaves the base weight at exactly 1. The
+   * transmission and specular textures multiply their factors, so a factor of
+   * 0 is 0 whatever they hold; a transmission factor of 1 is 1 only without one. */
   if (metal0 && m->transmission == 0.0f && m->specular == 0.0f) return IRIS_GLTF_LAMBERT;
-  if (metal0 && m->transmission == 1.0f) return IRIS_GLTF_DIELECTRIC;
+  if (metal0 && m->transmission == 1.0f && m->transmission_texture < 0) return IRIS_GLTF_DIELECTRIC;
   return IRIS_GLTF_GENERAL;
 }
 

@@ -22,7 +22,8 @@ typedef enum iris_gltf_class {
   IRIS_GLTF_NOT_GLTF = 0, /* diffuse, glossy or glass: already the simplest form */
   IRIS_GLTF_LAMBERT,      /* metallic 0, transmission 0, specularFactor 0: f = baseColor / pi */
   IRIS_GLTF_CONDUCTOR,    /* metallic 1 (factor 1, no metallic texture): GGX x Schlick(baseColor) */
-  IRIS_GLTF_DIELECTRIC,   /* metallic 0, transmission 1: Schlick-split reflection + refraction */
+  IRIS_GLTF_DIELECTRIC,   /* metallic 0, transmission 1 (no transmission texture): Schlick-split
+                             reflection + refraction */
   IRIS_GLTF_GENERAL       /* anything else: the full Appendix B mixture */
 } iris_gltf_class;
 

@@ -172,6 +172,7 @@ iris_material iris_material_default(iris_material_type type) {
   m.specular = 1.0f;
   m.specular_color[0] = m.specular_color[1] = m.specular_color[2] = 1.0f;
   m.transmission = 0.0f;
+  m.transmission_texture = m.specular_texture = m.specular_color_texture = -1;
   m.emission_texture = -1;
   m.emission_two_sided = true;
   m.double_sided = false;
@@ -227,6 +228,9 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     m->clearcoat_normal_texture = shift_ref(m->clearcoat_normal_texture, tex0);
     m->sheen_color_texture = shift_ref(m->sheen_color_texture, tex0);
     m->sheen_roughness_texture = shift_ref(m->sheen_roughness_texture, tex0);
+    m->transmission_texture = shift_ref(m->transmission_texture, tex0);
+    m->specular_texture = shift_ref(m->specular_texture, tex0);
+    m->specular_color_texture = shift_ref(m->specular_color_texture, tex0);
   }
   for (size_t i = 0; i < src->mesh_count; i++)
     src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
@@ -369,11 +373,13 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
   if (!isfinite(m->sheen_roughness) || m->sheen_roughness < 0.0f || m->sheen_roughness > 1.0f)
     FAIL("sheen_roughness %g outside [0, 1]", (double)m->sheen_roughness);
   {
-    const int32_t refs[5] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
-                             m->sheen_color_texture, m->sheen_roughness_texture};
-    const char *names[5] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
-                            "sheen_color_texture", "sheen_roughness_texture"};
-    for (int k = 0; k < 5; k++)
+    const int32_t refs[8] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+                             m->sheen_color_texture, m->sheen_roughness_texture, m->transmission_texture,
+                             m->specular_texture, m->specular_color_texture};
+    const char *names[8] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                            "sheen_color_texture", "sheen_roughness_texture", "transmission_texture",
+                            "specular_texture", "specular_color_texture"};
+    for (int k = 0; k < 8; k++)
       if ((st = check_texture_ref(refs[k], s->texture_count, names[k], file, element, err))) return st;
   }
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,

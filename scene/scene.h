@@ -73,6 +73,9 @@ typedef struct iris_material {
   float specular;          /* gltf KHR_materials_specular specularFactor (1 default) */
   float specular_color[3]; /* gltf specularColorFactor (1,1,1 default) */
   float transmission;      /* gltf KHR_materials_transmission factor */
+  /* gltf: transmission x texture R (linear), specular x texture A (linear),
+   * specular_color x texture RGB (sRGB-decoded); -1 none */
+  int32_t transmission_texture, specular_texture, specular_color_texture;
   float emission[3];       /* emitted radiance = colour x strength; all 0: not emissive */
   int32_t emission_texture;/* multiplies emission (sRGB-decoded); -1 none */
   bool emission_two_sided; /* true: emits from both faces (Cycles' behaviour) */

@@ -188,6 +188,10 @@ static cJSON *write_material(const iris_material *m) {
     if (!floats_equal(m->specular_color, d.specular_color, 3))
       add_floats(o, "specular_color", m->specular_color, 3);
     if (m->transmission != d.transmission) add_float(o, "transmission", m->transmission);
+    if (m->transmission_texture >= 0) cJSON_AddNumberToObject(o, "transmission_texture", m->transmission_texture);
+    if (m->specular_texture >= 0) cJSON_AddNumberToObject(o, "specular_texture", m->specular_texture);
+    if (m->specular_color_texture >= 0)
+      cJSON_AddNumberToObject(o, "specular_color_texture", m->specular_color_texture);
     if (m->clearcoat != d.clearcoat) add_float(o, "clearcoat", m->clearcoat);
     if (m->clearcoat_roughness != d.clearcoat_roughness) add_float(o, "clearcoat_roughness", m->clearcoat_roughness);
     if (m->clearcoat_texture >= 0) cJSON_AddNumberToObject(o, "clearcoat_texture", m->clearcoat_texture);
@@ -672,7 +676,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                                      "clearcoat_roughness_texture", "clearcoat_normal_texture",
                                      "clearcoat_normal_scale", "sheen_color", "sheen_roughness",
                                      "sheen_color_texture", "sheen_roughness_texture",
-                                     "attenuation_color", "attenuation_distance"};
+                                     "attenuation_color", "attenuation_distance", "transmission_texture",
+                                     "specular_texture", "specular_color_texture"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -690,7 +695,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                  {"clearcoat_roughness_texture", 0x8}, {"clearcoat_normal_texture", 0x8},
                  {"clearcoat_normal_scale", 0x8}, {"sheen_color", 0x8}, {"sheen_roughness", 0x8},
                  {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8},
-                 {"attenuation_color", 0x8}, {"attenuation_distance", 0x8}};
+                 {"attenuation_color", 0x8}, {"attenuation_distance", 0x8}, {"transmission_texture", 0x8},
+                 {"specular_texture", 0x8}, {"specular_color_texture", 0x8}};
   for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
     if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
       iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
@@ -741,6 +747,9 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     TRY(get_i32(c, o, "sheen_roughness_texture", -1, INT32_MAX, &m->sheen_roughness_texture));
     TRY(get_floats(c, o, "attenuation_color", m->attenuation_color, 3));
     TRY(get_float(c, o, "attenuation_distance", &m->attenuation_distance));
+    TRY(get_i32(c, o, "transmission_texture", -1, INT32_MAX, &m->transmission_texture));
+    TRY(get_i32(c, o, "specular_texture", -1, INT32_MAX, &m->specular_texture));
+    TRY(get_i32(c, o, "specular_color_texture", -1, INT32_MAX, &m->specular_color_texture));
   }
   memcpy(m->emission, full.emission, sizeof m->emission);
   m->emission_texture = full.emission_texture;

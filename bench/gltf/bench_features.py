@@ -18,6 +18,12 @@ replaced per variant:
   blend      + alphaMode BLEND, alpha 0.999 (almost opaque: the filter runs on every hit)
   clearcoat  + clearcoat 1, roughness 0.1
   sheen      + sheen colour 1, roughness 0.5 (the file's sheen without its textures)
+  spectrans  + transmission 0.5, specular 0.8, specular colour (1, 0.9, 0.8) (factors only)
+  spectrans-tex  spectrans + transmission, specular and specular colour textures, three
+             textures of a white 64x64 PNG (so the paths are those of spectrans: the
+             difference is the three lookups)
+  spectrans-packed  the same with specular and specular colour as one texture (the
+             extension's packed layout: two lookups)
 """
 import argparse
 import json
@@ -43,7 +49,24 @@ def variants(base):
     out["blend"] = dict(plain, alpha_mode="blend", alpha=0.999)
     out["clearcoat"] = dict(plain, clearcoat=1.0, clearcoat_roughness=0.1)
     out["sheen"] = dict(plain, sheen_color=[1, 1, 1], sheen_roughness=0.5)
+    out["spectrans"] = dict(plain, transmission=0.5, specular=0.8, specular_color=[1, 0.9, 0.8])
+    white = len(base["textures"])  # three white textures appended by main()
+    out["spectrans-tex"] = dict(out["spectrans"], transmission_texture=white, specular_texture=white + 1,
+                                specular_color_texture=white + 2)
+    out["spectrans-packed"] = dict(out["spectrans"], transmission_texture=white, specular_texture=white + 1,
+                                   specular_color_texture=white + 1)
     return out
+
+
+def write_white_png(path, size=64):
+    raw = b"".join(b"\x00" + b"\xff" * 4 * size for _ in range(size))
+
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data))
+
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", size, size, 8, 6, 0, 0, 0)) +
+                chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
 
 
 def strip_tangents(src, dst):
@@ -96,6 +119,11 @@ def main():
     for name, mat in variants(base).items():
         s = json.loads(json.dumps(base))
         s["materials"] = [mat]
+        if name.startswith("spectrans-"):
+            for k in range(3):  # three files, so that no two placements are one texture by accident
+                white = os.path.join(os.path.abspath(a.out), "white%d.png" % k)
+                write_white_png(white)
+                s["textures"].append({"file": white})
         if name != "normal":
             s["meshes"][0]["file"] = "plain.meshes/0.irmesh"
             s["meshes"][0]["attributes"] = [x for x in s["meshes"][0]["attributes"] if x != "tangents"]

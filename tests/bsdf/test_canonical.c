@@ -102,8 +102,23 @@ int main(void) {
   iris_material textured0 = gltf(0.9f, 0.6f, 0.3f, 0.0f, 0.3f, 0.0f, 0.0f);
   textured0.metallic_roughness_texture = 0; /* metallic = 0 x texture = 0 */
   CHECK_EQ_INT(iris_material_gltf_class(&textured0), IRIS_GLTF_LAMBERT);
+  /* KHR_materials_transmission / _specular textures multiply their factors:
+   * with factors 0 they change nothing (still a Lambert, rewritten, textures
+   * dropped); with a factor above 0 they do not make a Lambert. */
+  iris_material tex0 = gltf(0.9f, 0.6f, 0.3f, 0.0f, 0.3f, 0.0f, 0.0f);
+  tex0.transmission_texture = tex0.specular_texture = tex0.specular_color_texture = 0;
+  CHECK_EQ_INT(iris_material_gltf_class(&tex0), IRIS_GLTF_LAMBERT);
+  CHECK(iris_material_canonicalize(&tex0));
+  CHECK(tex0.transmission_texture < 0 && tex0.specular_texture < 0 && tex0.specular_color_texture < 0);
+  iris_material spec_tex = gltf(0.9f, 0.6f, 0.3f, 0.0f, 0.3f, 0.5f, 0.0f);
+  spec_tex.specular_texture = 0;
+  CHECK(iris_material_gltf_class(&spec_tex) != IRIS_GLTF_LAMBERT);
+  CHECK(!iris_material_canonicalize(&spec_tex));
   iris_material glass = gltf(1, 1, 1, 0.0f, 0.0f, 1.0f, 1.0f);
   CHECK_EQ_INT(iris_material_gltf_class(&glass), IRIS_GLTF_DIELECTRIC);
+  glass.transmission_texture = 0; /* transmission = 1 x texture R: not known to be 1 */
+  CHECK_EQ_INT(iris_material_gltf_class(&glass), IRIS_GLTF_GENERAL);
+  glass.transmission_texture = -1;
   CHECK(iris_material_gltf_smooth(&glass));
   glass.roughness = 0.02f;
   CHECK(!iris_material_gltf_smooth(&glass));
