@@ -9,7 +9,7 @@ For each file: `iris render FILE --camera view --method M` and Blender's importe
 (numpy.bool restored) with the file's own glTF camera "view", no world (black), Cycles CPU,
 64 bounces, no clamping, caustics on, box filter, no denoising. Pixels are classified by a
 ray cast through each pixel centre in Blender's scene (first surface, whatever its alpha):
-"lamp" (any lamp object), "walls" (the room), "table". Prints per-channel means over the
+"lamp" (any lamp object), "shade" (stainedglass, grill, bulbs), "walls" (the room), "table". Prints per-channel means over the
 whole image and each class and the ratios iris / Blender; writes OUT/NAME-compare.json.
 An existing OUT/NAME-iris.exr or OUT/NAME-blender.exr is reused with --reuse.
 """
@@ -146,8 +146,13 @@ def render_blender(a, sc, exr):
     bpy.ops.render.render(write_still=True)
 
 
+SHADE = ("stainedglass", "grill", "bulbs")  # the lamp's emissive glass and what shines through it
+
+
 def classes(a, sc, cam):
-    """0 = nothing, 1 = lamp, 2 = walls, 3 = table: the first surface through each pixel centre."""
+    """0 = nothing, 1 = the rest of the lamp, 2 = walls, 3 = table, 4 = shade (SHADE): the
+    first surface through each pixel centre, whatever its alpha (geometry only, so the
+    classes do not depend on either image's noise)."""
     from mathutils import Vector
     dg = bpy.context.evaluated_depsgraph_get()
     sc.render.resolution_x, sc.render.resolution_y = a.width, a.height
@@ -165,7 +170,8 @@ def classes(a, sc, cam):
             hit, _, _, _, ob, _ = sc.ray_cast(dg, o, d)
             if hit:
                 n = ob.name.lower()
-                out[y, x] = 2 if n.startswith("room") else 3 if n.startswith("table") else 1
+                out[y, x] = (2 if n.startswith("room") else 3 if n.startswith("table") else
+                             4 if n.split(".")[0] in SHADE else 1)
     return out
 
 
@@ -202,24 +208,29 @@ def main():
         if ba is None:  # one renderer only: its means, ratio 1
             ba = ia
         res = {"file": path, "iris_spp": a.iris_spp, "cycles_spp": a.cycles_spp, "method": a.method}
-        lum = ba.mean(2)
-        bright_lamp = (cls == 1) & (lum > np.quantile(lum[cls == 1], 0.75)) if (cls == 1).any() else cls == 1
-        for label, m in (("image", np.ones_like(cls, bool)), ("lamp", cls == 1),
-                         ("lamp_bright", bright_lamp), ("walls", cls == 2), ("table", cls == 3)):
+        for label, m in (("image", np.ones_like(cls, bool)), ("lamp", (cls == 1) | (cls == 4)),
+                         ("shade", cls == 4), ("walls", cls == 2), ("table", cls == 3)):
             if not m.any():
                 continue
             mi, mb = ia[m].mean(0), ba[m].mean(0)
+            # relative standard error of each mean, from the spread of its pixels (an upper
+            # bound: it counts the region's real variation as noise too)
+            se = lambda img, mu: (img[m].std(0) / np.sqrt(m.sum()) / np.maximum(mu, 1e-12)).tolist()
             res[label] = {"share": float(m.mean()), "iris": mi.tolist(), "blender": mb.tolist(),
-                          "ratio": (mi / np.maximum(mb, 1e-12)).tolist()}
+                          "ratio": (mi / np.maximum(mb, 1e-12)).tolist(), "iris_rel_se": se(ia, mi),
+                          "blender_rel_se": se(ba, mb)}
         with open(os.path.join(a.out, name + "-compare.json"), "w") as f:
             json.dump(res, f, indent=1)
         line = "| %s |" % name + "".join(
             " %s / %s = %s |" % (f3(res[k]["iris"]), f3(res[k]["blender"]), f3(res[k]["ratio"]))
-            for k in ("image", "lamp", "lamp_bright", "walls", "table") if k in res)
+            for k in ("image", "lamp", "shade", "walls", "table") if k in res)
+        line += " rel. s.e. walls iris %s, Blender %s |" % (
+            " ".join("%.3f" % x for x in res["walls"]["iris_rel_se"]),
+            " ".join("%.3f" % x for x in res["walls"]["blender_rel_se"])) if "walls" in res else ""
         rows.append(line)
         print(line)
         sys.stdout.flush()
-    print("| file | image: iris / Blender = ratio R G B | lamp | lamp, brightest quarter | walls | table |")
+    print("| file | image: iris / Blender = ratio R G B | lamp | shade (glass, grill, bulbs) | walls | table |")
     print("|---|---|---|---|---|---|")
     print("\n".join(rows))
 
