@@ -1304,9 +1304,6 @@ static void report_ignored(gltf_ctx *c) {
   if (c->zero_normals)
     iris_warnf("%s: %zu primitive(s) had zero-length normals; their normals were dropped (shaded flat)", f, c->zero_normals);
   if (c->warned_texcoord) iris_warnf("%s: textures using TEXCOORD_2 or higher are ignored", f);
-  if (c->warned_alpha_emission)
-    iris_warnf("%s: emissive MASK/BLEND materials: light sampling does not see their alpha (emission "
-               "from cut-out parts is still sampled)", f);
   if (c->warned_occlusion) iris_warnf("%s: occlusion textures are ignored (a path tracer has its own)", f);
   if (c->normal_map_no_normal)
     iris_warnf("%s: %zu primitive(s) without NORMAL are shaded flat, without their normal map", f,

@@ -455,7 +455,6 @@ iris_status gltf_validate_materials(gltf_ctx *c) {
         if ((st = gltf_check_range(c, el, "alphaCutoff", g->alpha_cutoff, 0, HUGE_VAL))) return st;
         m->alpha_cutoff = (float)g->alpha_cutoff;
       }
-      if (g->emissive[0] > 0 || g->emissive[1] > 0 || g->emissive[2] > 0) c->warned_alpha_emission = true;
     }
     if (g->unlit) {
       /* KHR_materials_unlit: the surface shows base colour x texture x vertex colour

@@ -78,7 +78,7 @@ typedef struct gltf_ctx {
   /* Present-but-ignored features, reported once each at the end. */
   char ignored_attributes[256];
   size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
-  bool warned_texcoord, warned_alpha_emission, warned_occlusion;
+  bool warned_texcoord, warned_occlusion;
   size_t normal_map_no_normal, normal_map_no_uv; /* primitives whose normal map is not applied */
   size_t tangents_generated, tangents_split;
   bool noticed_basisu;

@@ -322,7 +322,10 @@ static void add_emissive_placement(iris_lights *out, size_t instance, size_t *n,
     e->e1 = iris_sub(v[1], v[0]);
     e->e2 = iris_sub(v[2], v[0]);
     e->ng = iris_normalize(iris_cross(e->e1, e->e2));
-    e->textured = m->emission_texture >= 0 || m->unlit; /* evaluated per point (vertex colours) */
+    /* evaluated per point: a texture, vertex colours, or alpha coverage (a MASK emitter's
+     * cut-out parts do not exist, so they do not emit; a BLEND one is seen with
+     * probability alpha: surface_coverage) */
+    e->textured = m->emission_texture >= 0 || m->unlit || m->alpha_mode != IRIS_ALPHA_OPAQUE;
     *light = (uint32_t)*n;
     (*n)++;
   }
@@ -523,6 +526,18 @@ static iris_vec3 surface_emission(const iris_lights *lights, const iris_material
   }
   if (m->unlit) le = iris_mul(le, si->color); /* KHR_materials_unlit: base colour x vertex colour */
   return le;
+}
+
+/* What of a MASK/BLEND emitter exists at (b1, b2) of prim, as a ray that reaches the point
+ * sees it (renderer/accel.c's alpha filter): MASK 1 where alpha >= cutoff, else 0 (glTF:
+ * "fully opaque or fully transparent"); BLEND alpha, the probability that a ray stops there.
+ * A light sample's shadow ray ends just before the emitter, so without this next-event
+ * estimation would count emission from cut-out parts that BSDF-sampled rays pass through. */
+static float surface_coverage(const iris_lights *lights, const iris_material *m, uint32_t prim, float b1,
+                              float b2) {
+  float alpha = iris_accel_alpha(lights->accel, prim, b1, b2);
+  if (m->alpha_mode == IRIS_ALPHA_MASK) return alpha >= m->alpha_cutoff ? 1.0f : 0.0f;
+  return iris_clampf(alpha, 0.0f, 1.0f);
 }
 
 iris_vec3 iris_lights_emitted(const iris_lights *lights, const iris_interaction *si, iris_vec3 d) {
@@ -726,6 +741,11 @@ static bool sample_choice(const iris_lights *lights, iris_vec3 ref, const iris_l
     const iris_material *m = material_of(lights->scene, t->material);
     s->L = (t->flags & IRIS_LIGHT_TRI_TEXTURED) ? surface_emission(lights, m, &si)
                                                 : iris_v3_load(m->emission);
+    if (m->alpha_mode != IRIS_ALPHA_OPAQUE) { /* the shadow ray stops short of the emitter */
+      float c = surface_coverage(lights, m, lights->entries[i].prim, b1, b2);
+      if (!(c > 0.0f)) return false;
+      s->L = iris_scale(s->L, c);
+    }
     s->pdf = omega > 0.0f ? pmf / omega : pmf * d2 / (cos_l * t->area);
     return isfinite(s->pdf) && s->pdf > 0.0f;
   }

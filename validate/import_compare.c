@@ -54,6 +54,38 @@ static int input(const cJSON *o, const char *key, double v[3]) {
   return 0;
 }
 
+/* A Principled input driven by a node ("linked:<bl_idname>"), e.g. a texture. */
+static bool linked(const cJSON *o, const char *key) {
+  return strncmp(str(o, key), "linked:", 7) == 0;
+}
+
+/* Features whose handling differs between iris and Blender 3.4's importer + Cycles, named
+ * for the materials that have them (measured on StainedGlassLamp in a room:
+ * docs/import-gltf.md, "A glass lamp lighting a room"). */
+static void compare_features(const iris_material *m, const char *name, const cJSON *b, iris_import_diff *d) {
+  double v[3];
+  bool emissive = m->emission[0] > 0.0f || m->emission[1] > 0.0f || m->emission[2] > 0.0f;
+  if (emissive && !m->emission_two_sided)
+    note(d, "material", false,
+         "material '%s': emissive and not doubleSided: iris emits from the front face only (glTF), "
+         "Cycles from both faces (light from back faces, e.g. inside open bulbs, is Blender's only)", name);
+  if (m->alpha_mode == IRIS_ALPHA_MASK && (linked(b, "Alpha") || (input(b, "Alpha", v) == 1 && v[0] < 1.0)))
+    note(d, "material", false,
+         "material '%s': alphaMode MASK: iris keeps the surface where alpha >= %g (glTF); Blender's importer "
+         "feeds the alpha to Principled Alpha, which Cycles renders as stochastic transparency (no cutoff)",
+         name, m->alpha_cutoff);
+  /* iris does not read transmissionTexture yet (being added); drop this note when it does */
+  if (m->type == IRIS_MATERIAL_GLTF && m->transmission > 0.0f && linked(b, "Transmission"))
+    note(d, "material", false,
+         "material '%s': Blender's importer textures Transmission (transmissionTexture); iris uses the "
+         "factor %g alone", name, m->transmission);
+  if (m->type == IRIS_MATERIAL_GLTF && m->clearcoat > 0.0f)
+    note(d, "material", false,
+         "material '%s': clearcoat: iris layers the coat over the base (KHR_materials_clearcoat: base x "
+         "(1 - coat x Fresnel)); Blender 3.4's Principled v1 adds its Clearcoat lobe without darkening the base",
+         name);
+}
+
 static void compare_geometry(const iris_scene *s, const cJSON *inv, iris_import_diff *d) {
   d->iris_triangles = iris_scene_triangle_count(s);
   d->blender_triangles = (uint64_t)num(inv, "triangles", 0);
@@ -193,6 +225,7 @@ static void compare_materials(const iris_scene *s, const cJSON *inv, iris_import
     }
 #undef DIFF
     if (diffs[0]) note(d, "material", false, "material '%s': parameters differ:%s", name, diffs);
+    compare_features(m, name, b, d);
     /* Which BSDF each side renders: Blender's importer always builds a
      * Principled BSDF v1 (Disney diffuse, Specular = 0.5 by default). */
     double spec = input(b, "Specular", v) == 1 ? v[0] : -1;

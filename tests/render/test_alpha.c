@@ -7,7 +7,12 @@
  *  - light: that MASK quad in front of an emitter of radiance 1 filling the
  *    view passes exactly the cut-out fraction of its light, with bsdf, nee and
  *    mis (and the BLEND one 0.7), the images being equal for 1 and 2 threads;
- *  - opaque: the same quad with an opaque material blocks everything. */
+ *  - opaque: the same quad with an opaque material blocks everything;
+ *  - emitters: a white floor lit only by a two-sided emitting quad above it that is
+ *    MASK with alpha 0 (all cut out) stays black with every method, and a BLEND one of
+ *    alpha 0.3 lights it alike with bsdf (which sees the alpha through its rays) and
+ *    with nee and mis (light sampling, whose shadow rays end before the emitter and
+ *    must weigh its emission by the coverage itself). */
 #include <stdlib.h>
 
 #include "check.h"
@@ -188,8 +193,63 @@ static void test_light(void) {
   iris_scene_destroy(opaque);
 }
 
+/* white floor at z = 0, a two-sided emitter of radiance 1 at z = 1 (mode, alpha), the
+ * camera of alpha_scene seeing the floor through it */
+static iris_scene *emitter_scene(iris_alpha_mode mode, float alpha) {
+  iris_scene *s = iris_scene_create();
+  iris_material floor = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  floor.color[0] = floor.color[1] = floor.color[2] = 0.8f;
+  iris_scene_add_material(s, &floor);
+  iris_material light = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  light.color[0] = light.color[1] = light.color[2] = 0.0f;
+  light.emission[0] = light.emission[1] = light.emission[2] = 1.0f;
+  light.emission_two_sided = true;
+  light.alpha_mode = mode;
+  light.alpha = alpha;
+  light.alpha_cutoff = 0.5f;
+  iris_scene_add_material(s, &light);
+  add_quad(s, 0.0f, 0, false);
+  add_quad(s, 1.0f, 1, false);
+  iris_camera cam;
+  memset(&cam, 0, sizeof cam);
+  cam.name = iris_strdup("front");
+  cam.to_world = iris_mat4_identity();
+  cam.to_world.m[2][3] = 4.0f;
+  cam.yfov = 2.0f * atanf(1.0f / 4.0f);
+  cam.aspect = 1.0f;
+  iris_scene_add_camera(s, &cam);
+  return s;
+}
+
+static void test_emitters(void) {
+  iris_scene *cut = emitter_scene(IRIS_ALPHA_MASK, 0.0f);
+  iris_scene *blend = emitter_scene(IRIS_ALPHA_BLEND, 0.3f);
+  const iris_method methods[3] = {IRIS_METHOD_BSDF, IRIS_METHOD_NEE, IRIS_METHOD_MIS};
+  double ref = 0, ref_sigma = 0;
+  for (int k = 0; k < 3; k++) {
+    double mean, sigma;
+    if (render_mean(cut, methods[k], 0, &mean, &sigma, NULL)) {
+      printf("  %-4s cut-out MASK emitter: mean %.5f, expected 0\n", iris_method_name(methods[k]), mean);
+      CHECK(mean == 0.0);
+    }
+    if (render_mean(blend, methods[k], 0, &mean, &sigma, NULL)) {
+      if (k == 0) {
+        ref = mean;
+        ref_sigma = sigma;
+      }
+      printf("  %-4s BLEND 0.3 emitter: mean %.5f (sigma %.2g), bsdf %.5f\n", iris_method_name(methods[k]), mean,
+             sigma, ref);
+      CHECK(ref > 0.05);
+      CHECK(fabs(mean - ref) < 5 * sqrt(sigma * sigma + ref_sigma * ref_sigma) + 1e-3);
+    }
+  }
+  iris_scene_destroy(cut);
+  iris_scene_destroy(blend);
+}
+
 int main(void) {
   test_rays();
   test_light();
+  test_emitters();
   return iris_check_summary("render.alpha");
 }
