@@ -74,11 +74,12 @@ static void compare_features(const iris_material *m, const char *name, const cJS
          "material '%s': alphaMode MASK: iris keeps the surface where alpha >= %g (glTF); Blender's importer "
          "feeds the alpha to Principled Alpha, which Cycles renders as stochastic transparency (no cutoff)",
          name, m->alpha_cutoff);
-  /* iris does not read transmissionTexture yet (being added); drop this note when it does */
-  if (m->type == IRIS_MATERIAL_GLTF && m->transmission > 0.0f && linked(b, "Transmission"))
+  /* a transmission texture iris could not keep (e.g. an image it does not decode) */
+  if (m->type == IRIS_MATERIAL_GLTF && m->transmission > 0.0f && m->transmission_texture < 0 &&
+      linked(b, "Transmission"))
     note(d, "material", false,
-         "material '%s': Blender's importer textures Transmission (transmissionTexture); iris uses the "
-         "factor %g alone", name, m->transmission);
+         "material '%s': Blender's importer textures Transmission (transmissionTexture); iris has no "
+         "transmission texture for it and uses the factor %g alone", name, m->transmission);
   if (m->type == IRIS_MATERIAL_GLTF && m->clearcoat > 0.0f)
     note(d, "material", false,
          "material '%s': clearcoat: iris layers the coat over the base (KHR_materials_clearcoat: base x "

@@ -141,6 +141,10 @@ int main(void) {
   CHECK_EQ_INT(count_topic(&d, "material", "textures Transmission"), 1);
   CHECK_EQ_INT(count_topic(&d, "material", "Clearcoat lobe"), 1);
   for (int i = 0; i < d.note_count; i++) printf("  %s: %s\n", d.notes[i].topic, d.notes[i].text);
+  g->transmission_texture = 0; /* iris reads the transmission texture too: nothing to name */
+  CHECK(iris_import_compare(s, path, &d, &err) == IRIS_OK);
+  CHECK_EQ_INT(count_topic(&d, "material", "textures Transmission"), 0);
+  g->transmission_texture = -1;
   g->emission_two_sided = true; /* doubleSided: emits from both faces in both */
   g->alpha_mode = IRIS_ALPHA_OPAQUE;
   g->clearcoat = 0.0f;
