@@ -867,9 +867,10 @@ static iris_status import_capture(const char *json, iris_scene **s, char *msg, s
   return st;
 }
 
-/* A quad (strip of quad_pos) with NORMAL (0, 0, 1) and TEXCOORD_0 = xy. */
+/* A quad (strip of quad_pos) with NORMAL (0, 0, 1), TEXCOORD_0 = xy and, as accessor 4,
+ * TANGENT (cos 30, sin 30, 0, -1): a tilted frame that generation would not give. */
 static char *make_gltf_nuv(const char *rest) {
-  float bin[17 + 15 + 10];
+  float bin[17 + 15 + 10 + 20];
   memcpy(bin, quad_pos, 60);
   uint8_t idx[8] = {0};
   memcpy(idx, strip_idx, 6);
@@ -877,6 +878,7 @@ static char *make_gltf_nuv(const char *rest) {
   for (int v = 0; v < 5; v++) {
     bin[17 + 3 * v] = 0, bin[17 + 3 * v + 1] = 0, bin[17 + 3 * v + 2] = 1;
     bin[32 + 2 * v] = quad_pos[3 * v], bin[32 + 2 * v + 1] = quad_pos[3 * v + 1];
+    bin[42 + 4 * v] = 0.8660254f, bin[42 + 4 * v + 1] = 0.5f, bin[42 + 4 * v + 2] = 0, bin[42 + 4 * v + 3] = -1;
   }
   char b64[512];
   base64((const uint8_t *)bin, sizeof bin, b64);
@@ -886,11 +888,13 @@ static char *make_gltf_nuv(const char *rest) {
            "{\"asset\":{\"version\":\"2.0\"},"
            "\"buffers\":[{\"byteLength\":%zu,\"uri\":\"data:application/octet-stream;base64,%s\"}],"
            "\"bufferViews\":[{\"buffer\":0,\"byteLength\":60},{\"buffer\":0,\"byteOffset\":60,\"byteLength\":6},"
-           "{\"buffer\":0,\"byteOffset\":68,\"byteLength\":60},{\"buffer\":0,\"byteOffset\":128,\"byteLength\":40}],"
+           "{\"buffer\":0,\"byteOffset\":68,\"byteLength\":60},{\"buffer\":0,\"byteOffset\":128,\"byteLength\":40},"
+           "{\"buffer\":0,\"byteOffset\":168,\"byteLength\":80}],"
            "\"accessors\":[{\"bufferView\":0,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"},"
            "{\"bufferView\":1,\"componentType\":5121,\"count\":6,\"type\":\"SCALAR\"},"
            "{\"bufferView\":2,\"componentType\":5126,\"count\":5,\"type\":\"VEC3\"},"
-           "{\"bufferView\":3,\"componentType\":5126,\"count\":5,\"type\":\"VEC2\"}],"
+           "{\"bufferView\":3,\"componentType\":5126,\"count\":5,\"type\":\"VEC2\"},"
+           "{\"bufferView\":4,\"componentType\":5126,\"count\":5,\"type\":\"VEC4\"}],"
            "%s}",
            sizeof bin, b64, rest);
   return s;
@@ -911,14 +915,16 @@ static void check_anisotropy(void) {
       "{\"name\":\"prism\",\"extensions\":{\"KHR_materials_dispersion\":{\"dispersion\":0.5}}}],"
       "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":2,\"TEXCOORD_0\":3},\"indices\":1,"
       "\"mode\":5,\"material\":0},{\"attributes\":{\"POSITION\":0},\"indices\":1,\"mode\":5,\"material\":1},"
-      "{\"attributes\":{\"POSITION\":0,\"NORMAL\":2},\"indices\":1,\"mode\":5,\"material\":2}]}],"
+      "{\"attributes\":{\"POSITION\":0,\"NORMAL\":2},\"indices\":1,\"mode\":5,\"material\":2},"
+      "{\"attributes\":{\"POSITION\":0,\"NORMAL\":2,\"TEXCOORD_0\":3,\"TANGENT\":4},\"indices\":1,\"mode\":5,"
+      "\"material\":1}]}],"
       "\"nodes\":[{\"mesh\":0}],"
       "\"extensionsUsed\":[\"KHR_materials_anisotropy\",\"KHR_materials_dispersion\",\"KHR_texture_transform\"]";
   char *j = make_gltf_nuv(rest);
   iris_status st = import_capture(j, &s, msg, sizeof msg, warn, sizeof warn);
   free(j);
   EXPECT(st == IRIS_OK, "anisotropy: %s", msg);
-  if (st == IRIS_OK && s->mesh_count == 3) {
+  if (st == IRIS_OK && s->mesh_count == 4) {
     const iris_material *m0 = &s->materials[s->meshes[0].material], *m1 = &s->materials[s->meshes[1].material];
     EXPECT(m0->anisotropy == 0.5f && m0->anisotropy_rotation == 0.25f && m0->anisotropy_texture >= 0,
            "anisotropy: strength %g rotation %g texture %d", (double)m0->anisotropy, (double)m0->anisotropy_rotation,
@@ -933,6 +939,14 @@ static void check_anisotropy(void) {
     EXPECT(s->meshes[0].tangents != NULL, "anisotropic primitive with NORMAL and uvs: tangents generated");
     EXPECT(s->meshes[1].tangents == NULL, "anisotropic primitive without NORMAL: no tangents");
     EXPECT(s->meshes[2].tangents == NULL, "isotropic material: no tangents kept");
+    const iris_mesh *k = &s->meshes[3];
+    bool kept = k->tangents != NULL;
+    for (uint32_t v = 0; kept && v < k->vertex_count; v++)
+      kept = fabsf(k->tangents[4 * v] - 0.8660254f) < 1e-6f && fabsf(k->tangents[4 * v + 1] - 0.5f) < 1e-6f &&
+             k->tangents[4 * v + 3] == -1.0f;
+    EXPECT(kept, "anisotropic primitive with TANGENT (no normal map): the file's tangents kept");
+  } else {
+    EXPECT(0, "anisotropy: %zu meshes", s ? s->mesh_count : 0);
   }
   EXPECT(strstr(warn, "1 anisotropic primitive(s) have no tangent frame") != NULL,
          "anisotropy without tangents warned: %s", warn);
