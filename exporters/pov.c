@@ -538,6 +538,18 @@ iris_status iris_export_pov(const iris_scene *scene, const char *pov_path,
     if (scene->lights[i].range > 0.0f)
       iris_warnf("light '%s': range ignored by the POV-Ray export",
                  scene->lights[i].name ? scene->lights[i].name : "(unnamed)");
+  { /* POV-Ray's finish has no anisotropic highlight: one warning for all such materials */
+    size_t n = 0;
+    const char *first = NULL;
+    for (size_t i = 0; i < scene->material_count; i++)
+      if (scene->materials[i].type == IRIS_MATERIAL_GLTF && scene->materials[i].anisotropy > 0.0f) {
+        if (!first) first = scene->materials[i].name ? scene->materials[i].name : "(unnamed)";
+        n++;
+      }
+    if (n)
+      iris_warnf("%zu anisotropic material(s) (first '%s'): KHR_materials_anisotropy is exported isotropic "
+                 "to POV-Ray", n, first);
+  }
   if (!params->coverage) {
     /* POV-Ray's filter and reflection are one value per finish: the glTF
      * transmission and specular textures cannot drive them (docs/export.md). */

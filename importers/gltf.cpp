@@ -377,7 +377,7 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
   {
     tinygltf::TextureInfo none;
     o->clearcoat_texture = o->clearcoat_roughness_texture = o->clearcoat_normal_texture =
-        o->sheen_color_texture = o->sheen_roughness_texture = texture_ref(none, 1.0);
+        o->sheen_color_texture = o->sheen_roughness_texture = o->anisotropy_texture = texture_ref(none, 1.0);
   }
   if (const tinygltf::Value *v = ext("KHR_materials_clearcoat")) {
     o->has_clearcoat = true;
@@ -423,6 +423,14 @@ void fill_material(const tinygltf::Material &m, iris_gltf_material *o) {
         !texture_ref_value(*v, "sheenRoughnessTexture", &o->sheen_roughness_texture))
       o->bad_extension = "KHR_materials_sheen";
   }
+  if (const tinygltf::Value *v = ext("KHR_materials_anisotropy")) {
+    o->has_anisotropy = true;
+    if (!get_number(*v, "anisotropyStrength", &o->anisotropy_strength, nullptr) ||
+        !get_number(*v, "anisotropyRotation", &o->anisotropy_rotation, nullptr) ||
+        !texture_ref_value(*v, "anisotropyTexture", &o->anisotropy_texture))
+      o->bad_extension = "KHR_materials_anisotropy";
+  }
+  if (ext("KHR_materials_dispersion")) o->has_dispersion = true;
 }
 
 void fill_doc(const tinygltf::Model &m, const std::vector<ImageState> &image_states,

@@ -28,9 +28,9 @@
 static const char *const supported_extensions[] = {
     "KHR_materials_emissive_strength", "KHR_materials_specular", "KHR_materials_transmission",
     "KHR_materials_ior", "KHR_lights_punctual", "KHR_mesh_quantization", "KHR_texture_transform",
-    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit", "EXT_mesh_gpu_instancing",
-    "KHR_materials_variants"};
+    "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_volume", "KHR_materials_anisotropy",
+    "KHR_draco_mesh_compression", "EXT_meshopt_compression", "EXT_texture_webp", "KHR_materials_unlit",
+    "EXT_mesh_gpu_instancing", "KHR_materials_variants"};
 
 /* ---- small helpers ------------------------------------------------------ */
 
@@ -578,14 +578,15 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
       (st = attribute_accessor(c, p, "TEXCOORD_1", el, TYPE_VEC2, TYPE_VEC2, nv, &uv1)) ||
       (st = attribute_accessor(c, p, "TANGENT", el, TYPE_VEC4, TYPE_VEC4, nv, &tan)))
     return st;
-  /* Tangent frames only for a normal map, and only with NORMAL: "When normals are
-   * not specified, [...] the provided tangents (if present) MUST be ignored". */
-  int normal_set = gltf_material_normal_uv_set(c, mat);
+  /* Tangent frames only for a normal map or anisotropy, and only with NORMAL: "When
+   * normals are not specified, [...] the provided tangents (if present) MUST be ignored". */
+  int normal_set = gltf_material_tangent_uv_set(c, mat);
+  bool has_normal_map = gltf_material_normal_uv_set(c, mat) >= 0;
   if (normal_set >= 0 && !nrm) {
-    c->normal_map_no_normal++;
+    if (has_normal_map) c->normal_map_no_normal++;
     normal_set = -1;
   } else if (normal_set >= 0 && !(normal_set ? uv1 : uv) && !tan) {
-    c->normal_map_no_uv++;
+    if (has_normal_map) c->normal_map_no_uv++;
     normal_set = -1;
   }
   if (normal_set < 0) tan = NULL;
@@ -781,6 +782,8 @@ static iris_status convert_primitive(gltf_ctx *c, size_t mi, size_t pi, converte
     c->tangents_generated++;
     c->tangents_split += split;
   }
+  if (mat >= 0 && c->materials[mat].anisotropy > 0.0f && !m->tangents && m->triangle_count > 0)
+    c->anisotropy_no_tangents++;
   if (m->triangle_count == 0) {
     c->skipped_empty++;
     free_mesh_arrays(m);
@@ -1281,7 +1284,9 @@ static iris_status check_asset(gltf_ctx *c) {
   size_t used = 0;
   for (size_t i = 0; i < d->extensions_used_count; i++) {
     /* KHR_texture_basisu: its fallback source is used, with its own notice (gltf_material.c). */
-    if (is_supported_extension(d->extensions_used[i]) || strcmp(d->extensions_used[i], "KHR_texture_basisu") == 0)
+    /* KHR_materials_dispersion: its own warning naming the materials (report_ignored). */
+    if (is_supported_extension(d->extensions_used[i]) || strcmp(d->extensions_used[i], "KHR_texture_basisu") == 0 ||
+        strcmp(d->extensions_used[i], "KHR_materials_dispersion") == 0)
       continue;
     int w = snprintf(list + used, sizeof list - used, "%s%s", used ? ", " : "", d->extensions_used[i]);
     if (w > 0) used += (size_t)w < sizeof list - used ? (size_t)w : sizeof list - used - 1;
@@ -1311,6 +1316,12 @@ static void report_ignored(gltf_ctx *c) {
   if (c->normal_map_no_uv)
     iris_warnf("%s: %zu primitive(s) lack the uv set of their normal map, which is not applied", f,
                c->normal_map_no_uv);
+  if (c->anisotropy_no_tangents)
+    iris_warnf("%s: %zu anisotropic primitive(s) have no tangent frame (no NORMAL, or no uvs to make tangents "
+               "from) and are shaded isotropic", f, c->anisotropy_no_tangents);
+  if (c->dispersion_count)
+    iris_warnf("%s: KHR_materials_dispersion in material(s) %s: dispersion is not rendered: the ior alone is used",
+               f, c->dispersion_materials);
   if (c->warned_morph) iris_warnf("%s: morph targets ignored (base shape used)", f);
   if (c->warned_skin) iris_warnf("%s: skins ignored (bind pose used)", f);
   if (c->warned_ortho) iris_warnf("%s: orthographic cameras skipped", f);

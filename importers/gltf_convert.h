@@ -138,6 +138,10 @@ typedef struct iris_gltf_material {
   bool has_volume, has_attenuation_distance;
   double attenuation_distance, attenuation_color[3];
   bool unlit; /* KHR_materials_unlit */
+  bool has_anisotropy; /* KHR_materials_anisotropy */
+  double anisotropy_strength, anisotropy_rotation;
+  iris_gltf_texture_ref anisotropy_texture;
+  bool has_dispersion; /* KHR_materials_dispersion (not rendered: warned about) */
 } iris_gltf_material;
 
 typedef struct iris_gltf_texture {

@@ -30,7 +30,7 @@ enum {
   GLTF_SLOT_COLOR, GLTF_SLOT_METALLIC_ROUGHNESS, GLTF_SLOT_EMISSION, GLTF_SLOT_NORMAL,
   GLTF_SLOT_CLEARCOAT, GLTF_SLOT_CLEARCOAT_ROUGHNESS, GLTF_SLOT_CLEARCOAT_NORMAL, GLTF_SLOT_SHEEN_COLOR,
   GLTF_SLOT_SHEEN_ROUGHNESS, GLTF_SLOT_TRANSMISSION, GLTF_SLOT_SPECULAR, GLTF_SLOT_SPECULAR_COLOR,
-  GLTF_SLOT_COUNT
+  GLTF_SLOT_ANISOTROPY, GLTF_SLOT_COUNT
 };
 
 /* How a material slot places a texture: the glTF texture, the uv set and
@@ -80,6 +80,9 @@ typedef struct gltf_ctx {
   size_t skipped_points_lines, skipped_no_position, skipped_empty, degenerate_dropped;
   bool warned_texcoord, warned_occlusion;
   size_t normal_map_no_normal, normal_map_no_uv; /* primitives whose normal map is not applied */
+  size_t anisotropy_no_tangents; /* anisotropic primitives left without a tangent frame (isotropic) */
+  char dispersion_materials[256]; /* KHR_materials_dispersion users, named in one warning */
+  size_t dispersion_count;
   size_t tangents_generated, tangents_split;
   bool noticed_basisu;
   bool warned_morph, warned_skin, warned_ortho, warned_matrix_trs, warned_bad_image;
@@ -117,6 +120,9 @@ iris_status gltf_validate_materials(gltf_ctx *c);
 iris_status gltf_resolve_material(gltf_ctx *c, int gi, int32_t *out);
 /* The uv set (validated) glTF material `gi`'s normal map reads, -1 without one. */
 int gltf_material_normal_uv_set(const gltf_ctx *c, int gi);
+/* The uv set whose tangent frame material `gi` needs: its normal map's, else for
+ * KHR_materials_anisotropy the anisotropy texture's (0 untextured); -1: none. */
+int gltf_material_tangent_uv_set(const gltf_ctx *c, int gi);
 /* The alpha mode of (validated) glTF material `gi` (-1: the default material, opaque). */
 iris_alpha_mode gltf_material_alpha_mode(const gltf_ctx *c, int gi);
 /* Whether (validated) glTF material `gi` reads textures through TEXCOORD_1. */

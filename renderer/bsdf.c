@@ -17,6 +17,13 @@
 
 static const iris_vec3 zero3 = {0.0f, 0.0f, 0.0f};
 
+/* For the rarely taken paths (layers, anisotropy): the common BSDF stays small. */
+#if defined(__GNUC__)
+#define IRIS_NOINLINE __attribute__((noinline))
+#else
+#define IRIS_NOINLINE
+#endif
+
 static float alpha_of(float roughness) {
   float r = iris_clampf(isfinite(roughness) ? roughness : 1.0f, 0.0f, 1.0f);
   return r * r;
@@ -91,6 +98,51 @@ static float ggx_refract_pdf(float alpha, float eta, iris_vec3 wo, iris_vec3 wi)
   float denom;
   if (!refract_half(wo, wi, eta, &m, &denom)) return 0.0f;
   return iris_ggx_vndf_pdf(alpha, wo, m) * eta * eta * fabsf(iris_dot(wi, m)) / denom;
+}
+
+/* ---- anisotropic GGX lobes (KHR_materials_anisotropy), in the frame whose
+ * x axis is the anisotropy direction: ax = alpha_t, ay = alpha_b. Always the
+ * height-correlated Smith G, as the glTF BSDF uses. */
+
+/* alpha_b is floored here (as the glTF Sample Viewer does) so that a smooth
+ * material made anisotropic keeps a (thin) lobe rather than D = 0. */
+#define ANISO_MIN_ALPHA 1e-3f
+
+static float ggx_aniso_reflect_f(float ax, float ay, iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 m = iris_normalize(iris_add(wo, wi));
+  float g = 1.0f / (1.0f + iris_ggx_lambda_aniso(ax, ay, wo) + iris_ggx_lambda_aniso(ax, ay, wi));
+  return iris_ggx_d_aniso(ax, ay, m) * g / (4.0f * wo.z * wi.z);
+}
+
+static float ggx_aniso_reflect_pdf(float ax, float ay, iris_vec3 wo, iris_vec3 wi) {
+  if (wo.z < IRIS_BSDF_MIN_COS || wi.z < IRIS_BSDF_MIN_COS) return 0.0f;
+  iris_vec3 m = iris_normalize(iris_add(wo, wi));
+  return iris_ggx_g1_aniso(ax, ay, wo) * iris_ggx_d_aniso(ax, ay, m) / (4.0f * wo.z);
+}
+
+static float ggx_aniso_refract_f(float ax, float ay, float eta, iris_vec3 wo, iris_vec3 wi) {
+  iris_vec3 m;
+  float denom;
+  if (!refract_half(wo, wi, eta, &m, &denom)) return 0.0f;
+  float g = 1.0f / (1.0f + iris_ggx_lambda_aniso(ax, ay, wo) + iris_ggx_lambda_aniso(ax, ay, wi));
+  return iris_ggx_d_aniso(ax, ay, m) * g * fabsf(iris_dot(wo, m) * iris_dot(wi, m)) * eta * eta /
+         (wo.z * fabsf(wi.z) * denom);
+}
+
+static float ggx_aniso_refract_pdf(float ax, float ay, float eta, iris_vec3 wo, iris_vec3 wi) {
+  iris_vec3 m;
+  float denom;
+  if (!refract_half(wo, wi, eta, &m, &denom)) return 0.0f;
+  return iris_ggx_vndf_pdf_aniso(ax, ay, wo, m) * eta * eta * fabsf(iris_dot(wi, m)) / denom;
+}
+
+/* alpha_t, alpha_b of a gltf BSDF with anisotropy > 0 (docs/materials.md). */
+static void gltf_aniso_alphas(const iris_bsdf *b, float *at, float *ab) {
+  float a = alpha_of(b->roughness);
+  float s = iris_clampf(sanitize1(b->anisotropy), 0.0f, 1.0f);
+  *at = a + (1.0f - a) * s * s;
+  *ab = fmaxf(a, ANISO_MIN_ALPHA);
 }
 
 /* ---- diffuse: Lambert ---------------------------------------------------- */
@@ -239,7 +291,34 @@ typedef struct gltf_setup {
   float metallic;
   float transmission;
   float p_spec, p_diffuse, p_trans; /* lobe selection probabilities at wo */
+  /* KHR_materials_anisotropy: directions are turned into the frame whose x axis is
+   * the anisotropy direction (ca, sa); false: isotropic (alpha), nothing turned. */
+  bool aniso;
+  float ax, ay, ca, sa;
 } gltf_setup;
+
+/* Into / out of the anisotropy frame: a turn about z (cosines, Fresnel and the
+ * diffuse lobe do not change). */
+static iris_vec3 aniso_in(const gltf_setup *g, iris_vec3 w) {
+  return iris_v3(g->ca * w.x + g->sa * w.y, g->ca * w.y - g->sa * w.x, w.z);
+}
+static iris_vec3 aniso_out(const gltf_setup *g, iris_vec3 w) {
+  return iris_v3(g->ca * w.x - g->sa * w.y, g->sa * w.x + g->ca * w.y, w.z);
+}
+
+/* Kept out of line: the isotropic BSDF only pays the test of b->anisotropy. */
+static IRIS_NOINLINE void gltf_begin_aniso(const iris_bsdf *b, iris_vec3 *wo, gltf_setup *g) {
+  float at, ab;
+  gltf_aniso_alphas(b, &at, &ab);
+  g->smooth = at * ab <= IRIS_BSDF_SINGULAR_ALPHA2;
+  if (g->smooth) return;
+  float c = b->aniso_dir[0], sn = b->aniso_dir[1], len = sqrtf(c * c + sn * sn);
+  if (!(len > 1e-6f) || !isfinite(len)) c = 1.0f, sn = 0.0f, len = 1.0f;
+  g->aniso = true;
+  g->ax = at, g->ay = ab;
+  g->ca = c / len, g->sa = sn / len;
+  *wo = aniso_in(g, *wo);
+}
 
 static iris_vec3 schlick3(iris_vec3 f0, float c) {
   return iris_v3(iris_fresnel_schlick(f0.x, c), iris_fresnel_schlick(f0.y, c),
@@ -260,6 +339,8 @@ static bool gltf_begin(const iris_bsdf *b, iris_vec3 *wo, gltf_setup *g) {
   g->eta = g->inside ? 1.0f / ior : ior;
   g->alpha = alpha_of(b->roughness);
   g->smooth = alpha_is_singular(g->alpha);
+  g->aniso = false;
+  if (b->anisotropy > 0.0f) gltf_begin_aniso(b, wo, g);
   float f0 = iris_sqr((ior - 1.0f) / (ior + 1.0f));
   iris_vec3 sc = sanitize3(b->specular_color);
   g->f0 = iris_v3(fminf(f0 * sc.x, 1.0f), fminf(f0 * sc.y, 1.0f), fminf(f0 * sc.z, 1.0f));
@@ -309,30 +390,34 @@ static iris_vec3 gltf_eval_local(const iris_bsdf *b, const gltf_setup *g, iris_v
     float opaque = (1.0f - g->metallic) * (1.0f - iris_clampf(b->transmission, 0.0f, 1.0f));
     iris_vec3 f = iris_scale(base, opaque * gltf_base_weight(g, wo.z) * IRIS_INV_PI);
     if (!g->smooth) {
-      float spec = ggx_reflect_f(g->alpha, wo, wi, true);
+      float spec = g->aniso ? ggx_aniso_reflect_f(g->ax, g->ay, wo, wi) : ggx_reflect_f(g->alpha, wo, wi, true);
       f = iris_add(f, iris_scale(gltf_spec_tint(b, g, c), spec));
     }
     return f;
   }
   if (g->smooth || !(g->transmission > 0.0f)) return zero3;
-  float btdf = ggx_refract_f(g->alpha, g->eta, wo, wi, true);
+  float btdf = g->aniso ? ggx_aniso_refract_f(g->ax, g->ay, g->eta, wo, wi)
+                        : ggx_refract_f(g->alpha, g->eta, wo, wi, true);
   return iris_scale(base, g->transmission * gltf_base_weight(g, wo.z) * btdf);
 }
 
 static float gltf_pdf_local(const gltf_setup *g, iris_vec3 wo, iris_vec3 wi) {
   if (wi.z > 0.0f) {
     float p = g->p_diffuse * iris_sample_cosine_hemisphere_pdf(wi.z);
-    if (!g->smooth) p += g->p_spec * ggx_reflect_pdf(g->alpha, wo, wi);
+    if (!g->smooth)
+      p += g->p_spec * (g->aniso ? ggx_aniso_reflect_pdf(g->ax, g->ay, wo, wi) : ggx_reflect_pdf(g->alpha, wo, wi));
     return p;
   }
   if (g->smooth) return 0.0f;
-  return g->p_trans * ggx_refract_pdf(g->alpha, g->eta, wo, wi);
+  return g->p_trans * (g->aniso ? ggx_aniso_refract_pdf(g->ax, g->ay, g->eta, wo, wi)
+                                : ggx_refract_pdf(g->alpha, g->eta, wo, wi));
 }
 
 static iris_vec3 gltf_base_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   gltf_setup g;
   if (!gltf_begin(b, &wo, &g)) return zero3;
   if (g.inside) wi = flip_z(wi);
+  if (g.aniso) wi = aniso_in(&g, wi);
   return gltf_eval_local(b, &g, wo, wi);
 }
 
@@ -340,6 +425,7 @@ static float gltf_base_pdf(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   gltf_setup g;
   if (!gltf_begin(b, &wo, &g)) return 0.0f;
   if (g.inside) wi = flip_z(wi);
+  if (g.aniso) wi = aniso_in(&g, wi);
   return gltf_pdf_local(&g, wo, wi);
 }
 
@@ -357,7 +443,8 @@ static bool gltf_base_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, flo
       if (g.inside) s->wi = flip_z(s->wi);
       return s->pdf > 0.0f;
     }
-    s->wi = iris_reflect(wo, iris_ggx_sample_vndf(g.alpha, wo, u0, u1));
+    s->wi = iris_reflect(wo, g.aniso ? iris_ggx_sample_vndf_aniso(g.ax, g.ay, wo, u0, u1)
+                                     : iris_ggx_sample_vndf(g.alpha, wo, u0, u1));
     if (s->wi.z < IRIS_BSDF_MIN_COS) return false;
     s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
   } else if (u_lobe < g.p_spec + g.p_diffuse) {
@@ -374,13 +461,13 @@ static bool gltf_base_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, flo
       if (g.inside) s->wi = flip_z(s->wi);
       return true;
     }
-    if (!iris_refract(wo, iris_ggx_sample_vndf(g.alpha, wo, u0, u1), g.eta, &s->wi) ||
-        s->wi.z > -IRIS_BSDF_MIN_COS)
-      return false;
+    iris_vec3 m = g.aniso ? iris_ggx_sample_vndf_aniso(g.ax, g.ay, wo, u0, u1) : iris_ggx_sample_vndf(g.alpha, wo, u0, u1);
+    if (!iris_refract(wo, m, g.eta, &s->wi) || s->wi.z > -IRIS_BSDF_MIN_COS) return false;
     s->lobe = IRIS_LOBE_TRANSMISSION | IRIS_LOBE_GLOSSY;
   }
   s->f = sanitize3(gltf_eval_local(b, &g, wo, s->wi));
   s->pdf = sanitize1(gltf_pdf_local(&g, wo, s->wi));
+  if (g.aniso) s->wi = aniso_out(&g, s->wi);
   if (g.inside) s->wi = flip_z(s->wi);
   return s->pdf > 0.0f;
 }
@@ -503,13 +590,8 @@ static float layered_pdf(const iris_bsdf *b, const layers *l, iris_vec3 wo, iris
   return l->p_coat * coat_pdf(l, wo, wi) + l->p_sheen * sheen_pdf(wi) + p_base * gltf_base_pdf(b, wo, wi);
 }
 
-/* The layered paths are kept out of line so that the plain glTF BSDF inlines
- * into the dispatch as it did before the layers existed (measured: docs/performance.md). */
-#if defined(__GNUC__)
-#define IRIS_NOINLINE __attribute__((noinline))
-#else
-#define IRIS_NOINLINE
-#endif
+/* The layered paths are kept out of line (IRIS_NOINLINE) so that the plain glTF BSDF
+ * inlines into the dispatch as it did before the layers existed (measured: docs/performance.md). */
 
 static IRIS_NOINLINE iris_vec3 gltf_layered_eval(const iris_bsdf *b, iris_vec3 wo, iris_vec3 wi) {
   layers l;
@@ -590,6 +672,8 @@ iris_bsdf iris_bsdf_from_material(const iris_material *mat, iris_vec3 color, flo
   b.clearcoat = b.clearcoat_roughness = b.sheen_roughness = 0.0f;
   b.coat_n = iris_v3(0.0f, 0.0f, 1.0f);
   b.sheen_color = zero3;
+  b.anisotropy = 0.0f;
+  b.aniso_dir[0] = 1.0f, b.aniso_dir[1] = 0.0f;
   return b;
 }
 
@@ -651,6 +735,11 @@ bool iris_bsdf_sample(const iris_bsdf *b, iris_vec3 wo, float u_lobe, float u0, 
 uint32_t iris_bsdf_lobes(const iris_bsdf *b) {
   if (b->type == IRIS_BSDF_DIFFUSE) return IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
   bool smooth = alpha_is_singular(alpha_of(b->roughness));
+  if (b->type == IRIS_BSDF_GLTF && b->anisotropy > 0.0f) {
+    float at, ab;
+    gltf_aniso_alphas(b, &at, &ab);
+    smooth = at * ab <= IRIS_BSDF_SINGULAR_ALPHA2;
+  }
   uint32_t spec = smooth ? IRIS_LOBE_DELTA : IRIS_LOBE_GLOSSY;
   switch (b->type) {
     case IRIS_BSDF_DIFFUSE: return IRIS_LOBE_REFLECTION | IRIS_LOBE_DIFFUSE;
@@ -684,6 +773,11 @@ float iris_bsdf_guiding_roughness(const iris_bsdf *b) {
   uint32_t l = iris_bsdf_lobes(b);
   if (iris_bsdf_is_delta(b)) return 0.0f;
   if (!(l & (IRIS_LOBE_GLOSSY | IRIS_LOBE_DELTA))) return INFINITY;
+  if ((l & IRIS_LOBE_GLOSSY) && b->type == IRIS_BSDF_GLTF && b->anisotropy > 0.0f) {
+    float at, ab; /* the isotropic roughness of the same sqrt(at ab) */
+    gltf_aniso_alphas(b, &at, &ab);
+    return iris_clampf(sqrtf(sqrtf(at * ab)), 0.0f, 1.0f);
+  }
   if (l & IRIS_LOBE_GLOSSY) return iris_clampf(b->roughness, 0.0f, 1.0f);
   /* gltf with a smooth coat over a diffuse base: the diffuse share of the
    * material decides how much irradiance sampling may be used. */

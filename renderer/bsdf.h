@@ -50,6 +50,12 @@ typedef struct iris_bsdf {
   iris_vec3 coat_n;
   iris_vec3 sheen_color;
   float sheen_roughness;
+  /* gltf KHR_materials_anisotropy (0 = isotropic, the default): strength in
+   * [0, 1] and the anisotropy direction (cos, sin) in this BSDF's local frame.
+   * The specular and transmission lobes get alpha_t = mix(alpha, 1, strength^2)
+   * along that direction and alpha_b = alpha across it. Set by the caller. */
+  float anisotropy;
+  float aniso_dir[2];
 } iris_bsdf;
 
 /* Lobe flags of a sample (and of a BSDF as a whole). */

@@ -143,6 +143,32 @@ static void shade_spec_trans(const iris_integrator *it, const iris_material *m, 
   }
 }
 
+/* KHR_materials_anisotropy at the point: strength x texture B, and the direction
+ * (texture RG in [-1, 1], else the tangent) turned counter-clockwise by the
+ * material's rotation in the mesh's (tangent, bitangent) plane, then expressed in
+ * the shading frame. Called only for anisotropic materials on meshes with tangents. */
+static void shade_anisotropy(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
+                             iris_shading_point *sp) {
+  float strength = m->anisotropy, dx = 1.0f, dy = 0.0f;
+  if (m->anisotropy_texture >= 0) {
+    float t[4];
+    iris_texture_sample(it->textures, m->anisotropy_texture, si->uv, si->uv1, false, t);
+    dx = 2.0f * t[0] - 1.0f, dy = 2.0f * t[1] - 1.0f;
+    strength *= t[2];
+    if (!(dx * dx + dy * dy > 1e-12f)) dx = 1.0f, dy = 0.0f;
+  }
+  float c = cosf(m->anisotropy_rotation), s = sinf(m->anisotropy_rotation);
+  iris_vec3 dir = iris_add(iris_scale(si->tangent, c * dx - s * dy), iris_scale(si->bitangent, s * dx + c * dy));
+  iris_vec3 l = iris_frame_to_local(&sp->frame, dir);
+  float len = sqrtf(l.x * l.x + l.y * l.y);
+  if (!(strength > 0.0f) || !(len > 1e-6f) || !isfinite(len)) return; /* along the normal: isotropic */
+  sp->bsdf.anisotropy = iris_clampf(strength, 0.0f, 1.0f);
+  sp->bsdf.aniso_dir[0] = l.x / len;
+  sp->bsdf.aniso_dir[1] = l.y / len;
+  sp->lobes = iris_bsdf_lobes(&sp->bsdf);
+  sp->delta = iris_bsdf_is_delta(&sp->bsdf);
+}
+
 void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si, iris_vec3 wo,
                            int depth, iris_shading_point *sp) {
   const iris_material *m = si->material >= 0 && (size_t)si->material < it->scene->material_count
@@ -194,6 +220,7 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   sp->wo_local = iris_frame_to_local(&sp->frame, wo);
   if (m->type == IRIS_MATERIAL_GLTF && (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f))
     shade_layers(it, m, si, sp);
+  if (m->type == IRIS_MATERIAL_GLTF && m->anisotropy > 0.0f && si->has_tangent) shade_anisotropy(it, m, si, sp);
   mapped = mapped || (m->clearcoat > 0.0f && m->clearcoat_normal_texture >= 0 && si->has_tangent);
   sp->fold = mapped && !(sp->lobes & IRIS_LOBE_TRANSMISSION);
 }

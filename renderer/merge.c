@@ -95,6 +95,11 @@ uint64_t iris_merge_scene_hash(const iris_scene *scene) {
       int32_t t[3] = {m->transmission_texture, m->specular_texture, m->specular_color_texture};
       for (int k = 0; k < 3; k++) hash_u64(&s, (uint64_t)(int64_t)t[k] ^ 0x7370u);
     }
+    if (m->anisotropy > 0.0f) { /* (isotropic scenes hash as before) */
+      float a[2] = {m->anisotropy, m->anisotropy_rotation};
+      hash_floats(&s, a, 2);
+      hash_u64(&s, (uint64_t)(int64_t)m->anisotropy_texture);
+    }
     if (m->normal_texture >= 0) { /* (scenes without normal maps hash as before) */
       hash_u64(&s, (uint64_t)(int64_t)m->normal_texture);
       hash_floats(&s, &m->normal_scale, 1);

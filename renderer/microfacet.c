@@ -36,9 +36,10 @@ float iris_ggx_g1(float alpha, iris_vec3 w) {
   return 2.0f / (1.0f + sqrtf(1.0f + alpha * alpha * s2 / c2));
 }
 
-iris_vec3 iris_ggx_sample_vndf(float alpha, iris_vec3 wo, float u0, float u1) {
+/* Heitz 2018 with the stretch (ax, ay); inlined into both samplers below. */
+static inline iris_vec3 sample_vndf(float ax, float ay, iris_vec3 wo, float u0, float u1) {
   /* Section 3.2: stretch to the hemisphere configuration. */
-  iris_vec3 vh = iris_normalize(iris_v3(alpha * wo.x, alpha * wo.y, wo.z));
+  iris_vec3 vh = iris_normalize(iris_v3(ax * wo.x, ay * wo.y, wo.z));
   /* Section 4.1: orthonormal basis. */
   float lensq = vh.x * vh.x + vh.y * vh.y;
   iris_vec3 t1 = lensq > 1e-7f ? iris_scale(iris_v3(-vh.y, vh.x, 0.0f), 1.0f / sqrtf(lensq))
@@ -53,8 +54,45 @@ iris_vec3 iris_ggx_sample_vndf(float alpha, iris_vec3 wo, float u0, float u1) {
   iris_vec3 nh = iris_add(iris_add(iris_scale(t1, x), iris_scale(t2, y)),
                           iris_scale(vh, safe_sqrt(1.0f - x * x - y * y)));
   /* Section 3.4: back to the ellipsoid configuration. */
-  iris_vec3 m = iris_normalize(iris_v3(alpha * nh.x, alpha * nh.y, fmaxf(1e-7f, nh.z)));
+  iris_vec3 m = iris_normalize(iris_v3(ax * nh.x, ay * nh.y, fmaxf(1e-7f, nh.z)));
   return m;
+}
+
+iris_vec3 iris_ggx_sample_vndf(float alpha, iris_vec3 wo, float u0, float u1) {
+  return sample_vndf(alpha, alpha, wo, u0, u1);
+}
+
+iris_vec3 iris_ggx_sample_vndf_aniso(float ax, float ay, iris_vec3 wo, float u0, float u1) {
+  return sample_vndf(ax, ay, wo, u0, u1);
+}
+
+float iris_ggx_d_aniso(float ax, float ay, iris_vec3 m) {
+  if (m.z <= 0.0f) return 0.0f;
+  float len2 = m.x * m.x + m.y * m.y + m.z * m.z;
+  float x = m.x / ax, y = m.y / ay;
+  float t = (x * x + y * y + m.z * m.z) / len2;
+  if (!(t > 0.0f)) return 0.0f;
+  return 1.0f / (IRIS_PI * ax * ay * t * t);
+}
+
+float iris_ggx_lambda_aniso(float ax, float ay, iris_vec3 w) {
+  float c2 = w.z * w.z;
+  if (c2 <= 0.0f) return INFINITY;
+  float a2t2 = max0(ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
+  return 0.5f * (sqrtf(1.0f + a2t2) - 1.0f);
+}
+
+float iris_ggx_g1_aniso(float ax, float ay, iris_vec3 w) {
+  float c2 = w.z * w.z;
+  if (c2 <= 0.0f) return 0.0f;
+  float a2t2 = max0(ax * ax * w.x * w.x + ay * ay * w.y * w.y) / c2;
+  return 2.0f / (1.0f + sqrtf(1.0f + a2t2));
+}
+
+float iris_ggx_vndf_pdf_aniso(float ax, float ay, iris_vec3 wo, iris_vec3 m) {
+  float wm = iris_dot(wo, m);
+  if (wo.z <= 0.0f || wm <= 0.0f) return 0.0f;
+  return iris_ggx_g1_aniso(ax, ay, wo) * wm * iris_ggx_d_aniso(ax, ay, m) / wo.z;
 }
 
 float iris_ggx_vndf_pdf(float alpha, iris_vec3 wo, iris_vec3 m) {

@@ -1,4 +1,4 @@
-/* Isotropic GGX (Trowbridge-Reitz) microfacet pieces and dielectric Fresnel,
+/* GGX (Trowbridge-Reitz) microfacet pieces, isotropic and anisotropic, and dielectric Fresnel,
  * in the local shading frame (z = normal). The BSDFs in bsdf.c assemble
  * these; each formula is written out in docs/materials.md. */
 #ifndef IRIS_RENDERER_MICROFACET_H
@@ -23,6 +23,17 @@ float iris_ggx_g1(float alpha, iris_vec3 w);
 iris_vec3 iris_ggx_sample_vndf(float alpha, iris_vec3 wo, float u0, float u1);
 /* Density of that normal: D_wo(m) = G1(wo) max(0, wo.m) D(m) / wo.z. */
 float iris_ggx_vndf_pdf(float alpha, iris_vec3 wo, iris_vec3 m);
+
+/* Anisotropic GGX with roughness ax along the local x axis and ay along y
+ * (Heitz 2014, eqs. 85-86; KHR_materials_anisotropy's D with at = ax, ab = ay). */
+float iris_ggx_d_aniso(float ax, float ay, iris_vec3 m);
+/* Lambda(w) = (sqrt(1 + (ax^2 x^2 + ay^2 y^2) / z^2) - 1) / 2. */
+float iris_ggx_lambda_aniso(float ax, float ay, iris_vec3 w);
+float iris_ggx_g1_aniso(float ax, float ay, iris_vec3 w);
+/* Heitz 2018 handles anisotropy by stretching with (ax, ay); the isotropic
+ * sampler is this with ax = ay (same operations, same bits). */
+iris_vec3 iris_ggx_sample_vndf_aniso(float ax, float ay, iris_vec3 wo, float u0, float u1);
+float iris_ggx_vndf_pdf_aniso(float ax, float ay, iris_vec3 wo, iris_vec3 m);
 
 /* Exact unpolarised Fresnel reflectance of a dielectric interface for light
  * arriving at cos_i (sign ignored) from the side whose relative index is 1,

@@ -9,8 +9,9 @@
 iris_gltf_class iris_material_gltf_class(const iris_material *m) {
   if (m->type != IRIS_MATERIAL_GLTF) return IRIS_GLTF_NOT_GLTF;
   /* clearcoat and sheen layers: no Cycles node reproduces them (Principled v1
-   * approximates them), whatever the base is */
-  if (m->clearcoat > 0.0f || m->sheen_color[0] > 0.0f || m->sheen_color[1] > 0.0f || m->sheen_color[2] > 0.0f)
+   * approximates them), whatever the base is; anisotropy needs Principled too */
+  if (m->clearcoat > 0.0f || m->sheen_color[0] > 0.0f || m->sheen_color[1] > 0.0f || m->sheen_color[2] > 0.0f ||
+      m->anisotropy > 0.0f)
     return IRIS_GLTF_GENERAL;
   /* metallic = factor x texture B, so a factor of 0 is 0 whatever the texture;
    * a factor of 1 is 1 only without a texture. */

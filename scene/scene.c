@@ -184,6 +184,8 @@ iris_material iris_material_default(iris_material_type type) {
   m.clearcoat_texture = m.clearcoat_roughness_texture = m.clearcoat_normal_texture = -1;
   m.clearcoat_normal_scale = 1.0f;
   m.sheen_color_texture = m.sheen_roughness_texture = -1;
+  m.anisotropy = m.anisotropy_rotation = 0.0f;
+  m.anisotropy_texture = -1;
   m.attenuation_color[0] = m.attenuation_color[1] = m.attenuation_color[2] = 1.0f;
   m.attenuation_distance = 0.0f;
   return m;
@@ -231,6 +233,7 @@ iris_status iris_scene_merge(iris_scene *dst, iris_scene *src, iris_error *err) 
     m->transmission_texture = shift_ref(m->transmission_texture, tex0);
     m->specular_texture = shift_ref(m->specular_texture, tex0);
     m->specular_color_texture = shift_ref(m->specular_color_texture, tex0);
+    m->anisotropy_texture = shift_ref(m->anisotropy_texture, tex0);
   }
   for (size_t i = 0; i < src->mesh_count; i++)
     src->meshes[i].material = shift_ref(src->meshes[i].material, mat0);
@@ -372,14 +375,17 @@ static iris_status validate_material(const iris_scene *s, const iris_material *m
     FAIL("attenuation_distance %g must be finite and >= 0 (0: none)", (double)m->attenuation_distance);
   if (!isfinite(m->sheen_roughness) || m->sheen_roughness < 0.0f || m->sheen_roughness > 1.0f)
     FAIL("sheen_roughness %g outside [0, 1]", (double)m->sheen_roughness);
+  if (!isfinite(m->anisotropy) || m->anisotropy < 0.0f || m->anisotropy > 1.0f)
+    FAIL("anisotropy %g outside [0, 1]", (double)m->anisotropy);
+  if (!isfinite(m->anisotropy_rotation)) FAIL("anisotropy_rotation is not finite");
   {
-    const int32_t refs[8] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
+    const int32_t refs[9] = {m->clearcoat_texture, m->clearcoat_roughness_texture, m->clearcoat_normal_texture,
                              m->sheen_color_texture, m->sheen_roughness_texture, m->transmission_texture,
-                             m->specular_texture, m->specular_color_texture};
-    const char *names[8] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
+                             m->specular_texture, m->specular_color_texture, m->anisotropy_texture};
+    const char *names[9] = {"clearcoat_texture", "clearcoat_roughness_texture", "clearcoat_normal_texture",
                             "sheen_color_texture", "sheen_roughness_texture", "transmission_texture",
-                            "specular_texture", "specular_color_texture"};
-    for (int k = 0; k < 8; k++)
+                            "specular_texture", "specular_color_texture", "anisotropy_texture"};
+    for (int k = 0; k < 9; k++)
       if ((st = check_texture_ref(refs[k], s->texture_count, names[k], file, element, err))) return st;
   }
   return check_texture_ref(m->emission_texture, s->texture_count, "emission_texture", file,

@@ -103,6 +103,12 @@ typedef struct iris_material {
    * distance 0 = no attenuation (the extension's infinity) */
   float attenuation_color[3];
   float attenuation_distance;
+  /* gltf KHR_materials_anisotropy: strength in [0, 1] x texture B; the direction,
+   * in the mesh's tangent frame (tangent, bitangent), is the texture's RG mapped
+   * [0,1] -> [-1,1] (else (1, 0)) turned counter-clockwise by `anisotropy_rotation`
+   * radians. Needs mesh tangents; without them the surface is isotropic. */
+  float anisotropy, anisotropy_rotation;
+  int32_t anisotropy_texture; /* linear, -1 none */
 } iris_material;
 
 /* ---- meshes and instances --------------------------------------------- */

@@ -210,6 +210,10 @@ static cJSON *write_material(const iris_material *m) {
       add_floats(o, "attenuation_color", m->attenuation_color, 3);
     if (m->attenuation_distance != d.attenuation_distance)
       add_float(o, "attenuation_distance", m->attenuation_distance);
+    if (m->anisotropy != d.anisotropy) add_float(o, "anisotropy", m->anisotropy);
+    if (m->anisotropy_rotation != d.anisotropy_rotation)
+      add_float(o, "anisotropy_rotation", m->anisotropy_rotation);
+    if (m->anisotropy_texture >= 0) cJSON_AddNumberToObject(o, "anisotropy_texture", m->anisotropy_texture);
   }
   if (!floats_equal(m->emission, d.emission, 3)) add_floats(o, "emission", m->emission, 3);
   if (m->emission_texture >= 0) cJSON_AddNumberToObject(o, "emission_texture", m->emission_texture);
@@ -677,7 +681,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                                      "clearcoat_normal_scale", "sheen_color", "sheen_roughness",
                                      "sheen_color_texture", "sheen_roughness_texture",
                                      "attenuation_color", "attenuation_distance", "transmission_texture",
-                                     "specular_texture", "specular_color_texture"};
+                                     "specular_texture", "specular_color_texture", "anisotropy",
+                                     "anisotropy_rotation", "anisotropy_texture"};
   TRY(check_keys(c, o, keys, sizeof keys / sizeof *keys));
   TRY(require(c, o, "type"));
   int type = 0;
@@ -696,7 +701,8 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
                  {"clearcoat_normal_scale", 0x8}, {"sheen_color", 0x8}, {"sheen_roughness", 0x8},
                  {"sheen_color_texture", 0x8}, {"sheen_roughness_texture", 0x8},
                  {"attenuation_color", 0x8}, {"attenuation_distance", 0x8}, {"transmission_texture", 0x8},
-                 {"specular_texture", 0x8}, {"specular_color_texture", 0x8}};
+                 {"specular_texture", 0x8}, {"specular_color_texture", 0x8}, {"anisotropy", 0x8},
+                 {"anisotropy_rotation", 0x8}, {"anisotropy_texture", 0x8}};
   for (size_t k = 0; k < sizeof applies / sizeof *applies; k++)
     if (item(o, applies[k].key) && !(applies[k].types & (1u << type)))
       iris_warnf("%s: %s: '%s' does not apply to a %s material (ignored)", c->file, c->element,
@@ -750,6 +756,9 @@ static iris_status load_material(jctx *c, const cJSON *o, iris_material *m) {
     TRY(get_i32(c, o, "transmission_texture", -1, INT32_MAX, &m->transmission_texture));
     TRY(get_i32(c, o, "specular_texture", -1, INT32_MAX, &m->specular_texture));
     TRY(get_i32(c, o, "specular_color_texture", -1, INT32_MAX, &m->specular_color_texture));
+    TRY(get_float(c, o, "anisotropy", &m->anisotropy));
+    TRY(get_float(c, o, "anisotropy_rotation", &m->anisotropy_rotation));
+    TRY(get_i32(c, o, "anisotropy_texture", -1, INT32_MAX, &m->anisotropy_texture));
   }
   memcpy(m->emission, full.emission, sizeof m->emission);
   m->emission_texture = full.emission_texture;

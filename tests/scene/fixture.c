@@ -127,6 +127,9 @@ iris_scene *fixture_rich_scene(const char *dir) {
   m.ior = 1.33f;
   m.normal_texture = 1;
   m.normal_scale = 0.75f;
+  m.anisotropy = 0.625f;
+  m.anisotropy_rotation = -1.25f;
+  m.anisotropy_texture = 1;
   iris_scene_add_material(s, &m);
 
   iris_mesh cube = fixture_cube("cube", true, true, true);

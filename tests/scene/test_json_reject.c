@@ -138,6 +138,13 @@ static void test_rejects(void) {
   expect("\"color_texture\":\t0", "\"color_texture\":\t1", IRIS_ERR_INVALID, "materials[0]", "color_texture 1 out of range");
   expect("\"color\":\t[0.8, 0.1, 0.1]", "\"color\":\t[0.8, 0.1]", IRIS_ERR_INVALID, "materials[0]", "array of 3 numbers");
   expect("\"color\":\t[0.8, 0.1, 0.1]", "\"color\":\t[0.8, -0.1, 0.1]", IRIS_ERR_INVALID, "materials[0]", "non-negative");
+  /* KHR_materials_anisotropy fields: strength in [0, 1], rotation a finite float. */
+  expect("\"type\":\t\"glossy\"", "\"type\":\t\"gltf\", \"anisotropy\": 1.5", IRIS_ERR_INVALID, "materials[1]",
+         "anisotropy 1.5 outside [0, 1]");
+  expect("\"type\":\t\"glossy\"", "\"type\":\t\"gltf\", \"anisotropy_rotation\": 1e39", IRIS_ERR_INVALID,
+         "materials[1]", "anisotropy_rotation");
+  expect("\"type\":\t\"glossy\"", "\"type\":\t\"gltf\", \"anisotropy_texture\": 7", IRIS_ERR_INVALID,
+         "materials[1]", "anisotropy_texture 7 out of range");
   expect("\"t.png\"", "\"missing.png\"", IRIS_ERR_IO, "textures[0]", "cannot find texture file");
   expect("\"t.png\"", "\"scene.json\"", IRIS_ERR_UNSUPPORTED, "textures[0]", "not a PNG or JPEG");
   /* Cameras and lights. */

@@ -69,6 +69,9 @@ static void compare_scenes(const iris_scene *a, const iris_scene *b) {
       CHECK(same_floats(&x->specular, &y->specular, 1));
       CHECK(same_floats(x->specular_color, y->specular_color, 3));
       CHECK(same_floats(&x->transmission, &y->transmission, 1));
+      CHECK(same_floats(&x->anisotropy, &y->anisotropy, 1));
+      CHECK(same_floats(&x->anisotropy_rotation, &y->anisotropy_rotation, 1));
+      CHECK_EQ_INT(x->anisotropy_texture, y->anisotropy_texture);
     }
   }
   for (size_t i = 0; i < a->mesh_count && i < b->mesh_count; i++) {
