@@ -64,9 +64,10 @@ iris_vec3 iris_integrator_volume_transmittance(const iris_integrator *it, const 
 /* KHR_materials_clearcoat / _sheen values at the point (textures applied) into
  * the BSDF; the coat normal is the unmapped shading normal or the coat's own
  * normal map, expressed in the shading frame. Only for materials that have them. */
-static void shade_layers(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
+static bool shade_layers(const iris_integrator *it, const iris_material *m, const iris_interaction *si,
                          iris_shading_point *sp) {
   float t[4];
+  bool coat_mapped = false;
   if (m->clearcoat > 0.0f) {
     float cc = m->clearcoat, ccr = m->clearcoat_roughness;
     if (m->clearcoat_texture >= 0) {
@@ -78,7 +79,7 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
       ccr *= t[1];
     }
     iris_vec3 cn = si->ns;
-    const bool coat_mapped = m->clearcoat_normal_texture >= 0 && si->has_tangent;
+    coat_mapped = m->clearcoat_normal_texture >= 0 && si->has_tangent;
     if (coat_mapped) {
       iris_texture_sample(it->textures, m->clearcoat_normal_texture, si->uv, si->uv1, false, t);
       cn = iris_normal_map_apply(si->tangent, si->bitangent, si->ns, t, m->clearcoat_normal_scale);
@@ -110,6 +111,7 @@ static void shade_layers(const iris_integrator *it, const iris_material *m, cons
   }
   sp->lobes = iris_bsdf_lobes(&sp->bsdf);
   sp->delta = iris_bsdf_is_delta(&sp->bsdf);
+  return coat_mapped;
 }
 
 /* KHR_materials_transmission / _specular textures at the point, into the BSDF
@@ -218,10 +220,11 @@ void iris_integrator_shade(const iris_integrator *it, const iris_interaction *si
   }
   sp->frame = iris_frame_from_normal(sp->si.ns);
   sp->wo_local = iris_frame_to_local(&sp->frame, wo);
-  if (m->type == IRIS_MATERIAL_GLTF && (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f))
-    shade_layers(it, m, si, sp);
-  if (m->type == IRIS_MATERIAL_GLTF && m->anisotropy > 0.0f && si->has_tangent) shade_anisotropy(it, m, si, sp);
-  mapped = mapped || (m->clearcoat > 0.0f && m->clearcoat_normal_texture >= 0 && si->has_tangent);
+  if (m->type == IRIS_MATERIAL_GLTF) {
+    if (m->clearcoat > 0.0f || iris_max3(iris_v3_load(m->sheen_color)) > 0.0f)
+      mapped = shade_layers(it, m, si, sp) || mapped; /* a coat normal map folds too */
+    if (m->anisotropy > 0.0f && si->has_tangent) shade_anisotropy(it, m, si, sp);
+  }
   sp->fold = mapped && !(sp->lobes & IRIS_LOBE_TRANSMISSION);
 }
 
@@ -252,25 +255,11 @@ static bool fold_term(const iris_shading_point *sp, iris_vec3 wi, iris_vec3 *ml)
   return sp->bsdf.clearcoat > 0.0f && iris_dot(*ml, sp->bsdf.coat_n) > 0.0f;
 }
 
-bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
-                                 iris_direction_sample *out) {
-  float u_lobe = iris_sampler_slot(rng, IRIS_SLOT_LOBE);
-  float u0, u1;
-  iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u0, &u1);
-  return iris_integrator_sample_bsdf_u(sp, u_lobe, u0, u1, out);
-}
-
-bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, float u0, float u1,
-                                   iris_direction_sample *out) {
-  struct iris_bsdf_sample bs;
-  if (!iris_bsdf_sample(&sp->bsdf, sp->wo_local, u_lobe, u0, u1, &bs)) return false;
-  if (!(bs.pdf > 0.0f)) return false;
-  out->wi = iris_normalize(iris_frame_to_world(&sp->frame, bs.wi));
-  out->f = bs.f;
-  out->pdf = bs.pdf;
-  out->lobe = bs.lobe;
-  out->delta = (bs.lobe & IRIS_LOBE_DELTA) != 0;
-  if (!sp->fold) return true;
+/* A BSDF sample at a folded point into the folded BSDF's sample (out holds the
+ * unfolded one). Kept out of line: only normal-mapped points come here. */
+__attribute__((noinline)) static bool fold_sample(const iris_shading_point *sp, const struct iris_bsdf_sample *sample,
+                                                  iris_direction_sample *out) {
+  const struct iris_bsdf_sample bs = *sample;
   /* docs/rendering.md, "Normal maps": the folded BSDF. A non-delta sample's
    * f and pdf are the BSDF's value and density at bs.wi (iris_bsdf_sample's
    * contract), so only the other term of each sum is evaluated. */
@@ -297,7 +286,36 @@ bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, f
   return true;
 }
 
-iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) {
+/* The body of both entry points below, inlined into each (the path loop calls the
+ * first once per vertex). */
+static inline bool sample_bsdf(const iris_shading_point *sp, float u_lobe, float u0, float u1,
+                               iris_direction_sample *out) {
+  struct iris_bsdf_sample bs;
+  if (!iris_bsdf_sample(&sp->bsdf, sp->wo_local, u_lobe, u0, u1, &bs)) return false;
+  if (!(bs.pdf > 0.0f)) return false;
+  out->wi = iris_normalize(iris_frame_to_world(&sp->frame, bs.wi));
+  out->f = bs.f;
+  out->pdf = bs.pdf;
+  out->lobe = bs.lobe;
+  out->delta = (bs.lobe & IRIS_LOBE_DELTA) != 0;
+  return sp->fold ? fold_sample(sp, &bs, out) : true;
+}
+
+bool iris_integrator_sample_bsdf(const iris_shading_point *sp, iris_sampler *rng,
+                                 iris_direction_sample *out) {
+  float u_lobe = iris_sampler_slot(rng, IRIS_SLOT_LOBE);
+  float u0, u1;
+  iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u0, &u1);
+  return sample_bsdf(sp, u_lobe, u0, u1, out);
+}
+
+bool iris_integrator_sample_bsdf_u(const iris_shading_point *sp, float u_lobe, float u0, float u1,
+                                   iris_direction_sample *out) {
+  return sample_bsdf(sp, u_lobe, u0, u1, out);
+}
+
+/* The body of iris_integrator_bsdf_eval, inlined into light sampling. */
+static inline iris_vec3 bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) {
   if (!direction_allowed(sp, wi)) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, wi);
   iris_vec3 f = iris_bsdf_eval(&sp->bsdf, sp->wo_local, wl);
@@ -307,6 +325,8 @@ iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) 
   if (!(c > FOLD_MIN_COS)) return iris_v3(0, 0, 0);
   return iris_add(f, iris_scale(iris_bsdf_eval(&sp->bsdf, sp->wo_local, ml), fabsf(ml.z) / c));
 }
+
+iris_vec3 iris_integrator_bsdf_eval(const iris_shading_point *sp, iris_vec3 wi) { return bsdf_eval(sp, wi); }
 
 float iris_integrator_bsdf_pdf(const iris_shading_point *sp, iris_vec3 wi) {
   if (!sp->fold) return iris_bsdf_pdf(&sp->bsdf, sp->wo_local, iris_frame_to_local(&sp->frame, wi));
@@ -378,7 +398,7 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   }
   if (guided < 0 && !iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls))
     return iris_v3(0, 0, 0);
-  iris_vec3 f = iris_integrator_bsdf_eval(sp, ls.wi);
+  iris_vec3 f = bsdf_eval(sp, ls.wi);
   if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
   iris_ray shadow;
