@@ -75,6 +75,43 @@ def gltf_to_blender(p):
     return (p[0], -p[2], p[1])  # the add-on's +Y-up -> +Z-up
 
 
+def cycles_settings(sc, spp, threads, width, height, exr):
+    """The fair-comparison Cycles settings (docs/export.md): CPU, fixed spp, seed 1, box filter,
+    64 bounces of every kind, no clamping, caustics, no denoising, Standard view, a 32-bit
+    RGB EXR at `exr`. Also used by glass_lamp_compare.py."""
+    r, c = sc.render, sc.cycles
+    r.engine = "CYCLES"
+    c.device = "CPU"
+    c.feature_set = "SUPPORTED"
+    c.samples = spp
+    c.use_adaptive_sampling = False
+    c.seed = 1
+    c.pixel_filter_type = "BOX"
+    for k in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+              "volume_bounces", "transparent_max_bounces"):
+        setattr(c, k, 64)
+    c.min_light_bounces = 0
+    c.light_sampling_threshold = 0.0
+    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
+    c.blur_glossy = 0.0
+    c.caustics_reflective = c.caustics_refractive = True
+    c.use_fast_gi = False
+    c.use_denoising = False
+    for vl in sc.view_layers:
+        vl.cycles.use_denoising = False
+    sc.view_settings.view_transform = "Standard"
+    r.threads_mode = "FIXED"
+    r.threads = threads
+    r.resolution_x, r.resolution_y = width, height
+    r.resolution_percentage = 100
+    r.film_transparent = False
+    st = r.image_settings
+    st.file_format = "OPEN_EXR"
+    st.color_depth = "32"
+    st.color_mode = "RGB"
+    r.filepath = exr
+
+
 def render_blender(a, model, work, eye, target, yfov):
     if not hasattr(np, "bool"):
         np.bool = bool  # Blender 3.4's glTF add-on uses np.bool (removed in numpy 1.24)
@@ -97,36 +134,9 @@ def render_blender(a, model, work, eye, target, yfov):
     cam.location = e
     cam.rotation_euler = (t - e).to_track_quat("-Z", "Z").to_euler()
     sc.camera = cam
-    r, c = sc.render, sc.cycles
-    r.engine = "CYCLES"
-    c.device = "CPU"
-    c.samples = a.spp
-    c.use_adaptive_sampling = False
-    c.seed = 1
-    c.pixel_filter_type = "BOX"
-    for k in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
-              "volume_bounces", "transparent_max_bounces"):
-        setattr(c, k, 64)
-    c.light_sampling_threshold = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.blur_glossy = 0.0
-    c.caustics_reflective = c.caustics_refractive = True
-    c.use_denoising = False
-    for vl in sc.view_layers:
-        vl.cycles.use_denoising = False
-    sc.view_settings.view_transform = "Standard"
-    r.threads_mode = "FIXED"
-    r.threads = a.threads
-    r.resolution_x = r.resolution_y = a.size
-    r.resolution_percentage = 100
-    r.film_transparent = False
-    s = r.image_settings
-    s.file_format = "OPEN_EXR"
-    s.color_depth = "32"
-    s.color_mode = "RGB"
     name = os.path.splitext(os.path.basename(model))[0]
     exr = os.path.join(work, name + "-blender.exr")
-    r.filepath = exr
+    cycles_settings(sc, a.spp, a.threads, a.size, a.size, exr)
     bpy.ops.render.render(write_still=True)
     return exr
 
@@ -182,4 +192,5 @@ def main():
         sys.stdout.flush()
 
 
-main()
+if __name__ == "__main__":
+    main()

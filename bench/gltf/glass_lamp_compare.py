@@ -21,6 +21,9 @@ import sys
 import bpy
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_gltf_compare import cycles_settings  # noqa: E402 (the fair-comparison settings)
+
 
 def args():
     import argparse
@@ -112,37 +115,7 @@ def iris_backfaces():
 def render_blender(a, sc, exr):
     if a.reuse and os.path.exists(exr) or a.skip_blender:
         return
-    r, c = sc.render, sc.cycles
-    r.engine = "CYCLES"
-    c.device = "CPU"
-    c.feature_set = "SUPPORTED"
-    c.samples = a.cycles_spp
-    c.use_adaptive_sampling = False
-    c.seed = 1
-    c.pixel_filter_type = "BOX"
-    for k in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
-              "volume_bounces", "transparent_max_bounces"):
-        setattr(c, k, 64)
-    c.min_light_bounces = 0
-    c.light_sampling_threshold = 0.0
-    c.sample_clamp_direct = c.sample_clamp_indirect = 0.0
-    c.blur_glossy = 0.0
-    c.caustics_reflective = c.caustics_refractive = True
-    c.use_fast_gi = False
-    c.use_denoising = False
-    for vl in sc.view_layers:
-        vl.cycles.use_denoising = False
-    sc.view_settings.view_transform = "Standard"
-    r.threads_mode = "FIXED"
-    r.threads = a.threads
-    r.resolution_x, r.resolution_y = a.width, a.height
-    r.resolution_percentage = 100
-    r.film_transparent = False
-    s = r.image_settings
-    s.file_format = "OPEN_EXR"
-    s.color_depth = "32"
-    s.color_mode = "RGB"
-    r.filepath = exr
+    cycles_settings(sc, a.cycles_spp, a.threads, a.width, a.height, exr)
     bpy.ops.render.render(write_still=True)
 
 
