@@ -45,6 +45,18 @@ static void add_quad(iris_scene *s, float z, int32_t material, bool with_alpha) 
 }
 
 /* mask quad at z = 0 (facing +z, black diffuse, the given alpha), emitter at z = -1 */
+/* A camera at z = 4 seeing exactly x, y in [-1, 1] of the plane z = 0. */
+static void add_front_camera(iris_scene *s) {
+  iris_camera cam;
+  memset(&cam, 0, sizeof cam);
+  cam.name = iris_strdup("front");
+  cam.to_world = iris_mat4_identity();
+  cam.to_world.m[2][3] = 4.0f;
+  cam.yfov = 2.0f * atanf(1.0f / 4.0f);
+  cam.aspect = 1.0f;
+  iris_scene_add_camera(s, &cam);
+}
+
 static iris_scene *alpha_scene(iris_alpha_mode mode, float alpha, bool gradient) {
   iris_scene *s = iris_scene_create();
   iris_material mask = iris_material_default(IRIS_MATERIAL_DIFFUSE);
@@ -60,15 +72,7 @@ static iris_scene *alpha_scene(iris_alpha_mode mode, float alpha, bool gradient)
   iris_scene_add_material(s, &light);
   add_quad(s, 0.0f, 0, gradient);
   add_quad(s, -1.0f, 1, false);
-  /* camera at z = 4 seeing exactly x, y in [-1, 1] of the mask plane */
-  iris_camera cam;
-  memset(&cam, 0, sizeof cam);
-  cam.name = iris_strdup("front");
-  cam.to_world = iris_mat4_identity();
-  cam.to_world.m[2][3] = 4.0f;
-  cam.yfov = 2.0f * atanf(1.0f / 4.0f);
-  cam.aspect = 1.0f;
-  iris_scene_add_camera(s, &cam);
+  add_front_camera(s);
   return s;
 }
 
@@ -210,14 +214,7 @@ static iris_scene *emitter_scene(iris_alpha_mode mode, float alpha) {
   iris_scene_add_material(s, &light);
   add_quad(s, 0.0f, 0, false);
   add_quad(s, 1.0f, 1, false);
-  iris_camera cam;
-  memset(&cam, 0, sizeof cam);
-  cam.name = iris_strdup("front");
-  cam.to_world = iris_mat4_identity();
-  cam.to_world.m[2][3] = 4.0f;
-  cam.yfov = 2.0f * atanf(1.0f / 4.0f);
-  cam.aspect = 1.0f;
-  iris_scene_add_camera(s, &cam);
+  add_front_camera(s);
   return s;
 }
 
