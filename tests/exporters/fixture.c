@@ -8,6 +8,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "check.h"
+#include "core/fileio.h"
+#include "core/image.h"
+
 int32_t fixture_add_quad(iris_scene *scene, const char *name, const fixture_quad *q) {
   iris_mesh m;
   memset(&m, 0, sizeof m);
@@ -128,4 +132,33 @@ char *fixture_read_text(const char *path) {
   fclose(fp);
   if (buf) buf[n] = '\0';
   return buf;
+}
+
+int32_t fixture_add_png_texture(iris_scene *scene, const char *dir, const char *name, const float texels[4][3],
+                                bool nearest) {
+  iris_image img;
+  const char *names[3] = {"R", "G", "B"};
+  iris_error err;
+  iris_error_clear(&err);
+  CHECK_OK(iris_image_create(&img, 2, 2, 3, names, &err), &err);
+  memcpy(img.data, texels, 12 * sizeof(float));
+  char path[1200];
+  snprintf(path, sizeof path, "%s/%s.png", dir, name);
+  CHECK_OK(iris_png_write(path, &img, 0, 0.0f, &err), &err);
+  iris_image_destroy(&img);
+  iris_texture t;
+  memset(&t, 0, sizeof t);
+  t.name = iris_strdup(name);
+  size_t size = 0;
+  char *data = NULL;
+  CHECK_OK(iris_file_read(path, 0, &data, &size, &err), &err);
+  t.data = (uint8_t *)data;
+  t.data_size = size;
+  snprintf(t.mime, sizeof t.mime, "image/png");
+  t.wrap_s = t.wrap_t = IRIS_WRAP_REPEAT;
+  t.nearest = nearest;
+  remove(path);
+  int32_t i = iris_scene_add_texture(scene, &t);
+  if (i < 0) abort();
+  return i;
 }

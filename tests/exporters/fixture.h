@@ -32,6 +32,12 @@ void fixture_add_top_camera(iris_scene *scene, float height, float half, float a
 void fixture_film_to_plane(float fx, float fy, int w, int h, float half, float aspect, float *x,
                            float *y);
 
+/* Adds a 2x2 RGB PNG of `texels` (top-left, top-right, bottom-left, bottom-right)
+ * held in memory, as glTF-embedded images are (the exporter writes it out);
+ * `dir` holds the temporary file. Returns its index (aborts on failure). */
+int32_t fixture_add_png_texture(iris_scene *scene, const char *dir, const char *name, const float texels[4][3],
+                                bool nearest);
+
 /* Full path of an executable found in PATH, or false. */
 bool fixture_find_tool(const char *name, char *out, size_t size);
 /* Runs a shell command; its stdout+stderr go to `log` (may be NULL). Returns

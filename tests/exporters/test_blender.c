@@ -103,34 +103,8 @@ static int32_t add_material(iris_scene *s, iris_material m, const char *name) {
 
 /* A 2x2 texture: top-left red, top-right green, bottom-left blue, bottom-right white. */
 static int32_t add_checker_texture(iris_scene *s) {
-  iris_image img;
-  const char *names[3] = {"R", "G", "B"};
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, 2, 2, 3, names, &err), &err);
   const float texel[4][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}};
-  memcpy(img.data, texel, sizeof texel);
-  char path[1200];
-  snprintf(path, sizeof path, "%s/checker.png", g_dir);
-  CHECK_OK(iris_png_write(path, &img, 0, 0.0f, &err), &err);
-  iris_image_destroy(&img);
-  /* Held in memory, as glTF-embedded images are: the exporter writes it out. */
-  iris_texture t;
-  memset(&t, 0, sizeof t);
-  t.name = iris_strdup("checker");
-  size_t size = 0;
-  char *data = NULL;
-  CHECK_OK(iris_file_read(path, 0, &data, &size, &err), &err);
-  t.data = (uint8_t *)data;
-  t.data_size = size;
-  snprintf(t.mime, sizeof t.mime, "image/png");
-  t.wrap_s = IRIS_WRAP_REPEAT;
-  t.wrap_t = IRIS_WRAP_REPEAT;
-  t.nearest = true;
-  remove(path);
-  int32_t i = iris_scene_add_texture(s, &t);
-  if (i < 0) abort();
-  return i;
+  return fixture_add_png_texture(s, g_dir, "checker", texel, true);
 }
 
 static iris_scene *cells_scene(void) {

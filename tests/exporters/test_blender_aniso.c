@@ -19,30 +19,8 @@
 
 /* A 2x2 in-memory PNG (direction RG, strength B), as glTF-embedded images are held. */
 static int32_t add_texture(iris_scene *s, const char *dir) {
-  iris_image img;
-  const char *names[3] = {"R", "G", "B"};
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, 2, 2, 3, names, &err), &err);
   const float texel[4][3] = {{1, 0.5f, 1}, {0.5f, 1, 1}, {0.5f, 0.5f, 0.5f}, {0, 0.5f, 0.25f}};
-  memcpy(img.data, texel, sizeof texel);
-  char path[1200];
-  snprintf(path, sizeof path, "%s/dir.png", dir);
-  CHECK_OK(iris_png_write(path, &img, 0, 0.0f, &err), &err);
-  iris_image_destroy(&img);
-  iris_texture t;
-  memset(&t, 0, sizeof t);
-  t.name = iris_strdup("direction");
-  size_t size = 0;
-  char *data = NULL;
-  CHECK_OK(iris_file_read(path, 0, &data, &size, &err), &err);
-  t.data = (uint8_t *)data;
-  t.data_size = size;
-  snprintf(t.mime, sizeof t.mime, "image/png");
-  remove(path);
-  int32_t i = iris_scene_add_texture(s, &t);
-  if (i < 0) abort();
-  return i;
+  return fixture_add_png_texture(s, dir, "direction", texel, false);
 }
 
 static iris_scene *aniso_scene(const char *dir) {
