@@ -1,7 +1,8 @@
 /* Private to the glTF importer: the conversion context shared by the
- * geometry/scene converter (gltf_convert.c) and the material converter
- * (gltf_material.c), the glTF numeric codes, and the functions each offers
- * the other. Not a public interface. */
+ * accessor/primitive converter (gltf_convert.c), the node placement
+ * (gltf_nodes.c), the material converter (gltf_material.c) and the variants
+ * (gltf_variants.c), the glTF numeric codes, and the functions each offers
+ * the others. Not a public interface. */
 #ifndef IRIS_IMPORTERS_GLTF_PRIVATE_H
 #define IRIS_IMPORTERS_GLTF_PRIVATE_H
 
@@ -107,6 +108,19 @@ iris_status gltf_check_range(gltf_ctx *c, const char *el, const char *what, doub
                              double hi);
 
 #define ELEMENT(buf, ...) snprintf(buf, sizeof buf, __VA_ARGS__)
+
+/* Reads a (validated) accessor into count * ncomp floats, applying sparse substitution. */
+void gltf_read_floats(const iris_gltf_doc *d, const iris_gltf_accessor *a, int ncomp, float *out);
+
+/* ---- gltf_nodes.c ---------------------------------------------------------- */
+
+/* Cameras (perspective yfov/aspect, type) and KHR_lights_punctual lights checked. */
+iris_status gltf_validate_cameras_lights(gltf_ctx *c);
+/* c->parent filled: every node reference checked, one parent per node, no cycles. */
+iris_status gltf_validate_node_graph(gltf_ctx *c);
+/* Walks the default scene (else every root) in pre-order filling c->world, and
+ * adds the mesh instances, lights and cameras (the chosen one first). */
+iris_status gltf_place_nodes(gltf_ctx *c);
 
 /* ---- gltf_material.c ------------------------------------------------------ */
 
