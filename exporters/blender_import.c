@@ -1,6 +1,6 @@
 /* The script for Blender's own glTF importer (exporters/blender.h,
  * iris_export_blender_import; docs/validation.md, --blender-import): the
- * common prelude of blender.c, then the functions below, which import the file
+ * common prelude (blender_prelude.c), then the functions below, which import the file
  * with bpy.ops.import_scene.gltf, record what the importer created and render
  * it under iris's camera and world. */
 #include <errno.h>

@@ -1,5 +1,6 @@
 /* Internal to exporters/: the pieces of a Blender script that blender.c and
- * blender_import.c share (the Python prelude and literal writers). */
+ * blender_import.c share (the Python prelude of blender_prelude.c and the
+ * literal writers of blender.c). */
 #ifndef IRIS_EXPORTERS_BLENDER_SCRIPT_H
 #define IRIS_EXPORTERS_BLENDER_SCRIPT_H
 

@@ -1,6 +1,6 @@
 /* bench/export/gltf_residual: how far Cycles' rendering of an exported glTF
  * metallic-roughness material is from iris's, per material class, for the two
- * Blender mappings of exporters/blender.c: the Appendix B node tree (default)
+ * Blender mappings of exporters/blender_prelude.c: the Appendix B node tree (default)
  * and the Principled BSDF (params.gltf_principled). One image holds ten unit
  * spheres with white base colour under a uniform white sky (radiance 1) seen
  * by a distant camera (yfov 3 degrees, nearly orthographic): the disc mean is a

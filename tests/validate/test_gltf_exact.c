@@ -1,6 +1,6 @@
 /* validate.gltf_exact: glTF scenes whose materials Cycles can reproduce exactly,
  * written as real .gltf files, imported by iris, exported to Blender (the
- * Appendix B node tree of exporters/blender.c) and rendered by real Blender
+ * Appendix B node tree of exporters/blender_prelude.c) and rendered by real Blender
  * (SKIP without it), through iris_validate_run: every channel's mean within 1%
  * of iris and the 8x8 block z-test passing.
  *   room:  a Lambert-only room (specularFactor 0: imported as `diffuse`)
