@@ -198,6 +198,13 @@ static iris_status abandon_build(iris_accel *a, iris_error *err) {
   return st;
 }
 
+/* Commits an Embree scene; false when the user interrupted the build or Embree
+ * failed (the caller then abandons the build). */
+static bool commit_scene(iris_accel *a, RTCScene s) {
+  rtcCommitScene(s);
+  return !iris_cancel_requested() && !rtc_failed(a);
+}
+
 static iris_status nomem(iris_accel *a, iris_error *err, const char *what) {
   iris_status st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for %s", what);
   iris_accel_destroy(a);
@@ -513,8 +520,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
           rtcAttachGeometry(am->rtc, mg);
           rtcReleaseGeometry(mg);
         }
-        rtcCommitScene(am->rtc);
-        if (iris_cancel_requested() || rtc_failed(a)) return abandon_build(a, err);
+        if (!commit_scene(a, am->rtc)) return abandon_build(a, err);
         a->unique_meshes++;
       }
       snprintf(a->building, sizeof a->building, "instance %zu of %s", i,
@@ -536,8 +542,7 @@ iris_status iris_accel_build(const iris_scene *scene, iris_accel **out, iris_err
   }
   snprintf(a->building, sizeof a->building, "the top-level BVH (%zu placements, %u triangles)",
            a->instance_count, a->triangle_count);
-  rtcCommitScene(a->rtc);
-  if (iris_cancel_requested() || rtc_failed(a)) return abandon_build(a, err);
+  if (!commit_scene(a, a->rtc)) return abandon_build(a, err);
   a->building[0] = '\0';
   a->has_bounds = prims > 0;
   a->lo = lo;
