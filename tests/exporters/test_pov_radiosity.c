@@ -19,6 +19,7 @@
 #include "core/image.h"
 #include "exporters/pov.h"
 #include "fixture.h"
+#include "render_run.h"
 #include "renderer/film.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
@@ -63,15 +64,8 @@ static bool pov_image(const iris_scene *scene, const char *tag, iris_pov_radiosi
 }
 
 static bool iris_image_of(const iris_scene *scene, int w, int h, int spp, iris_image *img) {
-  iris_render_params rp = iris_render_params_default();
-  rp.width = w, rp.height = h, rp.spp = spp, rp.seed = 1;
-  iris_render_result rr;
-  iris_error err;
-  iris_error_clear(&err);
-  if (!CHECK(iris_render(scene, &rp, &rr, &err) == IRIS_OK)) return false;
-  bool ok = CHECK(iris_film_to_image(&rr.film, false, img, &err) == IRIS_OK);
-  iris_render_result_destroy(&rr);
-  return ok;
+  iris_render_params rp = iris_test_params(w, h, spp, IRIS_METHOD_COUNT, 1); /* the scene's method */
+  return CHECK(iris_test_render_image(scene, &rp, false, img));
 }
 
 static void means(const iris_image *img, const unsigned char *mask, double m[3]) {

@@ -44,14 +44,9 @@ static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision
 /* Renders `s` with `method` (spp samples, w x h); pilot: -1 auto, 0 none. */
 static bool render(const iris_scene *s, iris_method method, int w, int h, int spp, uint64_t seed, int64_t pilot,
                    iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(w, h, spp, method, seed);
   iris_guiding_params gp = iris_guiding_params_default();
   gp.pilot_paths = pilot;
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = method;
-  p.seed = seed;
   p.threads = 2;
   p.guide = &KEEP;
   p.guide_options = &gp;

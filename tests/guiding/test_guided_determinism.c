@@ -42,19 +42,14 @@ static bool same_guide(const iris_guiding *a, const iris_guiding *b) {
 }
 
 static bool render(const iris_scene *s, int threads, bool keep, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  /* 40 x 30: not a multiple of the 8-pixel tiles */
+  iris_render_params p = iris_test_params(40, 30, 6, IRIS_METHOD_GUIDED_NEE, 5);
   p.keep_training = keep; /* the training samples in the image, or not */
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 3; /* the render trains its guide too */
-  p.width = 40;
-  p.height = 30; /* not a multiple of the 8-pixel tiles */
-  p.spp = 6;
   p.threads = threads;
-  p.seed = 5;
-  p.method = IRIS_METHOD_GUIDED_NEE;
-  p.guide = &iris_guiding_provider;
-  p.guide_options = &gp;
+  iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
 }
 

@@ -39,7 +39,7 @@ typedef struct variant {
 
 static bool render(const iris_scene *s, const variant *v, int w, int h, int spp, uint64_t seed,
                    iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(w, h, spp, v->method, seed);
   iris_guiding_params gp = iris_guiding_params_default();
   if (v->alpha_max > 0.0f) gp.alpha_max = v->alpha_max;
   gp.splat = v->splat;
@@ -49,13 +49,7 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   gp.force = true; /* exercise the guide even where the budget would skip it (Veach) */
   if (v->keep) p.keep_training = v->keep > 0;
   if (v->sky_extreme) gp.sky_beta = 1.0f, gp.sky_regions = 32, gp.sky_probes = 1;
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = v->method;
-  p.seed = seed;
-  p.guide = &iris_guiding_provider;
-  p.guide_options = &gp;
+  iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
 }
 

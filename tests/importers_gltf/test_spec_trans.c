@@ -31,6 +31,7 @@
 #include "renderer/texture.h"
 #include "scene/scene.h"
 #include "tests/common/check.h"
+#include "tests/common/render_run.h"
 
 #define EXPECT(cond, ...) iris_check_record(!!(cond), __FILE__, __LINE__, __VA_ARGS__)
 #define W 24
@@ -241,24 +242,9 @@ static int check_shade(const iris_scene *s) {
 
 /* Mean radiance of the image (the quad fills it). */
 static bool render_mean(const iris_scene *s, double mean[3]) {
-  iris_render_params p = iris_render_params_default();
-  p.width = p.height = W;
-  p.spp = 64;
+  iris_render_params p = iris_test_params(W, W, 64, IRIS_METHOD_COUNT, 5); /* the scene's method */
   p.max_depth = 8;
-  p.seed = 5;
-  iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  if (!ok_call(iris_render(s, &p, &r, &err), &err)) return false;
-  mean[0] = mean[1] = mean[2] = 0;
-  for (int y = 0; y < W; y++)
-    for (int x = 0; x < W; x++) {
-      iris_vec3 c, v;
-      iris_film_pixel(&r.film, x, y, &c, &v);
-      mean[0] += c.x / (W * W), mean[1] += c.y / (W * W), mean[2] += c.z / (W * W);
-    }
-  iris_render_result_destroy(&r);
-  return true;
+  return CHECK(iris_test_render_mean(s, &p, mean, NULL));
 }
 
 static bool find_blender(char *out, size_t size) {

@@ -19,30 +19,14 @@
 #include "renderer/render.h"
 #include "scene/scene.h"
 #include "tests/common/check.h"
+#include "tests/common/render_run.h"
 
 #define EXPECT(cond, ...) iris_check_record(!!(cond), __FILE__, __LINE__, __VA_ARGS__)
 #define W 40
 
 static bool render(const iris_scene *s, iris_method m, iris_vec3 *pix) {
-  iris_render_params p = iris_render_params_default();
-  p.width = p.height = W;
-  p.spp = 16;
-  p.method = m;
-  p.seed = 3;
-  iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, &r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  for (int y = 0; y < W; y++)
-    for (int x = 0; x < W; x++) {
-      iris_vec3 v;
-      iris_film_pixel(&r.film, x, y, &pix[y * W + x], &v);
-    }
-  iris_render_result_destroy(&r);
-  return true;
+  iris_render_params p = iris_test_params(W, W, 16, m, 3);
+  return iris_test_render_pixels(s, &p, pix);
 }
 
 /* Largest difference between the unlit quads' pixels and their colours. */

@@ -18,6 +18,7 @@
 #include "renderer/render.h"
 #include "scene/scene.h"
 #include "tests/common/check.h"
+#include "tests/common/render_run.h"
 
 #include <meshoptimizer.h>
 
@@ -394,23 +395,8 @@ static bool render_file(const char *name, iris_vec3 *pix, int w) {
   cam.yfov = 0.5f;
   cam.aspect = 1.0f;
   iris_scene_add_camera(s, &cam);
-  iris_render_params p = iris_render_params_default();
-  p.width = p.height = w;
-  p.spp = 8;
-  p.seed = 5;
-  p.method = IRIS_METHOD_MIS;
-  iris_render_result r;
-  iris_error e;
-  iris_error_clear(&e);
-  bool ok = iris_render(s, &p, &r, &e) == IRIS_OK;
-  CHECK_OK(ok ? IRIS_OK : e.status, &e);
-  if (ok) {
-    for (int i = 0; i < w * w; i++) {
-      iris_vec3 v;
-      iris_film_pixel(&r.film, i % w, i / w, &pix[i], &v);
-    }
-    iris_render_result_destroy(&r);
-  }
+  iris_render_params p = iris_test_params(w, w, 8, IRIS_METHOD_MIS, 5);
+  bool ok = CHECK(iris_test_render_pixels(s, &p, pix));
   iris_scene_destroy(s);
   return ok;
 }

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "core/fileio.h"
 #include "core/rng.h"
 #include "renderer/guiding/guiding.h"
@@ -205,30 +206,21 @@ static iris_guiding_params g_gp;
 static iris_light_sampler g_light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT; /* of every render_to */
 
 static bool render_to(const iris_scene *s, job j, const char *name, iris_render_result *keep) {
-  iris_render_params p = iris_render_params_default();
-  p.width = 40;
-  p.height = 24; /* not a multiple of the 8-pixel tiles */
-  p.spp = j.spp;
-  p.seed = j.seed;
-  p.method = j.method;
+  /* 40 x 24: not a multiple of the 8-pixel tiles */
+  iris_render_params p = iris_test_params(40, 24, j.spp, j.method, j.seed);
   p.max_depth = j.max_depth;
   p.threads = j.threads;
   p.sample_offset = j.offset;
   p.bounds = j.bounds;
   p.light_sampler = g_light_sampler;
-  if (iris_method_uses_guiding(j.method)) {
-    p.guide = &iris_guiding_provider;
-    p.guide_options = &g_gp;
-  }
+  iris_test_attach_guide(&p, &g_gp);
   iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  iris_status st = iris_render(s, &p, &r, &err);
-  CHECK_OK(st, &err);
-  if (st != IRIS_OK) return false;
+  if (!CHECK(iris_test_render(s, &p, &r))) return false;
   char path[600];
   path_in(path, sizeof path, name);
-  st = iris_render_write_exr(&r, path, "test", true, &err);
+  iris_error err;
+  iris_error_clear(&err);
+  iris_status st = iris_render_write_exr(&r, path, "test", true, &err);
   CHECK_OK(st, &err);
   if (keep)
     *keep = r;

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/accel.h"
 #include "renderer/render.h"
 
@@ -121,29 +122,14 @@ static void test_rays(void) {
 
 static bool render_mean(const iris_scene *s, iris_method m, int threads, double *mean, double *sigma,
                         iris_film *keep) {
-  iris_render_params p = iris_render_params_default();
-  p.width = p.height = 32;
-  p.spp = 64;
-  p.method = m;
+  iris_render_params p = iris_test_params(32, 32, 64, m, 7);
   p.threads = threads;
-  p.seed = 7;
   iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, &r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
-  double sum = 0, var = 0;
-  for (int y = 0; y < 32; y++)
-    for (int x = 0; x < 32; x++) {
-      iris_vec3 mu, v;
-      iris_film_pixel(&r.film, x, y, &mu, &v);
-      sum += mu.y;
-      var += v.y;
-    }
-  *mean = sum / 1024.0;
-  *sigma = sqrt(var) / 1024.0;
+  if (!iris_test_render(s, &p, &r)) return false;
+  double mu[3], var[3];
+  region(&r.film, 0, 0, 32, 32, mu, var);
+  *mean = mu[1];
+  *sigma = sqrt(var[1]);
   if (keep) {
     *keep = r.film;
     memset(&r.film, 0, sizeof r.film);

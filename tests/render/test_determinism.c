@@ -10,13 +10,9 @@
 
 static bool render(const iris_scene *s, int threads, uint64_t seed, iris_method m,
                    iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
-  p.width = 40;
-  p.height = 24; /* not a multiple of the 8-pixel tiles */
-  p.spp = 12;
+  /* 40 x 24: not a multiple of the 8-pixel tiles */
+  iris_render_params p = iris_test_params(40, 24, 12, m, seed);
   p.threads = threads;
-  p.seed = seed;
-  p.method = m;
   return iris_test_render(s, &p, r);
 }
 

@@ -25,21 +25,13 @@
 
 static bool render(const iris_scene *s, iris_method m, int w, int h, int spp, uint64_t seed,
                    iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(w, h, spp, m, seed);
   /* guided-nee would skip guiding here (the scene is lit mostly directly):
    * forced, so that MIS of the map, the guide and the BSDF is what is tested */
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
   gp.photons = 100000;
-  if (iris_method_uses_guiding(m)) {
-    p.guide = &iris_guiding_provider;
-    p.guide_options = &gp;
-  }
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
-  p.seed = seed;
+  iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
 }
 

@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "chi2.h"
 #include "core/fileio.h"
 #include "core/image.h"
@@ -261,19 +262,13 @@ static void test_furnace(const char *uniform) {
       iris_scene_set_environment_color(s, one);
     }
     for (int m = 0; m < IRIS_METHOD_COUNT; m++) {
-      iris_render_params p = iris_render_params_default();
-      p.width = p.height = 16;
-      p.spp = 32;
+      iris_render_params p = iris_test_params(16, 16, 32, (iris_method)m, 0);
       p.threads = 2;
-      p.method = (iris_method)m;
       iris_guiding_params gp = iris_guiding_params_default();
       gp.photons = 20000;
-      if (iris_method_uses_guiding(p.method)) {
-        p.guide = &iris_guiding_provider;
-        p.guide_options = &gp;
-      }
+      iris_test_attach_guide(&p, &gp);
       iris_render_result res;
-      CHECK_OK(iris_render(s, &p, &res, &err), &err);
+      CHECK(iris_test_render(s, &p, &res));
       /* pixel by pixel: everything between rho (sphere) and 1 (sky; silhouette
        * pixels mix both), the centre rho and the corners 1 within 5 sigma */
       iris_image img;
@@ -321,17 +316,10 @@ static void test_determinism(const char *map) {
     gp.photons = 20000;
     gp.force = true;
     for (int t = 0; t < 2; t++) {
-      iris_render_params p = iris_render_params_default();
-      p.width = p.height = 12;
-      p.spp = 8;
+      iris_render_params p = iris_test_params(12, 12, 8, (iris_method)m, 42);
       p.threads = t + 1;
-      p.seed = 42;
-      p.method = (iris_method)m;
-      if (iris_method_uses_guiding(p.method)) {
-        p.guide = &iris_guiding_provider;
-        p.guide_options = &gp;
-      }
-      CHECK_OK(iris_render(s, &p, &r[t], &err), &err);
+      iris_test_attach_guide(&p, &gp);
+      CHECK(iris_test_render(s, &p, &r[t]));
     }
     size_t n = 3 * (size_t)r[0].film.width * (size_t)r[0].film.height;
     iris_check_record(memcmp(r[0].film.sum, r[1].film.sum, n * sizeof(double)) == 0 &&

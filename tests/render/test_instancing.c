@@ -273,18 +273,12 @@ static iris_scene *make_scene(bool baked, const char *normal_map, int light_plac
 
 static bool render(const iris_scene *s, iris_method method, int w, int h, int spp, int threads,
                    iris_pixel_bounds bounds, uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(w, h, spp, method, seed);
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = method;
-  p.seed = seed;
   p.threads = threads;
   p.bounds = bounds;
-  p.guide = &iris_guiding_provider;
-  p.guide_options = &gp;
+  iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
 }
 

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 
@@ -21,20 +22,10 @@ typedef struct stats {
 /* Renders and averages the pixels with mask(x, y) (NULL: all). */
 static bool render_stats(const iris_scene *s, iris_method m, int w, int h, int spp, int max_depth,
                          uint64_t seed, stats *out) {
-  iris_render_params p = iris_render_params_default();
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
+  iris_render_params p = iris_test_params(w, h, spp, m, seed);
   p.max_depth = max_depth;
-  p.seed = seed;
   iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, &r, &err) != IRIS_OK) {
-    fprintf(stderr, "render failed: %s\n", err.message);
-    return false;
-  }
+  if (!iris_test_render(s, &p, &r)) return false;
   memset(out, 0, sizeof *out);
   out->min_px = 1e30;
   out->max_px = -1e30;

@@ -217,12 +217,7 @@ static void check_point(const iris_light_tree *t, const iris_light_bounds *l, si
 
 static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
-  p.seed = seed;
+  iris_render_params p = iris_test_params(w, h, spp, m, seed);
   p.threads = threads;
   p.light_sampler = ls;
   return iris_test_render(s, &p, r);

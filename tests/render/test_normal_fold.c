@@ -304,16 +304,11 @@ static iris_scene *make_scene(const char *map, int mat) {
 }
 
 static bool render(const iris_scene *s, iris_method method, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(40, 40, 32, method, 3);
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
-  p.width = p.height = 40;
-  p.spp = 32;
-  p.method = method;
-  p.seed = 3;
   p.threads = 2;
-  p.guide = &iris_guiding_provider;
-  p.guide_options = &gp;
+  iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
 }
 

@@ -23,13 +23,8 @@
 
 static bool render(const iris_scene *s, iris_method m, iris_sampler_kind k, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
+  iris_render_params p = iris_test_params(w, h, spp, m, seed);
   p.sampler = k;
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
-  p.seed = seed;
   return iris_test_render(s, &p, r);
 }
 

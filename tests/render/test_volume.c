@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/render.h"
 
 static void add_mesh(iris_scene *s, const float *p, size_t nv, const uint32_t *idx, size_t nt, int32_t mat) {
@@ -63,27 +64,12 @@ static void check(float distance, const double want[3]) {
   iris_scene *s = volume_scene(distance);
   const iris_method methods[3] = {IRIS_METHOD_BSDF, IRIS_METHOD_NEE, IRIS_METHOD_MIS};
   for (int k = 0; k < 3; k++) {
-    iris_render_params p = iris_render_params_default();
-    p.width = p.height = 8;
-    p.spp = 4;
-    p.method = methods[k];
-    iris_render_result r;
-    iris_error err;
-    iris_error_clear(&err);
-    iris_status st = iris_render(s, &p, &r, &err);
-    CHECK_OK(st, &err);
-    if (st != IRIS_OK) continue;
-    double sum[3] = {0, 0, 0};
-    for (int y = 0; y < 8; y++)
-      for (int x = 0; x < 8; x++) {
-        iris_vec3 mu, v;
-        iris_film_pixel(&r.film, x, y, &mu, &v);
-        sum[0] += mu.x, sum[1] += mu.y, sum[2] += mu.z;
-      }
+    iris_render_params p = iris_test_params(8, 8, 4, methods[k], 0);
+    double mean[3];
+    if (!CHECK(iris_test_render_mean(s, &p, mean, NULL))) continue;
     printf("  distance %g %-4s: %.5f %.5f %.5f (expected %.5f %.5f %.5f)\n", (double)distance,
-           iris_method_name(methods[k]), sum[0] / 64, sum[1] / 64, sum[2] / 64, want[0], want[1], want[2]);
-    for (int c = 0; c < 3; c++) CHECK_NEAR(sum[c] / 64, want[c], 2e-4);
-    iris_render_result_destroy(&r);
+           iris_method_name(methods[k]), mean[0], mean[1], mean[2], want[0], want[1], want[2]);
+    for (int c = 0; c < 3; c++) CHECK_NEAR(mean[c], want[c], 2e-4);
   }
   iris_scene_destroy(s);
 }

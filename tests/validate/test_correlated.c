@@ -16,6 +16,7 @@
 #include <stdlib.h>
 
 #include "check.h"
+#include "render_run.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 #include "validate/metrics.h"
@@ -25,23 +26,9 @@
 #define B 4
 
 static bool render(const iris_scene *s, iris_sampler_kind k, int spp, uint64_t seed, iris_image *out) {
-  iris_render_params p = iris_render_params_default();
-  p.width = W;
-  p.height = H;
-  p.spp = spp;
-  p.seed = seed;
+  iris_render_params p = iris_test_params(W, H, spp, IRIS_METHOD_MIS, seed);
   p.sampler = k;
-  p.method = IRIS_METHOD_MIS;
-  iris_render_result r;
-  iris_error err;
-  iris_error_clear(&err);
-  if (iris_render(s, &p, &r, &err) != IRIS_OK) {
-    fprintf(stderr, "render: %s\n", err.message);
-    return false;
-  }
-  bool ok = iris_film_to_image(&r.film, true, out, &err) == IRIS_OK;
-  iris_render_result_destroy(&r);
-  return ok;
+  return iris_test_render_image(s, &p, true, out);
 }
 
 int main(void) {
