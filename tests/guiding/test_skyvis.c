@@ -21,31 +21,12 @@
 #include "chi2.h"
 #include "core/fileio.h"
 #include "core/image.h"
+#include "exr_map.h"
 #include "guide_fixture.h"
 #include "renderer/envmap.h"
 #include "renderer/guiding/skyvis.h"
 #include "scenes/builtin.h"
 #include "scenes/sky.h"
-
-static void write_map(const char *path, int w, int h) {
-  static const char *const rgb[3] = {"R", "G", "B"};
-  iris_image img;
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, w, h, 3, rgb, &err), &err);
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      float *p = &img.data[3 * ((size_t)y * (size_t)w + (size_t)x)];
-      float v = 0.05f + 0.5f * (float)x / (float)w + 0.2f * (float)y / (float)h;
-      if (y == 0 || y == h - 1) v = 0.0f;                                        /* black polar rows */
-      if (x >= w / 3 && x < w / 3 + 2 && y >= h / 4 && y < h / 4 + 2) v = 300.0f; /* a sun */
-      p[0] = v;
-      p[1] = 0.7f * v;
-      p[2] = 0.3f * v + 0.01f;
-    }
-  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
-  iris_image_destroy(&img);
-}
 
 typedef struct region_ctx {
   const iris_envmap *env;
@@ -267,7 +248,7 @@ int main(void) {
   char dir[1024], path[1100];
   if (iris_test_tmpdir(dir, sizeof dir, "skyvis") != 0) return TEST_SKIP("no temporary folder");
   snprintf(path, sizeof path, "%s/map.exr", dir);
-  write_map(path, 61, 29);
+  iris_test_write_sun_map(path, 61, 29, 0.2f, 2, 300.0f);
   test_regions_and_mixture(path);
   test_built_from_scene();
   return iris_check_summary("guiding.skyvis");

@@ -19,6 +19,7 @@
 #include "check.h"
 #include "cli_run.h"
 #include "core/image.h"
+#include "exr_map.h"
 
 static const char *iris_bin, *assets;
 static char dir[512];
@@ -46,18 +47,18 @@ static int count(const char *hay, const char *needle) {
   return n;
 }
 
+/* 0.5 + 0.01 (i % 7) for channel value i, with `bad` (unless 0) in G of texel (2, 1). */
+static void map_texel(void *ctx, int x, int y, int w, int h, float p[3]) {
+  (void)h;
+  float bad = *(const float *)ctx;
+  for (int k = 0; k < 3; k++) p[k] = 0.5f + 0.01f * (float)((3 * (y * w + x) + k) % 7);
+  if (bad != 0.0f && x == 2 && y == 1) p[1] = bad;
+}
+
 static void write_map(const char *name, int w, int h, float bad) {
-  static const char *const rgb[3] = {"R", "G", "B"};
   char path[1024];
   snprintf(path, sizeof path, "%s/%s", dir, name);
-  iris_image img;
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, w, h, 3, rgb, &err), &err);
-  for (int i = 0; i < 3 * w * h; i++) img.data[i] = 0.5f + 0.01f * (float)(i % 7);
-  if (bad != 0.0f) img.data[3 * (w + 2) + 1] = bad;
-  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
-  iris_image_destroy(&img);
+  iris_test_write_exr_map(path, w, h, map_texel, &bad);
 }
 
 static void write_text(const char *name, const char *text) {

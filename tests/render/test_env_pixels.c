@@ -24,6 +24,7 @@
 #include "check.h"
 #include "cli_run.h"
 #include "core/image.h"
+#include "exr_map.h"
 
 #define MAP_W 64
 #define MAP_H 32
@@ -52,22 +53,12 @@ static float rnd(void) {
   return (float)((lcg >> 40) & 0xFFFFFF) / 16777216.0f;
 }
 
-static void write_map(const char *path) {
-  static const char *const rgb[3] = {"R", "G", "B"};
-  iris_image img;
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, MAP_W, MAP_H, 3, rgb, &err), &err);
-  for (int y = 0; y < MAP_H; y++)
-    for (int x = 0; x < MAP_W; x++) {
-      float *p = &img.data[3 * (y * MAP_W + x)];
-      for (int k = 0; k < 3; k++) p[k] = 0.05f + rnd();
-      if (x % 5 == 2 && y % 3 == 1) p[x % 3] = 40.0f;  /* one-texel spikes */
-      if (y == 0) p[0] = 8.0f, p[1] = 0.1f, p[2] = 0.1f; /* top row red */
-      if (y == MAP_H - 1) p[0] = 0.1f, p[1] = 0.1f, p[2] = 8.0f; /* bottom row blue */
-    }
-  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
-  iris_image_destroy(&img);
+static void map_texel(void *ctx, int x, int y, int w, int h, float p[3]) {
+  (void)ctx, (void)w, (void)h;
+  for (int k = 0; k < 3; k++) p[k] = 0.05f + rnd();
+  if (x % 5 == 2 && y % 3 == 1) p[x % 3] = 40.0f;  /* one-texel spikes */
+  if (y == 0) p[0] = 8.0f, p[1] = 0.1f, p[2] = 0.1f; /* top row red */
+  if (y == MAP_H - 1) p[0] = 0.1f, p[1] = 0.1f, p[2] = 8.0f; /* bottom row blue */
 }
 
 static const char *const views[4] = {"front", "seam", "north", "south"};
@@ -130,7 +121,7 @@ int main(int argc, char **argv) {
   CHECK(iris_test_tmpdir(dir, sizeof dir, "env_pixels") == 0);
   char path[1024];
   snprintf(path, sizeof path, "%s/map.exr", dir);
-  write_map(path);
+  iris_test_write_exr_map(path, MAP_W, MAP_H, map_texel, NULL);
   snprintf(path, sizeof path, "%s/scene.json", dir);
   write_scene(path);
   for (int v = 0; v < 4; v++) {

@@ -23,6 +23,7 @@
 #include "chi2.h"
 #include "core/fileio.h"
 #include "core/image.h"
+#include "exr_map.h"
 #include "renderer/envmap.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/lights.h"
@@ -31,28 +32,12 @@
 
 static char g_dir[1024];
 
-static void write_map(const char *path, int w, int h, int kind) {
-  static const char *const rgb[3] = {"R", "G", "B"};
-  iris_image img;
-  iris_error err;
-  iris_error_clear(&err);
-  CHECK_OK(iris_image_create(&img, w, h, 3, rgb, &err), &err);
-  for (int y = 0; y < h; y++)
-    for (int x = 0; x < w; x++) {
-      float *p = &img.data[3 * ((size_t)y * (size_t)w + (size_t)x)];
-      if (kind == 0) {
-        p[0] = p[1] = p[2] = 1.0f;
-      } else {
-        float v = 0.05f + 0.5f * (float)x / (float)w;
-        if (y == 0 || y == h - 1) v = 0.0f;                     /* black polar rows */
-        if (x >= w / 3 && x < w / 3 + 3 && y >= h / 4 && y < h / 4 + 2) v = 200.0f; /* a sun */
-        p[0] = v;
-        p[1] = 0.7f * v;
-        p[2] = 0.3f * v + 0.01f;
-      }
-    }
-  CHECK_OK(iris_exr_write(path, &img, NULL, 0, &err), &err);
-  iris_image_destroy(&img);
+/* The patterned map: a gradient along x with a 3 x 2 sun of 200. */
+static void write_map(const char *path, int w, int h) { iris_test_write_sun_map(path, w, h, 0.0f, 3, 200.0f); }
+
+static void white_texel(void *ctx, int x, int y, int w, int h, float rgb[3]) {
+  (void)ctx, (void)x, (void)y, (void)w, (void)h;
+  rgb[0] = rgb[1] = rgb[2] = 1.0f;
 }
 
 static bool env_sample(void *ctx, const double u[3], double dir[3]) {
@@ -341,7 +326,7 @@ static void test_odd_sizes(void) {
   for (size_t k = 0; k < sizeof S / sizeof S[0]; k++) {
     char path[1200];
     snprintf(path, sizeof path, "%s/odd%zu.exr", g_dir, k);
-    write_map(path, S[k][0], S[k][1], 1);
+    write_map(path, S[k][0], S[k][1]);
     iris_environment_map m = {path, 1.0f, 0.0f};
     iris_envmap env;
     iris_error err;
@@ -385,8 +370,8 @@ int main(void) {
   char patterned[1200], uniform[1200];
   snprintf(patterned, sizeof patterned, "%s/pattern.exr", g_dir);
   snprintf(uniform, sizeof uniform, "%s/uniform.exr", g_dir);
-  write_map(patterned, 32, 16, 1); /* small: the adaptive quadrature of its edges is the cost */
-  write_map(uniform, 32, 16, 0);
+  write_map(patterned, 32, 16); /* small: the adaptive quadrature of its edges is the cost */
+  iris_test_write_exr_map(uniform, 32, 16, white_texel, NULL);
   test_mapping(patterned);
   test_sampling(patterned);
   test_furnace(uniform);
