@@ -20,15 +20,9 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ET
 
-failures = 0
-
-
-def check(ok, what):
-    global failures
-    if not ok:
-        failures += 1
-        print("FAIL:", what)
-    return ok
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 
 def run(iris, args, cwd):
@@ -191,10 +185,9 @@ def main(argv):
                      work)
     check(rc == 2 and "sizes differ" in se and not os.path.exists(bad), f"wrong-size reference: {rc} {se}")
 
-    print(f"bench.cli: {failures} failure(s)")
-    if failures == 0:
+    if not checks.failures:
         shutil.rmtree(work, ignore_errors=True)
-    return 1 if failures else 0
+    return checks.summary("bench.cli")
 
 
 if __name__ == "__main__":

@@ -17,15 +17,9 @@ import shutil
 import subprocess
 import sys
 
-failures = 0
-
-
-def check(ok, what):
-    global failures
-    if not ok:
-        failures += 1
-        print("FAIL:", what)
-    return ok
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 
 def main():
@@ -68,8 +62,7 @@ def main():
     line = next((l for l in table.splitlines() if l.startswith("| cycles")), "")
     mean = (cyc.get((0.8, 0), {}).get("relmse", 0) + cyc.get((0.8, 1), {}).get("relmse", 0)) / 2
     check(f"{mean:.4g}" in line, f"table's Cycles row {line!r} lacks the mean relMSE {mean:.4g}")
-    print("bench.cycles:", "ok" if failures == 0 else f"{failures} failures")
-    return 1 if failures else 0
+    return checks.summary("bench.cycles")
 
 
 if __name__ == "__main__":

@@ -21,15 +21,14 @@ import struct
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import checks  # noqa: E402
+from checks import check, fail  # noqa: E402
+
 W, H = 64, 32          # map size
 IMG = 64               # image size
 ROT = 30.0             # --env-rotation, degrees
 TARGET = (0.7, 0.45, 0.55)  # world direction (glTF / iris, +Y up) of the bright block
-
-
-def fail(msg):
-    print("FAILED:", msg)
-    sys.exit(1)
 
 
 def rgbe(r, g, b):
@@ -204,22 +203,17 @@ def main():
         print("%-16s mean %.4f  centroid x %+.2f px, y %+.2f px (down)" % (k, *v))
     # Where the formula puts the light: the camera looks along -Z from +Z, x right, y up.
     ex, ey = target[0], -target[1]
-    ok = True
     for k, (mean, cx, cy) in st.items():
-        if not (cx * ex > 0 and cy * ey > 0 and abs(cx) > 1.0 and abs(cy) > 1.0):
-            print("FAILED: %s: lit side centroid (%+.2f, %+.2f) is not towards (%+.2f, %+.2f)" %
-                  (k, cx, cy, ex, ey))
-            ok = False
+        check(cx * ex > 0 and cy * ey > 0 and abs(cx) > 1.0 and abs(cy) > 1.0,
+              "%s: lit side centroid (%+.2f, %+.2f) is towards (%+.2f, %+.2f)" % (k, cx, cy, ex, ey))
     ci = st["iris.exr"]
     for k in ("export.exr", "gltf-import.exr"):
         d = math.hypot(st[k][1] - ci[1], st[k][2] - ci[2])
-        if d > 1.5:
-            print("FAILED: %s centroid is %.2f px from iris's" % (k, d))
-            ok = False
+        check(d <= 1.5, "%s centroid is %.2f px from iris's (at most 1.5)" % (k, d))
     # Brightness is not compared here: iris's glTF material and Blender's Principled
     # BSDF differ (docs/export.md); the energy of an environment-lit export is
     # checked with iris's own materials in render.env_cycles.
-    return 0 if ok else 1
+    return checks.summary("render.env_orientation")
 
 
 if __name__ == "__main__":

@@ -23,17 +23,11 @@ import threading
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import cdp  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
 
 CHROMIUM = os.environ.get("IRIS_CHROMIUM", "/usr/bin/chromium")
-failures = 0
-
-
-def check(ok, what):
-    global failures
-    if not ok:
-        failures += 1
-        print("FAIL:", what)
-    return ok
 
 
 def run(cmd, cwd):
@@ -180,10 +174,9 @@ def main(argv):
         if browser:
             browser.close()
         server.close()
-    print(f"report.browser: {failures} failure(s)")
-    if failures == 0:
+    if not checks.failures:
         shutil.rmtree(work, ignore_errors=True)
-    return 1 if failures else 0
+    return checks.summary("report.browser")
 
 
 if __name__ == "__main__":

@@ -15,17 +15,16 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "common"))
+import checks  # noqa: E402
+from checks import check  # noqa: E402
+
 
 def main():
     workdir, iris, driver, exr_close = (os.path.abspath(p) for p in sys.argv[1:5])
     shutil.rmtree(workdir, ignore_errors=True)
     os.makedirs(workdir)
-    failures = []
-
-    def check(cond, what):
-        print(("ok: " if cond else "FAILED: ") + what, flush=True)
-        if not cond:
-            failures.append(what)
+    checks.verbose = True
 
     scene = ["cornell-box", "--seed", "5", "--max-depth", "3"]
     merged = os.path.join(workdir, "merged.exr")
@@ -100,10 +99,9 @@ def main():
     usage(base + ["--spp", "4", "--", "cornell-box", "--sample-offset=3"], "--sample-offset")
     usage(base + ["--spp", "4", "--", "door", "--method", "guided", "--guide-out", "g"], "--guide-out")
     usage(["sweep", "--dry-run", "--workdir", job, "--template", "echo {x}"], "no --set gives it")
-    print(f"{len(failures)} failed")
-    if not failures:
+    if not checks.failures:
         shutil.rmtree(workdir, ignore_errors=True)
-    return 1 if failures else 0
+    return checks.summary("slurm.driver_local")
 
 
 if __name__ == "__main__":
