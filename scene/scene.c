@@ -1,6 +1,6 @@
 /* The in-memory scene: lifetime, appenders, merging, validation and the
- * derived quantities (bounds, triangle counts). The file format is in
- * scene_io.c; docs/format.md describes both. */
+ * derived quantities (bounds, triangle counts). The file format is written
+ * by scene_write.c and loaded by scene_load.c; docs/format.md describes both. */
 #include "scene/scene.h"
 
 #include <malloc.h>
