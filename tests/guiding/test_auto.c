@@ -183,25 +183,7 @@ static void test_unbiased(void) {
   bool ok_m = CHECK(render(s, IRIS_METHOD_MIS, w, h, 2 * spp, 302, -1, &m));
   if (ok_a && ok_m) {
     CHECK_EQ_STR(iris_method_name(a.method), "guided-nee");
-    double worst = 0.0;
-    for (int blk = -1; blk < bx * by; blk++) {
-      int x0 = 0, y0 = 0, x1 = w, y1 = h;
-      if (blk >= 0) {
-        x0 = (blk % bx) * 8, y0 = (blk / bx) * 8;
-        x1 = x0 + 8, y1 = y0 + 8;
-      }
-      double ma[3], va[3], mb[3], vb[3];
-      region(&m.film, x0, y0, x1, y1, ma, va);
-      region(&a.film, x0, y0, x1, y1, mb, vb);
-      for (int k = 0; k < 3; k++) {
-        double sd = sqrt(va[k] + vb[k]);
-        double z = sd > 0 ? (ma[k] - mb[k]) / sd : (ma[k] == mb[k] ? 0.0 : INFINITY);
-        if (fabs(z) > worst) worst = fabs(z);
-        iris_check_record(fabs(z) <= (blk < 0 ? z_image : z_block), __FILE__, __LINE__,
-                          "door mis vs auto, %s (%d,%d)-(%d,%d) channel %d: %.5f vs %.5f, z = %.2f",
-                          blk < 0 ? "image" : "block", x0, y0, x1, y1, k, ma[k], mb[k], z);
-      }
-    }
+    double worst = iris_test_z_compare(&m.film, &a.film, bx, by, z_image, z_block, "door mis vs auto");
     printf("door: mis vs auto (%s): worst |z| = %.2f (image < %.1f, blocks < %.2f)\n", a.method_reason, worst,
            z_image, z_block);
     CHECK_EQ_INT(a.stats.nan_count, 0);

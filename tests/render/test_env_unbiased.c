@@ -61,7 +61,6 @@ static void compare(const iris_scene *s, const char *what, const bool use[IRIS_M
   for (int a = 0; a < NM; a++)
     for (int b = a + 1; b < NM; b++) {
       if (!ok[a] || !ok[b]) continue;
-      double worst = 0.0;
       const int bx = W / 8, by = H / 8;
       /* nee's blocks on the glossy sphere are heavy-tailed even with the sun
        * (the sun's highlight is sampled, the dim sky in the narrow lobe is
@@ -69,25 +68,10 @@ static void compare(const iris_scene *s, const char *what, const bool use[IRIS_M
        * (8192-spp runs of block (24,0)-(32,8) agree with mis: 0.0910 vs
        * 0.0906), so nee is compared over the whole image only. */
       const bool image_only = a == IRIS_METHOD_NEE || b == IRIS_METHOD_NEE;
-      for (int blk = -1; blk < (image_only ? 0 : bx * by); blk++) {
-        int x0 = 0, y0 = 0, x1 = W, y1 = H;
-        if (blk >= 0) {
-          x0 = (blk % bx) * 8, y0 = (blk / bx) * 8;
-          x1 = x0 + 8, y1 = y0 + 8;
-        }
-        double ma[3], va[3], mb[3], vb[3];
-        region(&r[a].film, x0, y0, x1, y1, ma, va);
-        region(&r[b].film, x0, y0, x1, y1, mb, vb);
-        for (int k = 0; k < 3; k++) {
-          double sd = sqrt(va[k] + vb[k]);
-          double z = sd > 0 ? (ma[k] - mb[k]) / sd : (ma[k] == mb[k] ? 0.0 : INFINITY);
-          if (fabs(z) > worst) worst = fabs(z);
-          iris_check_record(fabs(z) <= z_max, __FILE__, __LINE__,
-                            "%s: %s vs %s, %s (%d,%d)-(%d,%d) channel %d: %.5f vs %.5f, z = %.2f", what,
-                            iris_method_name((iris_method)a), iris_method_name((iris_method)b),
-                            blk < 0 ? "image" : "block", x0, y0, x1, y1, k, ma[k], mb[k], z);
-        }
-      }
+      char pair[200];
+      snprintf(pair, sizeof pair, "%s: %s vs %s", what, iris_method_name((iris_method)a),
+               iris_method_name((iris_method)b));
+      double worst = iris_test_z_compare(&r[a].film, &r[b].film, image_only ? 0 : bx, by, z_max, z_max, pair);
       double ma[3], va[3], mb[3], vb[3];
       region(&r[a].film, 0, 0, W, H, ma, va);
       region(&r[b].film, 0, 0, W, H, mb, vb);

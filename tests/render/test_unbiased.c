@@ -87,28 +87,12 @@ int main(void) {
     for (int a = 0; a < 3; a++)
       for (int b = a + 1; b < 3; b++) {
         if (!ok[a] || !ok[b]) continue;
-        double worst = 0.0;
         int bx = cases[c].w / 8, by = cases[c].h / 8;
         const bool image_only = c == 1 && (methods[a] == IRIS_METHOD_NEE || methods[b] == IRIS_METHOD_NEE);
-        for (int blk = -1; blk < (image_only ? 0 : bx * by); blk++) {
-          int x0 = 0, y0 = 0, x1 = cases[c].w, y1 = cases[c].h;
-          if (blk >= 0) {
-            x0 = (blk % bx) * 8, y0 = (blk / bx) * 8;
-            x1 = x0 + 8, y1 = y0 + 8;
-          }
-          double ma[3], va[3], mb[3], vb[3];
-          region(&r[a].film, x0, y0, x1, y1, ma, va);
-          region(&r[b].film, x0, y0, x1, y1, mb, vb);
-          for (int k = 0; k < 3; k++) {
-            double sd = sqrt(va[k] + vb[k]);
-            double z = sd > 0 ? (ma[k] - mb[k]) / sd : (ma[k] == mb[k] ? 0.0 : INFINITY);
-            if (fabs(z) > worst) worst = fabs(z);
-            iris_check_record(fabs(z) <= z_max, __FILE__, __LINE__,
-                              "%s %s: %s vs %s, %s (%d,%d)-(%d,%d) channel %d: %.5f vs %.5f, z = %.2f",
-                              cases[c].name, iris_sampler_kind_name(kind), iris_method_name(methods[a]), iris_method_name(methods[b]),
-                              blk < 0 ? "image" : "block", x0, y0, x1, y1, k, ma[k], mb[k], z);
-          }
-        }
+        char pair[200];
+        snprintf(pair, sizeof pair, "%s %s: %s vs %s", cases[c].name, iris_sampler_kind_name(kind),
+                 iris_method_name(methods[a]), iris_method_name(methods[b]));
+        double worst = iris_test_z_compare(&r[a].film, &r[b].film, image_only ? 0 : bx, by, z_max, z_max, pair);
         printf("%s%s %s: %s vs %s: worst |z| = %.2f\n", cases[c].name, c == 2 ? "+gltf" : "",
                iris_sampler_kind_name(kind), iris_method_name(methods[a]),
                iris_method_name(methods[b]), worst);
