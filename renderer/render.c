@@ -269,7 +269,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       res->interrupted = true;
       if (res->adaptive_outcome.rounds == 0) st = iris_cancel_error(err);
     }
-    res->spp = res->adaptive_outcome.spp_max - res->train_spp;
+    /* the reserved sample range (the cap): a part at the next offset cannot overlap */
+    res->spp = p.spp;
     res->seconds = iris_time_now() - t1;
     for (int i = 0; i < p.threads; i++) {
       res->stats.paths += stats[i].paths;

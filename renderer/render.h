@@ -150,7 +150,8 @@ typedef struct iris_render_result {
   iris_triangle_sampling light_sampling;
   iris_light_sampler light_sampler;
   int spp;               /* samples per pixel completed in the image passes; adaptive: the
-                            most any pixel took (its sample indices offset .. offset+spp-1) */
+                            cap, the sample indices reserved (offset .. offset+spp-1; each
+                            pixel's count is in the film) */
   iris_adaptive_params adaptive; /* as rendered (rule OFF: uniform) */
   iris_adaptive_outcome adaptive_outcome;
   int train_spp;         /* training samples per pixel also in the film (keep_training) */
