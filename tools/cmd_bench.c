@@ -29,7 +29,9 @@ static void print_help(void) {
       "                       auto: guided-nee or mis per scene); a method may\n"
       "                       name its variant: mis@independent, mis@area,\n"
       "                       mis@independent+area, mis@power (sampler, emitter\n"
-      "                       triangles, light sampler power|tree)\n"
+      "                       triangles, light sampler power|tree), mis@adaptive\n"
+      "                       (adaptive sampling, samples where they lower relMSE\n"
+      "                       most), mis@freeze (Cycles' rule at its threshold 0.01)\n"
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
@@ -247,7 +249,7 @@ int iris_cmd_bench(int argc, char **argv) {
       iris_light_sampler lsr;
       if (!iris_bench_method_parse(items[k], &m, &smp, &lsr, &ls))
         return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee, "
-                                         "optionally @ and + joined independent, area, power, tree)", items[k]);
+                                         "optionally @ and + joined independent, area, power, tree, adaptive, freeze)", items[k]);
       /* --sampler and --light-sampling set what a plain name means */
       if (!strchr(items[k], '@')) {
         smp = sampler;
@@ -259,6 +261,7 @@ int iris_cmd_bench(int argc, char **argv) {
       p.light_samplings[p.method_count] = ls;
       p.keep_training[p.method_count] = iris_bench_method_keeps_training(items[k]);
       p.light_samplers[p.method_count] = lsr;
+      p.adaptive[p.method_count] = iris_bench_method_adaptive(items[k]);
       char a[64], b[64];
       iris_bench_method_label(&p, p.method_count, a, sizeof a);
       for (int j = 0; j < p.method_count; j++)

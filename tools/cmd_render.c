@@ -498,12 +498,12 @@ int iris_cmd_render(int argc, char **argv) {
     char train[48] = "";
     if (res.train_spp > 0) snprintf(train, sizeof train, " + %d training spp", res.train_spp);
     char spp[48];
-    if (res.adaptive.rule != IRIS_ADAPTIVE_OFF)
+    if (res.adaptive.rule != IRIS_ADAPTIVE_OFF) {
       snprintf(spp, sizeof spp, "adaptive, %.1f spp mean", res.adaptive_outcome.spp_mean);
-    if (res.adaptive.rule != IRIS_ADAPTIVE_OFF && res.train_spp > 0)
-      snprintf(train, sizeof train, " (%d of them training)", res.train_spp);
-    else
+      if (res.train_spp > 0) snprintf(train, sizeof train, " (%d of them training)", res.train_spp);
+    } else {
       snprintf(spp, sizeof spp, "%d spp", res.spp);
+    }
     iris_infof("render: %s, %dx%d, %s%s (%s), %.2f s, %.2f Msamples/s, %.1f Mrays/s%s",
                input, res.film.width, res.film.height, spp, train,
                res.method_reason[0] ? res.method_reason : iris_method_name(res.method),

@@ -50,10 +50,13 @@ const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf
   const bool train = iris_method_uses_guiding(p->methods[k]) && p->keep_training[k] != IRIS_KEEP_TRAINING_DEFAULT;
   /* "@" and the non-default variants joined by "+" */
   char suffix[64] = "";
-  const char *parts[4] = {indep ? "independent" : NULL, area ? "area" : NULL,
+  const char *parts[5] = {indep ? "independent" : NULL, area ? "area" : NULL,
                           tree ? iris_light_sampler_name(p->light_samplers[k]) : NULL,
-                          train ? (p->keep_training[k] ? "keep" : "discard") : NULL};
-  for (int i = 0; i < 4; i++)
+                          train ? (p->keep_training[k] ? "keep" : "discard") : NULL,
+                          p->adaptive[k] == IRIS_ADAPTIVE_RELMSE   ? "adaptive"
+                          : p->adaptive[k] == IRIS_ADAPTIVE_FREEZE ? "freeze"
+                                                                   : NULL};
+  for (int i = 0; i < 5; i++)
     if (parts[i])
       snprintf(suffix + strlen(suffix), sizeof suffix - strlen(suffix), "%s%s", suffix[0] ? "+" : "@", parts[i]);
   snprintf(buf, size, "%s%s", iris_method_name(p->methods[k]), suffix);
@@ -65,6 +68,19 @@ bool iris_bench_method_keeps_training(const char *label) {
   if (at && strstr(at, "keep")) return true;
   if (at && strstr(at, "discard")) return false;
   return IRIS_KEEP_TRAINING_DEFAULT;
+}
+
+iris_adaptive_rule iris_bench_method_adaptive(const char *label) {
+  const char *at = strchr(label, '@');
+  if (!at) return IRIS_ADAPTIVE_OFF;
+  char buf[64];
+  snprintf(buf, sizeof buf, "%s", at + 1);
+  iris_adaptive_rule r = IRIS_ADAPTIVE_OFF;
+  for (char *save = NULL, *tok = strtok_r(buf, "+", &save); tok; tok = strtok_r(NULL, "+", &save)) {
+    if (strcmp(tok, "adaptive") == 0) r = IRIS_ADAPTIVE_RELMSE;
+    if (strcmp(tok, "freeze") == 0) r = IRIS_ADAPTIVE_FREEZE;
+  }
+  return r;
 }
 
 bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
@@ -88,6 +104,8 @@ bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kin
         *light = IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE;
       else if (strcmp(tok, "keep") == 0 || strcmp(tok, "discard") == 0)
         ; /* iris_bench_method_keeps_training */
+      else if (strcmp(tok, "adaptive") == 0 || strcmp(tok, "freeze") == 0)
+        ; /* iris_bench_method_adaptive */
       else if (iris_light_sampler_parse(tok, light_sampler))
         ;
       else
@@ -753,6 +771,13 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           rp.light_sampling = p.light_samplings[k];
           rp.keep_training = p.keep_training[k];
           rp.light_sampler = p.light_samplers[k];
+          if (p.adaptive[k] != IRIS_ADAPTIVE_OFF) {
+            /* @freeze: Cycles' rule at Blender's threshold; @adaptive: the
+             * relMSE allocation with the budget alone deciding. No spp cap. */
+            rp.adaptive.rule = p.adaptive[k];
+            rp.adaptive.noise_threshold = p.adaptive[k] == IRIS_ADAPTIVE_FREEZE ? IRIS_BENCH_ADAPTIVE_THRESHOLD : 0.0;
+            rp.spp = 1 << 20;
+          }
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;
@@ -776,7 +801,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           /* the whole call: setup, passes and the film's allocation */
           row.seconds = wall;
           row.setup_seconds = rr.setup_seconds;
-          row.spp = rr.spp;
+          row.spp = rr.adaptive.rule != IRIS_ADAPTIVE_OFF ? (int)(rr.adaptive_outcome.spp_mean + 0.5) : rr.spp;
           iris_image img;
           st = iris_film_to_image(&rr.film, false, &img, err);
           iris_render_result_destroy(&rr);

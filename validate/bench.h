@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "renderer/adaptive.h"
 #include "renderer/integrator.h"
 #include "validate/validate.h"
 
@@ -54,6 +55,9 @@ typedef struct iris_bench_params {
    * ("@keep" / "@discard" when not IRIS_KEEP_TRAINING_DEFAULT) */
   bool keep_training[IRIS_BENCH_MAX_METHODS];
   iris_light_sampler light_samplers[IRIS_BENCH_MAX_METHODS]; /* NEE's light choice (@power, @tree) */
+  iris_adaptive_rule adaptive[IRIS_BENCH_MAX_METHODS]; /* @adaptive: relmse allocation, the budget
+                                                           deciding; @freeze: Cycles' rule at
+                                                           IRIS_BENCH_ADAPTIVE_THRESHOLD, the budget a cap */
   int method_count;
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
@@ -92,6 +96,10 @@ const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf
 /* Whether a label asks for the training samples to be kept ("@keep"),
  * discarded ("@discard"), else IRIS_KEEP_TRAINING_DEFAULT. */
 bool iris_bench_method_keeps_training(const char *label);
+/* The adaptive rule a label asks for: "@adaptive" relmse, "@freeze" Cycles' rule, else off. */
+iris_adaptive_rule iris_bench_method_adaptive(const char *label);
+/* The noise threshold of @freeze rows: Blender's default. */
+#define IRIS_BENCH_ADAPTIVE_THRESHOLD 0.01
 bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
                              iris_triangle_sampling *light);
 
