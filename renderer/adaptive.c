@@ -366,7 +366,11 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
   s.HW = s.hx1 - s.hx0;
   s.HH = s.hy1 - s.hy0;
   s.train = j->film->count[0];
-  s.min_spp = p->min_spp > 0 ? p->min_spp : iris_adaptive_auto_min_spp(p->noise_threshold);
+  /* Cycles' automatic minimum with a threshold; without one (a target error
+   * or a time budget deciding) the scouts decide from the start */
+  s.min_spp = p->min_spp > 0                ? p->min_spp
+              : p->noise_threshold > 0.0    ? iris_adaptive_auto_min_spp(p->noise_threshold)
+                                            : IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD;
   if (s.min_spp > j->spp_cap) s.min_spp = j->spp_cap;
   const size_t n = (size_t)s.W * (size_t)s.H, hn = (size_t)s.HW * (size_t)s.HH;
   iris_status st = iris_film_create(&s.scout, s.HW, s.HH, err);

@@ -46,7 +46,9 @@ const char *iris_adaptive_rule_name(iris_adaptive_rule r);
 bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out);
 
 /* Cycles 3.4's automatic minimum samples for a noise threshold:
- * max(4, ceil(16 / T^0.3)) (64 at 0.01). */
+ * max(4, ceil(16 / T^0.3)) (64 at 0.01). Without a threshold (only a target
+ * error or a time budget) the minimum is IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD. */
+#define IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD 16
 int iris_adaptive_auto_min_spp(double noise_threshold);
 
 /* The relMSE denominator offset and the share of largest per-pixel errors
@@ -57,7 +59,7 @@ int iris_adaptive_auto_min_spp(double noise_threshold);
 typedef struct iris_adaptive_params {
   iris_adaptive_rule rule;
   double noise_threshold; /* Cycles' scale (Blender's default 0.01); 0: none */
-  int min_spp;            /* image samples every pixel gets first; 0: automatic */
+  int min_spp;            /* image samples every pixel gets first; 0: automatic (above) */
   double target_error;    /* stop once the image's estimated relMSE is at most this; 0: none */
   bool decide_on_image;   /* tests only: decide from the image's own samples (biased) */
 } iris_adaptive_params;

@@ -67,7 +67,7 @@ static const iris_option ADAPTIVE_ROWS[] = {
      "adaptive sampling until the image's estimated relMSE is at\n"
      "most E (--time caps it); the estimate reached is reported", NULL},
     {"min-spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, offsetof(render_cli, min_spp),
-     "samples every pixel gets first (default as Cycles:\nmax(4, ceil(16 / T^0.3)), 64 at T = 0.01)", NULL},
+     "samples every pixel gets first (default as Cycles:\nmax(4, ceil(16 / T^0.3)), 64 at T = 0.01; 16 without T)", NULL},
     {"adaptive", 0, IRIS_OPT_CHOICE, "RULE", 0, 0, offsetof(render_cli, adaptive),
      "relmse (default with --noise-threshold/--target-error:\nsamples where they lower the image's "
      "relMSE most) | freeze\n(Cycles' rule) | off (every pixel the same spp)", ADAPTIVE_CHOICES},
