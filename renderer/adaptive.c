@@ -334,6 +334,42 @@ static void run_image(state *s) {
   run_pass(&c, j->threads);
 }
 
+static uint64_t total_paths(const iris_adaptive_job *j) {
+  uint64_t p = 0;
+  for (int i = 0; i < j->threads; i++) p += j->stats[i].paths;
+  return p;
+}
+
+/* The first round's image samples under a time budget: every pixel the same
+ * samples, in passes of about ROUND_PATHS paths, up to the minimum or until
+ * the next pass would overrun the budget (at least one pass). Returns true
+ * when the budget stopped it. */
+static bool uniform_passes(state *s, double t0, uint64_t *image_paths, double *sec_per_path) {
+  const iris_adaptive_job *j = s->job;
+  const size_t n = (size_t)s->W * (size_t)s->H;
+  uint32_t chunk = (uint32_t)(ROUND_PATHS / n);
+  if (chunk < 1) chunk = 1;
+  for (bool first = true;; first = false) {
+    const uint32_t have = j->film->count[0]; /* uniform so far */
+    if (have >= (uint32_t)s->min_spp) return false;
+    uint32_t c = chunk;
+    if (have + c > (uint32_t)s->min_spp) c = (uint32_t)s->min_spp - have;
+    double elapsed = iris_time_now() - t0;
+    if (!first && elapsed + *sec_per_path * (double)c * (double)n > j->budget) return true;
+    if (iris_cancel_requested()) return false; /* the round loop sees it */
+    for (size_t i = 0; i < n; i++) {
+      s->take[i] = c;
+      s->first[i] = have - s->train;
+    }
+    double tr = iris_time_now();
+    uint64_t before = total_paths(j);
+    run_image(s);
+    uint64_t done = total_paths(j) - before;
+    *image_paths += done;
+    if (done) *sec_per_path = (iris_time_now() - tr) / (double)done;
+  }
+}
+
 static void state_free(state *s) {
   iris_film_destroy(&s->scout);
   free(s->scout_take);
@@ -343,12 +379,6 @@ static void state_free(state *s) {
   free(s->need);
   free(s->weight);
   free(s->target);
-}
-
-static uint64_t total_paths(const iris_adaptive_job *j) {
-  uint64_t p = 0;
-  for (int i = 0; i < j->threads; i++) p += j->stats[i].paths;
-  return p;
 }
 
 iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome *out, iris_error *err) {
@@ -407,11 +437,15 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
       if (fit < budget) budget = fit;
     }
     double scout_n = 0.0;
+    bool spent = false; /* the budget ran out in the first round's uniform passes */
     if (round == 0) {
-      /* uniform first round: min spp of image samples and SCOUT_MIN scouts */
+      /* uniform first round: min spp of image samples and SCOUT_MIN scouts;
+       * under a time budget the image samples go in uniform passes that stop
+       * when the next would overrun it (counts fixed in advance: no bias) */
+      if (j->budget > 0.0) spent = uniform_passes(&s, t0, &image_paths, &sec_per_path);
       for (size_t i = 0; i < n; i++) {
         uint32_t have = j->film->count[i];
-        s.take[i] = have < (uint32_t)s.min_spp ? (uint32_t)s.min_spp - have : 0;
+        s.take[i] = have < (uint32_t)s.min_spp && !spent ? (uint32_t)s.min_spp - have : 0;
         s.first[i] = have - s.train;
       }
       for (size_t i = 0; i < hn; i++) {
@@ -447,7 +481,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
     uint64_t before = total_paths(j);
     run_image(&s);
     uint64_t mid = total_paths(j);
-    if (!p->decide_on_image && scout_n > 0.0) run_scouts(&s);
+    if (!p->decide_on_image && scout_n > 0.0 && !spent) run_scouts(&s);
     uint64_t after = total_paths(j);
     image_paths += mid - before;
     scout_paths += after - mid;
@@ -469,6 +503,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
       out->reached_target = true;
       break;
     }
+    if (spent) break;
   }
   out->error_estimate = error >= 0.0 ? error : iris_adaptive_film_error(j->film);
   double spp = 0.0;

@@ -275,6 +275,29 @@ static void fill_metrics(const iris_image *img, const iris_image *ref, iris_benc
   row->nonfinite = nans + infs;
 }
 
+/* DIR/images/<scene>-<what>-spp.png: an adaptive render's samples per pixel,
+ * log2(count / mean count) in false colour over [-3, 3] (blue: fewer than the
+ * mean, red: more). */
+static iris_status write_count_map(const char *out_dir, const iris_bench_scene *sc, const char *what,
+                                   const iris_film *film, iris_error *err) {
+  char dir[1100], name[300], path[1500];
+  iris_path_join(out_dir, "images", dir, sizeof dir);
+  iris_status st = iris_mkdir_p(dir, err);
+  if (st != IRIS_OK) return st;
+  size_t n = (size_t)film->width * (size_t)film->height;
+  float *v = malloc(n * sizeof *v);
+  if (!v) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
+  double mean = 0.0;
+  for (size_t i = 0; i < n; i++) mean += film->count[i];
+  mean = mean > 0.0 ? mean / (double)n : 1.0;
+  for (size_t i = 0; i < n; i++) v[i] = film->count[i] > 0 ? (float)log2(film->count[i] / mean) : -3.0f;
+  snprintf(name, sizeof name, "%s-%s-spp.png", sc->name, what);
+  iris_path_join(dir, name, path, sizeof path);
+  st = iris_report_write_false_colour(path, v, film->width, film->height, 3.0f, err);
+  free(v);
+  return st;
+}
+
 /* DIR/images/<scene>-<what>.png and, against a reference, <scene>-<what>-diff.png
  * (relative energy difference, blue-white-red over [-0.5, 0.5]). */
 static iris_status write_preview(const char *out_dir, iris_bench_scene *sc, const char *what,
@@ -804,12 +827,14 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           row.spp = rr.adaptive.rule != IRIS_ADAPTIVE_OFF ? (int)(rr.adaptive_outcome.spp_mean + 0.5) : rr.spp;
           iris_image img;
           st = iris_film_to_image(&rr.film, false, &img, err);
+          const bool preview = s == 0 && t == p.time_count - 1;
+          if (st == IRIS_OK && preview && rr.adaptive.rule != IRIS_ADAPTIVE_OFF)
+            st = write_count_map(p.out_dir, sc, label, &rr.film, err);
           iris_render_result_destroy(&rr);
           if (st != IRIS_OK) break;
           fill_metrics(&img, &bs[i].ref, &row);
           st = add_row(res, &row, err);
-          if (st == IRIS_OK && s == 0 && t == p.time_count - 1)
-            st = write_preview(p.out_dir, sc, label, &img, &bs[i].ref, exposure, err);
+          if (st == IRIS_OK && preview) st = write_preview(p.out_dir, sc, label, &img, &bs[i].ref, exposure, err);
           iris_image_destroy(&img);
         }
     if (st == IRIS_OK && p.cycles) st = run_cycles(&p, &ctx, &bs[i], sc, res, exposure, false, err);
@@ -925,6 +950,11 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
       if (strcmp(sc->images[k], "reference") != 0) {
         snprintf(name, sizeof name, "images/%s-%s-diff.png", sc->name, sc->images[k]);
         cJSON_AddStringToObject(e, "diff", name);
+        /* adaptive rows: their sample-count map (write_count_map) */
+        snprintf(name, sizeof name, "images/%s-%s-spp.png", sc->name, sc->images[k]);
+        char full[1500];
+        iris_path_join(p->out_dir, name, full, sizeof full);
+        if (iris_path_exists(full)) cJSON_AddStringToObject(e, "spp", name);
       }
       cJSON_AddItemToArray(im, e);
     }
