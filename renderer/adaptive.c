@@ -110,6 +110,10 @@ static void pass_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
   iris_path_stats local = {0};
   const int fw = c->x1 - c->x0;
   for (uint64_t t = begin; t < end; t++) {
+    /* a stop request ends a round within a tile (rounds can be long); the
+     * counts stay true, and a count cut by a signal is no function of the
+     * samples, so the image stays unbiased */
+    if (iris_cancel_requested()) break;
     int tx = c->x0 + (int)(t % (uint64_t)c->tiles_x) * TILE;
     int ty = c->y0 + (int)(t / (uint64_t)c->tiles_x) * TILE;
     for (int y = ty; y < ty + TILE && y < c->y1; y++)

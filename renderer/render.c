@@ -213,8 +213,17 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
    * indices from 0 and trains its guide itself (docs/guiding.md). */
   const bool keep_training = p.keep_training && p.sample_offset == 0 && !p.no_passes;
   if (st == IRIS_OK && (resolve || iris_method_uses_guiding(p.method))) {
+    /* the guide sizes its training by the render's spp: with adaptive
+     * sampling that is a cap, so it gets 4x the minimum instead */
+    int guide_spp = p.spp;
+    if (adaptive) {
+      int m = p.adaptive.min_spp > 0             ? p.adaptive.min_spp
+              : p.adaptive.noise_threshold > 0.0 ? iris_adaptive_auto_min_spp(p.adaptive.noise_threshold)
+                                                 : IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD;
+      if (4 * m < guide_spp) guide_spp = 4 * m;
+    }
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
-                           p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
+                           p.guide_options, p.time_budget > 0.0 ? 0 : guide_spp,
                            p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve,
                            p.phase, p.phase_ctx, t0, keep_training ? &res->film : NULL, b};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
@@ -267,7 +276,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     st = iris_adaptive_run(&job, &res->adaptive_outcome, err);
     if (st == IRIS_OK && res->adaptive_outcome.interrupted) {
       res->interrupted = true;
-      if (res->adaptive_outcome.rounds == 0) st = iris_cancel_error(err);
+      /* a pixel without samples: no image, as when the first pass is cut */
+      if (res->adaptive_outcome.rounds == 0 || res->adaptive_outcome.spp_min == 0) st = iris_cancel_error(err);
     }
     /* the reserved sample range (the cap): a part at the next offset cannot overlap */
     res->spp = p.spp;
