@@ -16,7 +16,8 @@
  *   or one of its 8 neighbours needs more.
  * - relmse (iris's default): each round's samples go where one more sample
  *   lowers the image's relMSE most: targets proportional to the pixel's
- *   sqrt(sum_c var_c / (mean_c^2 + eps)), the 3x3 maximum of it, so that the
+ *   sqrt(sum_c var_c / (mean_c^2 + eps)) pooled over its 3x3 neighbourhood
+ *   (root mean square: 9 pixels' scouts decide together), so that the
  *   image's estimated relMSE falls fastest; with a noise threshold, no pixel
  *   is taken past the count the threshold asks for. */
 #ifndef IRIS_RENDERER_ADAPTIVE_H

@@ -72,7 +72,8 @@ static const iris_option ADAPTIVE_ROWS[] = {
      "relmse (default with --noise-threshold/--target-error:\nsamples where they lower the image's "
      "relMSE most) | freeze\n(Cycles' rule) | off (every pixel the same spp)", ADAPTIVE_CHOICES},
 };
-static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (docs/rendering.md, \"Adaptive sampling\")",
+static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (off unless one of these is given: --spp\n"
+                                                   "and --time then mean what they say; docs/rendering.md)",
                                                    ADAPTIVE_ROWS, sizeof ADAPTIVE_ROWS / sizeof ADAPTIVE_ROWS[0]};
 static const iris_option_group OUTPUT_OPTIONS = {"Output and reporting", OUTPUT_ROWS,
                                                  sizeof OUTPUT_ROWS / sizeof OUTPUT_ROWS[0]};

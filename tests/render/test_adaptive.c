@@ -255,17 +255,17 @@ static void merge_parts(void) {
   size_t mc = 0;
   if (ok && CHECK(iris_merge_files(paths, 2, out, NULL, &err) == IRIS_OK) &&
       CHECK(iris_exr_read(out, &m, &meta, &mc, &err) == IRIS_OK)) {
-    int cs = iris_image_channel(&m, "spp");
-    CHECK(cs >= 0);
+    int cs = iris_image_channel(&m, "spp"), cr = iris_image_channel(&m, "R");
+    CHECK(cs >= 0 && cr >= 0);
     int bad = 0, spread = 0;
-    for (int y = 0; y < 16 && cs >= 0; y++)
+    for (int y = 0; y < 16 && cs >= 0 && cr >= 0; y++)
       for (int x = 0; x < 16; x++) {
         size_t i = (size_t)y * 16 + (size_t)x;
         double n0 = r[0].film.count[i], n1 = r[1].film.count[i];
         spread += n0 != r[0].film.count[0];
         double want = (r[0].film.sum[3 * i] / n0 * n0 + r[1].film.sum[3 * i] / n1 * n1) / (n0 + n1);
         const float *px = m.data + i * (size_t)m.channel_count;
-        bad += px[cs] != (float)(n0 + n1) || fabs(px[0] - want) > 1e-5 * (fabs(want) + 1e-3);
+        bad += px[cs] != (float)(n0 + n1) || fabs(px[cr] - want) > 1e-5 * (fabs(want) + 1e-3);
       }
     iris_check_record(bad == 0, __FILE__, __LINE__, "%d merged pixels are not the count-weighted mean", bad);
     iris_check_record(spread > 0, __FILE__, __LINE__, "the parts were not adaptive (all pixels %u samples)",
