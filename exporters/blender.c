@@ -453,7 +453,8 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
         "# fair-comparison settings of iris's docs/export.md. Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
-        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n",
+        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n"
+        "#           [--adaptive-threshold T [--adaptive-min-samples N]] [--time-limit SECONDS]\n",
         fp);
   iris_blender_put_prelude(fp);
 

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -198,6 +199,7 @@ iris_status iris_merge_part_info_parse(const iris_image *img, const iris_image_m
     if (iris_image_channel(img, rgb[c]) < 0)
       return iris_error_set(err, IRIS_ERR_INVALID, path, 0, NULL, "has no %s channel", rgb[c]);
   }
+  out->has_counts = iris_image_channel(img, "spp") >= 0;
   out->has_variance = iris_image_channel(img, "var.R") >= 0 &&
                       iris_image_channel(img, "var.G") >= 0 &&
                       iris_image_channel(img, "var.B") >= 0;
@@ -390,12 +392,19 @@ iris_status iris_merge_add(iris_merge *m, const char *path, const iris_image *im
     cm[c] = iris_image_channel(img, names[c]);
     cv[c] = in->has_variance ? iris_image_channel(img, names[3 + c]) : -1;
   }
-  const double nb = (double)(in->spp + in->train_spp); /* the film's count per pixel */
+  const double uniform_nb = (double)(in->spp + in->train_spp); /* the film's count per pixel */
+  const int cn = in->has_counts ? iris_image_channel(img, "spp") : -1; /* adaptive: per pixel */
+  if (cn >= 0) m->any_counts = true;
   const int cc = img->channel_count;
   for (int y = in->y0; y < in->y1; y++)
     for (int x = in->x0; x < in->x1; x++) {
       const float *px = img->data + ((size_t)(y - in->y0) * (size_t)img->width + (size_t)(x - in->x0)) * (size_t)cc;
       size_t i = (size_t)y * (size_t)m->width + (size_t)x;
+      const double nb = cn >= 0 ? (double)px[cn] : uniform_nb;
+      if (!(nb >= 0.0 && nb <= 4294967295.0 && nb == floor(nb)))
+        return iris_error_set(err, IRIS_ERR_INVALID, path, 0, "spp", "pixel (%d, %d): %g is not a sample count", x,
+                              y, (double)px[cn]);
+      if (nb == 0.0) continue;
       double na = m->n[i], n = na + nb;
       for (int c = 0; c < 3; c++) {
         double mb = px[cm[c]];
@@ -515,10 +524,11 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
   int64_t begin = 0, end = 0;
   iris_status st = check_coverage(m, &begin, &end, err);
   if (st != IRIS_OK) return st;
-  static const char *const names[6] = {"R", "G", "B", "var.R", "var.G", "var.B"};
+  static const char *const with_var[7] = {"R", "G", "B", "var.R", "var.G", "var.B", "spp"};
+  static const char *const without_var[4] = {"R", "G", "B", "spp"};
   const bool var = m->all_variance;
-  const int cc = var ? 6 : 3;
-  st = iris_image_create(out, m->width, m->height, cc, names, err);
+  const int cc = (var ? 6 : 3) + (m->any_counts ? 1 : 0);
+  st = iris_image_create(out, m->width, m->height, cc, var ? with_var : without_var, err);
   if (st != IRIS_OK) return st;
   size_t n = (size_t)m->width * (size_t)m->height;
   for (size_t i = 0; i < n; i++) {
@@ -528,6 +538,7 @@ iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **
       px[c] = (float)m->mean[3 * i + c];
       if (var) px[3 + c] = k > 1.0 ? (float)(m->m2[3 * i + c] / (k - 1.0) / k) : 0.0f;
     }
+    if (m->any_counts) px[cc - 1] = (float)k;
   }
 
   /* Metadata: the first part's iris:* keys (not the EXR's own, such as type

@@ -42,6 +42,8 @@ typedef struct iris_merge_part_info {
   int64_t train_spp;    /* iris:train_spp: the guide's training samples also in the image (only
                            at sample offset 0: docs/distributed.md; default 0) */
   bool has_variance;    /* var.R/G/B present (variance of the mean) */
+  bool has_counts;      /* an "spp" channel: each pixel's sample count (adaptive sampling; training
+                           samples included); its iris:spp is then the reserved index range */
 } iris_merge_part_info;
 
 /* Parses and checks a part's metadata against its image (window size equals
@@ -68,6 +70,7 @@ typedef struct iris_merge {
   double render_seconds; /* sum over parts */
   uint64_t nan_count;    /* sum over parts */
   bool all_variance;
+  bool any_counts;       /* some part had per-pixel counts: the merge writes an "spp" channel */
   int64_t train_spp;     /* of the parts at sample offset 0 (all equal) */
   int width, height;
   double *n;    /* samples per pixel */
@@ -87,7 +90,8 @@ iris_status iris_merge_add(iris_merge *m, const char *path, const iris_image *im
 /* Checks that the parts tile the frame exactly (no overlapping windows, no
  * pixel left out) and that every window has a contiguous, non-overlapping run
  * of sample ranges, the same run everywhere; then produces the merged image
- * (R, G, B and, when every part had it, var.R/G/B) and its metadata
+ * (R, G, B and, when every part had it, var.R/G/B; "spp", each pixel's merged
+ * sample count, when any part was adaptive) and its metadata
  * (malloc'ed; the caller frees *meta). */
 iris_status iris_merge_finish(iris_merge *m, iris_image *out, iris_image_meta **meta,
                               size_t *meta_count, iris_error *err);

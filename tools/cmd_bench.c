@@ -29,7 +29,9 @@ static void print_help(void) {
       "                       auto: guided-nee or mis per scene); a method may\n"
       "                       name its variant: mis@independent, mis@area,\n"
       "                       mis@independent+area, mis@power (sampler, emitter\n"
-      "                       triangles, light sampler power|tree)\n"
+      "                       triangles, light sampler power|tree), mis@adaptive\n"
+      "                       (adaptive sampling, samples where they lower relMSE\n"
+      "                       most), mis@freeze (Cycles' rule at its threshold 0.01)\n"
       "      --times LIST     comma-separated budgets in seconds, e.g. 1,2,4,8,16\n"
       "      --seeds N        seeds 0..N-1 per budget (default 1)\n"
       "      --threads N      worker threads (default: all cores)\n"
@@ -47,7 +49,10 @@ static void print_help(void) {
       "      --cache DIR      cache of auto references (default ~/.cache/iris/bench)\n"
       "Cycles:\n"
       "      --cycles         also render with Blender Cycles at the spp of each budget's\n"
-      "                       mis run (seed 0); its render time excludes start-up\n"
+      "                       mis run (seed s); its render time excludes start-up\n"
+      "      --cycles-adaptive   also render with Cycles as Blender users run it:\n"
+      "                       adaptive sampling on, each budget its time limit\n"
+      "      --cycles-threshold T   Cycles' noise threshold (default 0.01, Blender's)\n"
       "      --blender EXE    Blender executable (default $IRIS_BLENDER, else blender)\n"
       "Output:\n"
       "  -o, --out DIR        results.csv, results.json, table.md, table.html, images/,\n"
@@ -166,6 +171,13 @@ int iris_cmd_bench(int argc, char **argv) {
     } else if (strcmp(a, "--cycles") == 0) {
       NO_VALUE();
       p.cycles = true;
+    } else if (strcmp(a, "--cycles-adaptive") == 0) {
+      NO_VALUE();
+      p.cycles_adaptive = true;
+    } else if (strcmp(a, "--cycles-threshold") == 0) {
+      NEED_VALUE();
+      if (!iris_cli_parse_float(CMD, a, val, 1e-6, 0.999, &dv)) return IRIS_EXIT_USAGE;
+      p.cycles_threshold = dv;
     } else if (strcmp(a, "--blender") == 0) {
       NEED_VALUE();
       p.blender = val;
@@ -237,7 +249,7 @@ int iris_cmd_bench(int argc, char **argv) {
       iris_light_sampler lsr;
       if (!iris_bench_method_parse(items[k], &m, &smp, &lsr, &ls))
         return iris_cli_usage_error(CMD, "unknown method '%s' (auto, bsdf, nee, mis, guided, guided-nee, "
-                                         "optionally @ and + joined independent, area, power, tree)", items[k]);
+                                         "optionally @ and + joined independent, area, power, tree, adaptive, freeze)", items[k]);
       /* --sampler and --light-sampling set what a plain name means */
       if (!strchr(items[k], '@')) {
         smp = sampler;
@@ -249,6 +261,7 @@ int iris_cmd_bench(int argc, char **argv) {
       p.light_samplings[p.method_count] = ls;
       p.keep_training[p.method_count] = iris_bench_method_keeps_training(items[k]);
       p.light_samplers[p.method_count] = lsr;
+      p.adaptive[p.method_count] = iris_bench_method_adaptive(items[k]);
       char a[64], b[64];
       iris_bench_method_label(&p, p.method_count, a, sizeof a);
       for (int j = 0; j < p.method_count; j++)

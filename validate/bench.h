@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "renderer/adaptive.h"
 #include "renderer/integrator.h"
 #include "validate/validate.h"
 
@@ -54,6 +55,9 @@ typedef struct iris_bench_params {
    * ("@keep" / "@discard" when not IRIS_KEEP_TRAINING_DEFAULT) */
   bool keep_training[IRIS_BENCH_MAX_METHODS];
   iris_light_sampler light_samplers[IRIS_BENCH_MAX_METHODS]; /* NEE's light choice (@power, @tree) */
+  iris_adaptive_rule adaptive[IRIS_BENCH_MAX_METHODS]; /* @adaptive: relmse allocation, the budget
+                                                           deciding; @freeze: Cycles' rule at
+                                                           IRIS_BENCH_ADAPTIVE_THRESHOLD, the budget a cap */
   int method_count;
   double times[IRIS_BENCH_MAX_TIMES];  /* wall-clock budgets in seconds, setup included */
   int time_count;
@@ -65,7 +69,10 @@ typedef struct iris_bench_params {
                                  the other follows the scene's aspect ratio */
   int threads;                /* <= 0: all cores (iris and Blender) */
   int max_depth;              /* < 0: the scene's, else 64 */
-  bool cycles;                /* also time Blender Cycles */
+  bool cycles;                /* also time Blender Cycles at mis's spp ("cycles" rows) */
+  bool cycles_adaptive;       /* also Cycles as users run it ("cycles-adaptive" rows): adaptive
+                                 sampling at cycles_threshold, each budget its time limit */
+  double cycles_threshold;    /* Cycles' noise threshold (default 0.01, Blender's) */
   const char *blender;        /* NULL: $IRIS_BLENDER, else "blender" */
   double target_relmse;       /* time-to-target column; <= 0: per scene (bench_table.h) */
   const char *out_dir;
@@ -89,6 +96,10 @@ const char *iris_bench_method_label(const iris_bench_params *p, int k, char *buf
 /* Whether a label asks for the training samples to be kept ("@keep"),
  * discarded ("@discard"), else IRIS_KEEP_TRAINING_DEFAULT. */
 bool iris_bench_method_keeps_training(const char *label);
+/* The adaptive rule a label asks for: "@adaptive" relmse, "@freeze" Cycles' rule, else off. */
+iris_adaptive_rule iris_bench_method_adaptive(const char *label);
+/* The noise threshold of @freeze rows: Blender's default. */
+#define IRIS_BENCH_ADAPTIVE_THRESHOLD 0.01
 bool iris_bench_method_parse(const char *label, iris_method *m, iris_sampler_kind *sampler, iris_light_sampler *light_sampler,
                              iris_triangle_sampling *light);
 
@@ -117,7 +128,8 @@ typedef struct iris_bench_scene {
   double reference_relmse; /* the reference's own expected relMSE, from its variance channels
                               (contained in every measured relMSE); < 0 unknown */
   double target_relmse;  /* used for the time-to-target column */
-  char images[IRIS_BENCH_MAX_METHODS + 2][64]; /* preview PNG names in DIR/images: reference, methods, cycles */
+  char images[IRIS_BENCH_MAX_METHODS + 3][64]; /* preview PNG names in DIR/images: reference, methods,
+                                                  cycles, cycles-adaptive */
   int image_count;
 } iris_bench_scene;
 
@@ -126,7 +138,7 @@ typedef struct iris_bench_result {
   size_t row_count, row_capacity;
   iris_bench_scene scenes[IRIS_BENCH_MAX_SCENES];
   int scene_count;
-  bool cycles_done;
+  bool cycles_done, cycles_adaptive_done;
   char cycles_version[64];
   bool charts;             /* the plot script ran */
   bool interrupted;

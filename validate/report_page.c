@@ -230,6 +230,13 @@ static void bench_section(page *pg, const char *sub, const cJSON *o) {
         join_rel(sub, diff, rel, sizeof rel);
         put_figure(pg, rel, cap, "render");
       }
+      const char *spp = jstr(im, "spp");
+      if (spp[0]) { /* adaptive: where the samples went */
+        char cap[96];
+        snprintf(cap, sizeof cap, "%s samples per pixel (log2 of count / mean, blue -3 .. red +3)", jstr(im, "what"));
+        join_rel(sub, spp, rel, sizeof rel);
+        put_figure(pg, rel, cap, "render");
+      }
       fprintf(fp, "</div>\n");
     }
     fprintf(fp, "</div>\n");
