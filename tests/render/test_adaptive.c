@@ -32,12 +32,9 @@
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 
+/* The fixture's parameters (spp set by the caller), on 2 threads. */
 static iris_render_params base(int w, int h, iris_method m, uint64_t seed) {
-  iris_render_params p = iris_render_params_default();
-  p.width = w;
-  p.height = h;
-  p.method = m;
-  p.seed = seed;
+  iris_render_params p = iris_test_params(w, h, 0, m, seed);
   p.threads = 2;
   return p;
 }
