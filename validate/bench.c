@@ -734,6 +734,10 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           rp.light_sampling = p.light_samplings[k];
           rp.keep_training = p.keep_training[k];
           rp.light_sampler = p.light_samplers[k];
+          if (rp.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && !rp.guide) { /* the caches' light tables */
+            rp.guide = &iris_guiding_provider;
+            rp.guide_options = &gp;
+          }
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;
