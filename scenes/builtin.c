@@ -6,6 +6,7 @@
 
 #include "scenes/door.h"
 #include "scenes/office.h"
+#include "scenes/rooms.h"
 #include "scenes/sky.h"
 #include "scenes/stress/stress.h"
 
@@ -18,7 +19,9 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
                                     "env-objects", "env-spheres", "sky-room",
                                     /* 400 ceiling lamps (scenes/office.h) */
-                                    "office", NULL};
+                                    "office",
+                                    /* rooms along a corridor, most lamps hidden (scenes/rooms.h) */
+                                    "corridor-rooms", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -332,6 +335,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = iris_sky_room_build(s);
   else if (strcmp(name, "office") == 0)
     st = iris_office_scene_build(s);
+  else if (strcmp(name, "corridor-rooms") == 0)
+    st = iris_rooms_scene_build(s);
   else if (iris_stress_find(name))
     st = iris_stress_build(name, s);
   else

@@ -1015,6 +1015,10 @@ static iris_status provider_guide(const iris_guide_setup *setup, const iris_guid
   }
   iris_status st = p->guide_in ? iris_guiding_load(p->guide_in, scene_hash, settings_hash, setup->threads, g, err)
                                : iris_guiding_build(setup, p, g, err);
+  if (st == IRIS_OK && p->guide_in && (*g)->lights.count &&
+      (!setup->learn_lights || !iris_light_select_attach(&(*g)->lights, *g, setup->lights)))
+    st = iris_error_set(err, IRIS_ERR_PARSE, p->guide_in, 0, NULL,
+                        "guide file's learned light tables do not fit this scene's lights (corrupted)");
   if (st == IRIS_OK && p->guide_in) { /* not in the file: derived from the caches and the scene */
     (*g)->params.use_nee = p->use_nee;
     (*g)->params.sky_regions = p->sky_regions;

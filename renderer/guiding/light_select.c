@@ -101,6 +101,8 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
                                     const iris_photon_map *photons, int k, int threads, iris_error *err) {
   memset(sel, 0, sizeof *sel);
   sel->beta = IRIS_LIGHT_SELECT_BETA;
+  if (getenv("IRIS_LB")) sel->beta = (float)atof(getenv("IRIS_LB")); /* EXPERIMENT */
+  if (getenv("IRIS_LK")) k = atoi(getenv("IRIS_LK")); /* EXPERIMENT */
   if (!lights->tree || g->cache_count == 0 || k <= 0) return IRIS_OK;
   const iris_light_tree *t = lights->tree;
   size_t nd = 0;
@@ -169,6 +171,25 @@ void iris_light_select_destroy(iris_light_select *sel) {
   float beta = sel->beta;
   memset(sel, 0, sizeof *sel);
   sel->beta = beta;
+}
+
+bool iris_light_select_attach(iris_light_select *sel, const iris_guiding *g, const iris_lights *lights) {
+  const iris_light_tree *t = lights->tree;
+  if (!t || sel->cache_count != g->cache_count || !(sel->beta >= 0.0f && sel->beta < 1.0f)) return false;
+  for (size_t i = 0; i < sel->cache_count; ++i) {
+    const iris_light_select_slot *s = &sel->slots[i * IRIS_LIGHT_SELECT_SLOTS];
+    if (sel->count[i] > IRIS_LIGHT_SELECT_SLOTS) return false;
+    float prev = 0.0f;
+    for (uint32_t k = 0; k < sel->count[i]; ++k) {
+      if (s[k].leaf >= t->node_count || !(t->nodes[s[k].leaf].flags & IRIS_LIGHT_NODE_LEAF)) return false;
+      if (!(s[k].cdf >= prev && s[k].cdf <= 1.0f)) return false;
+      prev = s[k].cdf;
+    }
+    if (sel->count[i] && prev != 1.0f) return false;
+  }
+  sel->g = g;
+  sel->tree = t;
+  return true;
 }
 
 /* The tied caches at (p, n) that learned something; 0 where the mixture is the tree alone. */

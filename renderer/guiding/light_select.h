@@ -60,6 +60,10 @@ iris_status iris_light_select_build(iris_light_select *sel, const struct iris_gu
                                     const iris_lights *lights, const iris_photon_map *photons, int k,
                                     int threads, iris_error *err);
 void iris_light_select_destroy(iris_light_select *sel);
+/* Ties tables read from a guide file (guide_file.h) to g and the lights'
+ * tree: false when they do not fit it (a leaf that is not one of the tree's
+ * leaves, a cdf that does not rise to 1, beta outside [0, 1)). */
+bool iris_light_select_attach(iris_light_select *sel, const struct iris_guiding *g, const iris_lights *lights);
 /* Bytes of the tables of `caches` caches (iris info's memory estimate). */
 size_t iris_light_select_bytes(size_t caches);
 

@@ -8,7 +8,8 @@
  *  - the pmfs sum to (1 - beta) x the tree's sum + beta where caches learned
  *    something (one with the tree's dead ends left out);
  *  - a light the caches never saw keeps (1 - beta) of its tree probability;
- *  - the tables are the same for 1 and 2 threads and learned something;
+ *  - the tables are the same for 1 and 2 threads and learned something, and
+ *    come back the same from a guide file (refused where a leaf is no leaf);
  *  - renders: mis, nee and guided-nee with learned selection agree with mis
  *    with the tree within statistical error (office; nee and mis on
  *    veach-mis), and a learned render is the same for 1 and 2 threads. */
@@ -21,6 +22,7 @@
 #include "chi2.h"
 #include "film_stats.h"
 #include "render_run.h"
+#include "renderer/guiding/guide_file.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/guiding/light_select.h"
 #include "renderer/render.h"
@@ -220,6 +222,29 @@ int main(void) {
             memcmp(w2.g->lights.count, sel->count, sel->cache_count) == 0 &&
             memcmp(w2.g->lights.slots, sel->slots, sel->cache_count * IRIS_LIGHT_SELECT_SLOTS * sizeof *sel->slots) == 0);
       world_destroy(&w2);
+    }
+    /* the tables through a guide file: the same, and refused when they do not fit the lights' tree */
+    {
+      iris_error err;
+      iris_error_clear(&err);
+      const char *path = "test_light_select.guide";
+      iris_guiding *back = NULL;
+      CHECK_OK(iris_guiding_save(w.g, path, 1, 2, &err), &err);
+      CHECK_OK(iris_guiding_load(path, 1, 2, 1, &back, &err), &err);
+      if (CHECK(back != NULL)) {
+        CHECK(back->lights.cache_count == sel->cache_count && back->lights.beta == sel->beta &&
+              memcmp(back->lights.count, sel->count, sel->cache_count) == 0 &&
+              memcmp(back->lights.slots, sel->slots, sel->cache_count * IRIS_LIGHT_SELECT_SLOTS * sizeof *sel->slots) == 0);
+        CHECK(iris_light_select_attach(&back->lights, back, &w.lights));
+        CHECK(iris_light_select_pmf(&back->lights, w.g->caches[0].p, w.g->caches[0].frame.n, 3) ==
+              iris_light_select_pmf(sel, w.g->caches[0].p, w.g->caches[0].frame.n, 3));
+        size_t i = 0;
+        while (i < sel->cache_count && !sel->count[i]) i++;
+        back->lights.slots[i * IRIS_LIGHT_SELECT_SLOTS].leaf = 1; /* the root's first child: not a leaf here */
+        CHECK(!iris_light_select_attach(&back->lights, back, &w.lights));
+        iris_guiding_destroy(back);
+      }
+      remove(path);
     }
     /* points: caches with a table (their own position and normal), and
      * points beside them (between caches, another normal) */
