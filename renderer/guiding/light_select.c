@@ -52,6 +52,7 @@ typedef struct build_ctx {
   const direct_photon *dp;
   iris_kdtree tree;
   uint32_t k;
+  float max_d2;
   uint32_t **ids;
   float **d2;
   leaf_energy **sums;
@@ -67,7 +68,7 @@ static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
     if (iris_cancel_requested()) return;
     const iris_cache *cache = &sel->g->caches[i];
     accept_ctx a = {c->dp, cache->frame.n, cache->sphere != 0};
-    uint32_t n = iris_kdtree_knn_if(&c->tree, cache->p, c->k, INFINITY, accept_photon, &a, ids, d2);
+    uint32_t n = iris_kdtree_knn_if(&c->tree, cache->p, c->k, c->max_d2, accept_photon, &a, ids, d2);
     for (uint32_t j = 0; j < n; ++j) {
       sums[j].leaf = c->dp[ids[j]].leaf;
       sums[j].energy = c->dp[ids[j]].energy;
@@ -101,8 +102,6 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
                                     const iris_photon_map *photons, int k, int threads, iris_error *err) {
   memset(sel, 0, sizeof *sel);
   sel->beta = IRIS_LIGHT_SELECT_BETA;
-  if (getenv("IRIS_LB")) sel->beta = (float)atof(getenv("IRIS_LB")); /* EXPERIMENT */
-  if (getenv("IRIS_LK")) k = atoi(getenv("IRIS_LK")); /* EXPERIMENT */
   if (!lights->tree || g->cache_count == 0 || k <= 0) return IRIS_OK;
   const iris_light_tree *t = lights->tree;
   size_t nd = 0;
@@ -115,6 +114,8 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
   memset(&c, 0, sizeof c);
   c.sel = sel;
   c.k = (uint32_t)k;
+  /* pick_radius2 is (3 x the caches' spacing)^2 (guiding.c) */
+  c.max_d2 = IRIS_LIGHT_SELECT_RADIUS * IRIS_LIGHT_SELECT_RADIUS * g->pick_radius2 / 9.0f;
   direct_photon *dp = malloc(sizeof *dp * nd);
   sel->count = calloc(g->cache_count, 1);
   sel->slots = calloc(g->cache_count * IRIS_LIGHT_SELECT_SLOTS, sizeof *sel->slots);

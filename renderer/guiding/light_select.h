@@ -1,7 +1,8 @@
 /* Learned light selection (--light-sampler learned; docs/guiding.md,
  * "Learned light selection"): every irradiance cache keeps a distribution
- * over the light tree's leaves learned from the photons that arrived there
- * straight from a light (by emitter: what is not hidden from the cache), and
+ * over the light tree's leaves learned from the photons that arrived near it
+ * (within half the caches' spacing) straight from a light, by emitter: what
+ * is not hidden from the cache; and
  * next-event estimation chooses a light from the mixture
  *
  *     P(l | x, n) = (1 - beta) P_tree(l | x, n) + beta (1/m) sum_j q_j(leaf(l)) P_leaf(l),
@@ -34,6 +35,9 @@ struct iris_guiding;
 #define IRIS_LIGHT_SELECT_SLOTS 16
 /* Default share of the learned choice (docs/guiding.md, "Learned light selection"). */
 #define IRIS_LIGHT_SELECT_BETA 0.5f
+/* Photons a cache learns from lie within this factor of the caches' spacing
+ * (the 90th percentile of the distance to the 5th nearest cache). */
+#define IRIS_LIGHT_SELECT_RADIUS 0.5f
 
 typedef struct iris_light_select_slot {
   uint32_t leaf; /* node index of a light-tree leaf */
@@ -52,7 +56,8 @@ typedef struct iris_light_select {
 } iris_light_select;
 
 /* Learns the tables of g's caches from the photons' direct hits (the k =
- * cache_k nearest usable ones of each cache, as the caches' own photons,
+ * cache_k nearest usable ones of each cache within IRIS_LIGHT_SELECT_RADIUS
+ * of the spacing, filtered as the caches' own photons,
  * their energy summed by the tree leaf of the light they left). Needs
  * lights->tree (else the selection stays empty: the tree alone chooses).
  * Deterministic for any thread count. */
