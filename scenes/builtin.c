@@ -46,6 +46,18 @@ static int32_t add_mesh_instance(iris_scene *scene, iris_mesh *m) {
   return iris_scene_add_instance(scene, &inst) < 0 ? -1 : mi;
 }
 
+int32_t iris_builtin_add_diffuse(iris_scene *scene, const char *name, float r, float g, float b, float emission,
+                                 const float tint[3]) {
+  iris_material m = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  m.name = iris_strdup(name);
+  m.color[0] = r;
+  m.color[1] = g;
+  m.color[2] = b;
+  for (int k = 0; k < 3; k++) m.emission[k] = tint[k] * emission;
+  m.emission_two_sided = false;
+  return m.name ? iris_scene_add_material(scene, &m) : -1;
+}
+
 int32_t iris_builtin_add_quad(iris_scene *scene, iris_vec3 c, iris_vec3 a, iris_vec3 b, int n,
                               int32_t material, const char *name) {
   if (n < 1) n = 1;

@@ -31,6 +31,10 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
  * an identity instance. Returns the mesh index or -1 when out of memory. */
 int32_t iris_builtin_add_sphere(iris_scene *scene, iris_vec3 center, float radius, int segments,
                                 int32_t material, const char *name);
+/* Appends a diffuse material of colour (r, g, b) emitting emission x tint
+ * (one-sided); returns its index or -1 when out of memory. */
+int32_t iris_builtin_add_diffuse(iris_scene *scene, const char *name, float r, float g, float b, float emission,
+                                 const float tint[3]);
 /* Appends the parallelogram c + s*a + t*b, (s, t) in [-1, 1]^2, split into
  * n x n quads, and an identity instance; the front face is on the side of
  * cross(a, b). */

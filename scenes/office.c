@@ -6,17 +6,11 @@
 
 #include "scenes/builtin.h"
 
+/* The lamps' warm white. */
+static const float TINT[3] = {1.0f, 0.95f, 0.85f};
+
 static int32_t add_material(iris_scene *s, const char *name, float r, float g, float b, float emission) {
-  iris_material m = iris_material_default(IRIS_MATERIAL_DIFFUSE);
-  m.name = iris_strdup(name);
-  m.color[0] = r;
-  m.color[1] = g;
-  m.color[2] = b;
-  m.emission[0] = emission;
-  m.emission[1] = 0.95f * emission;
-  m.emission[2] = 0.85f * emission;
-  m.emission_two_sided = false;
-  return m.name ? iris_scene_add_material(s, &m) : -1;
+  return iris_builtin_add_diffuse(s, name, r, g, b, emission, TINT);
 }
 
 #define LAMPS 20          /* per side */

@@ -706,7 +706,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     }
   }
   if (st == IRIS_OK && !g->stats.skipped && s->learn_lights && g->cache_count) {
-    st = iris_light_select_build(&g->lights, g, s->lights, &photons, p->cache_k, s->threads, err);
+    st = iris_light_select_build(&g->lights, g, s->lights, &photons, p->cache_k, s->seed, s->threads, err);
     g->stats.memory_bytes += g->lights.count ? iris_light_select_bytes(g->cache_count) : 0;
   }
   g->stats.cache_seconds = iris_time_now() - t1;

@@ -6,6 +6,7 @@
 
 #include "core/cancel.h"
 #include "core/parallel.h"
+#include "core/rng.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/guiding/kdtree.h"
 
@@ -49,6 +50,8 @@ static int by_energy(const void *a, const void *b) {
 
 typedef struct build_ctx {
   iris_light_select *sel;
+  const iris_lights *lights;
+  uint64_t seed;
   const direct_photon *dp;
   iris_kdtree tree;
   uint32_t k;
@@ -57,6 +60,36 @@ typedef struct build_ctx {
   float **d2;
   leaf_energy **sums;
 } build_ctx;
+
+/* The share of the tree's light samples at a cache whose shadow ray hits
+ * something: IRIS_LIGHT_SELECT_PROBES samples of the tree at the cache's
+ * position and normal, numbers from a hash of (seed, cache, probe). */
+static double hidden_share(const build_ctx *c, const iris_cache *cache, uint64_t index) {
+  const iris_lights *L = c->lights;
+  int valid = 0, hidden = 0;
+  for (int k = 0; k < IRIS_LIGHT_SELECT_PROBES; ++k) {
+    uint64_t h = iris_hash4(c->seed, index, (uint64_t)k, 0x11947ULL);
+    float u = (float)((h >> 40) * 0x1p-24), u0 = (float)(((h >> 16) & 0xffffffu) * 0x1p-24);
+    float u1 = (float)(iris_mix64(h) >> 40) * 0x1p-24f;
+    iris_light_choice ch = {0, 0.0f, true};
+    if (!iris_light_tree_sample(L->tree, cache->p, cache->frame.n, u, &ch.light, &ch.pmf_group)) continue;
+    iris_light_sample ls;
+    if (!iris_lights_sample_choice(L, cache->p, &ch, u0, u1, &ls)) continue;
+    if (!(iris_dot(ls.wi, cache->frame.n) > 0.0f) && !cache->sphere) continue;
+    iris_ray r;
+    if (isfinite(ls.dist) && !ls.delta) {
+      r = iris_spawn_ray_to(cache->p, cache->frame.n, ls.p, ls.n);
+    } else {
+      r.o = iris_offset_origin(cache->p, cache->frame.n, ls.wi);
+      r.d = ls.wi;
+      r.tmin = 0.0f;
+      r.tmax = isfinite(ls.dist) ? ls.dist * (1.0f - 1e-5f) : INFINITY;
+    }
+    valid++;
+    hidden += iris_accel_occluded(L->accel, &r);
+  }
+  return valid ? (double)hidden / (double)valid : 0.0;
+}
 
 static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   build_ctx *c = ctx;
@@ -83,13 +116,16 @@ static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
     uint32_t used = leaves < IRIS_LIGHT_SELECT_SLOTS ? leaves : IRIS_LIGHT_SELECT_SLOTS;
     double total = 0.0, acc = 0.0;
     for (uint32_t j = 0; j < used; ++j) total += sums[j].energy;
-    if (!(total > 0.0)) used = 0;
+    if (!(total > 0.0) || n < IRIS_LIGHT_SELECT_MIN_PHOTONS) used = 0;
     iris_light_select_slot *s = &sel->slots[i * IRIS_LIGHT_SELECT_SLOTS];
     for (uint32_t j = 0; j < used; ++j) {
       acc += sums[j].energy;
       s[j].leaf = sums[j].leaf;
       s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / total);
     }
+    /* Where the tree's choice is rarely hidden, the table has nothing to add
+     * (and its noise to lose): the tree alone. */
+    if (used && hidden_share(c, cache, i) < IRIS_LIGHT_SELECT_HIDDEN_MIN) used = 0;
     sel->count[i] = (uint8_t)used;
   }
 }
@@ -99,7 +135,8 @@ size_t iris_light_select_bytes(size_t caches) {
 }
 
 iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *g, const iris_lights *lights,
-                                    const iris_photon_map *photons, int k, int threads, iris_error *err) {
+                                    const iris_photon_map *photons, int k, uint64_t seed, int threads,
+                                    iris_error *err) {
   memset(sel, 0, sizeof *sel);
   sel->beta = IRIS_LIGHT_SELECT_BETA;
   if (!lights->tree || g->cache_count == 0 || k <= 0) return IRIS_OK;
@@ -113,6 +150,8 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
   build_ctx c;
   memset(&c, 0, sizeof c);
   c.sel = sel;
+  c.lights = lights;
+  c.seed = seed;
   c.k = (uint32_t)k;
   /* pick_radius2 is (3 x the caches' spacing)^2 (guiding.c) */
   c.max_d2 = IRIS_LIGHT_SELECT_RADIUS * IRIS_LIGHT_SELECT_RADIUS * g->pick_radius2 / 9.0f;

@@ -10,7 +10,11 @@
  * the caches j = 1..m those Algorithm 1 ties for (x, n) (iris_guiding_pick
  * with the normal light selection is told, the geometric one) that have a
  * table; beta = 0 where there are none (zero normal, no cache, nothing
- * learned). The tree keeps every light it would choose reachable, so a
+ * learned). A cache keeps a table only where it learned from at least
+ * IRIS_LIGHT_SELECT_MIN_PHOTONS photons and where shadow-ray probes of the
+ * tree's own choice at the cache find at least IRIS_LIGHT_SELECT_HIDDEN_MIN
+ * of it hidden: elsewhere the tree already chooses what is seen, and the
+ * table would only add its noise. The tree keeps every light it would choose reachable, so a
  * light the caches never saw costs at most a factor 1/(1 - beta) of its
  * samples. The pmf is one function of (x, n, l): the sampler and the MIS
  * weight of a BSDF-sampled hit from the same vertex agree bit for bit. */
@@ -38,6 +42,12 @@ struct iris_guiding;
 /* Photons a cache learns from lie within this factor of the caches' spacing
  * (the 90th percentile of the distance to the 5th nearest cache). */
 #define IRIS_LIGHT_SELECT_RADIUS 0.5f
+/* A cache keeps its table only where at least this share of the tree's light
+ * samples at the cache (IRIS_LIGHT_SELECT_PROBES shadow rays) is hidden. */
+#define IRIS_LIGHT_SELECT_HIDDEN_MIN 0.15
+#define IRIS_LIGHT_SELECT_PROBES 32
+/* ... and learned from at least this many direct photons. */
+#define IRIS_LIGHT_SELECT_MIN_PHOTONS 32
 
 typedef struct iris_light_select_slot {
   uint32_t leaf; /* node index of a light-tree leaf */
@@ -63,7 +73,7 @@ typedef struct iris_light_select {
  * Deterministic for any thread count. */
 iris_status iris_light_select_build(iris_light_select *sel, const struct iris_guiding *g,
                                     const iris_lights *lights, const iris_photon_map *photons, int k,
-                                    int threads, iris_error *err);
+                                    uint64_t seed, int threads, iris_error *err);
 void iris_light_select_destroy(iris_light_select *sel);
 /* Ties tables read from a guide file (guide_file.h) to g and the lights'
  * tree: false when they do not fit it (a leaf that is not one of the tree's
