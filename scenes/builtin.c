@@ -58,6 +58,16 @@ int32_t iris_builtin_add_diffuse(iris_scene *scene, const char *name, float r, f
   return m.name ? iris_scene_add_material(scene, &m) : -1;
 }
 
+bool iris_builtin_add_lamps(iris_scene *scene, float base, const float tint[3], int32_t lamp[4]) {
+  for (int k = 0; k < 4; k++) {
+    char name[32];
+    snprintf(name, sizeof name, "lamp_%d", 1 << k);
+    lamp[k] = iris_builtin_add_diffuse(scene, name, 0.8f, 0.8f, 0.8f, base * (float)(1 << k), tint);
+    if (lamp[k] < 0) return false;
+  }
+  return true;
+}
+
 int32_t iris_builtin_add_quad(iris_scene *scene, iris_vec3 c, iris_vec3 a, iris_vec3 b, int n,
                               int32_t material, const char *name) {
   if (n < 1) n = 1;

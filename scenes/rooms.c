@@ -35,12 +35,7 @@ iris_status iris_rooms_scene_build(iris_scene *s) {
   int32_t floor = add_material(s, "floor", 0.45f, 0.4f, 0.35f, 0.0f);
   int32_t corridor_lamp = add_material(s, "corridor_lamp", 0.8f, 0.8f, 0.8f, 1.5f);
   int32_t lamp[4];
-  for (int k = 0; k < 4; k++) {
-    char name[32];
-    snprintf(name, sizeof name, "lamp_%d", 1 << k);
-    lamp[k] = add_material(s, name, 0.8f, 0.8f, 0.8f, 3.0f * (float)(1 << k));
-    if (lamp[k] < 0) return IRIS_ERR_NOMEM;
-  }
+  if (!iris_builtin_add_lamps(s, 3.0f, TINT, lamp)) return IRIS_ERR_NOMEM;
   if (wall < 0 || floor < 0 || corridor_lamp < 0) return IRIS_ERR_NOMEM;
   const float D = 1.0f + ROOM; /* the rooms' far walls */
   bool ok = true;

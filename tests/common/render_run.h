@@ -19,4 +19,21 @@ static inline bool iris_test_render(const iris_scene *s, const iris_render_param
   return true;
 }
 
+/* iris_test_render of w x h pixels, spp samples, with a method, a light
+ * sampler, a thread count, a seed and a guide provider (NULL: none). */
+static inline bool iris_test_render_light(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads,
+                                          int w, int h, int spp, uint64_t seed, const iris_guide_provider *guide,
+                                          iris_render_result *r) {
+  iris_render_params p = iris_render_params_default();
+  p.width = w;
+  p.height = h;
+  p.spp = spp;
+  p.method = m;
+  p.seed = seed;
+  p.threads = threads;
+  p.light_sampler = ls;
+  p.guide = guide;
+  return iris_test_render(s, &p, r);
+}
+
 #endif

@@ -148,16 +148,7 @@ static void check_point(const world *w, iris_vec3 p, iris_vec3 n, int k, int n_t
 
 static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
-  p.seed = seed;
-  p.threads = threads;
-  p.light_sampler = ls;
-  p.guide = &iris_guiding_provider;
-  return iris_test_render(s, &p, r);
+  return iris_test_render_light(s, m, ls, threads, w, h, spp, seed, &iris_guiding_provider, r);
 }
 
 static void compare(const char *name, const char *what, const iris_render_result *a, const iris_render_result *b,

@@ -192,15 +192,7 @@ static void check_point(const iris_light_tree *t, const iris_light_bounds *l, si
 
 static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_render_params_default();
-  p.width = w;
-  p.height = h;
-  p.spp = spp;
-  p.method = m;
-  p.seed = seed;
-  p.threads = threads;
-  p.light_sampler = ls;
-  return iris_test_render(s, &p, r);
+  return iris_test_render_light(s, m, ls, threads, w, h, spp, seed, NULL, r);
 }
 
 int main(void) {
