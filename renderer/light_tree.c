@@ -384,6 +384,21 @@ static uint32_t descend(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, doub
   }
 }
 
+uint32_t iris_light_tree_leaf_choose(const iris_light_tree *t, uint32_t leaf, double v) {
+  const iris_light_tree_node *nd = &t->nodes[leaf];
+  /* by power: the first cdf above v */
+  const float *cdf = &t->leaf_cdf[nd->index];
+  uint32_t j = 0, hi = (nd->flags >> 8) - 1;
+  while (j < hi) {
+    uint32_t mid = (j + hi) / 2;
+    if (v < (double)cdf[mid])
+      hi = mid;
+    else
+      j = mid + 1;
+  }
+  return t->leaf_lights[nd->index + j];
+}
+
 bool iris_light_tree_sample(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, float u, uint32_t *light,
                             float *pmf) {
   *light = 0;
@@ -409,18 +424,7 @@ bool iris_light_tree_sample(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, 
   double q = 1.0 - pi;
   uint32_t leaf = descend(t, p, n, &v, NULL, &q);
   if (leaf == UINT32_MAX) return false;
-  const iris_light_tree_node *nd = &t->nodes[leaf];
-  /* within the leaf by power, with what is left of u: the first cdf above v */
-  const float *cdf = &t->leaf_cdf[nd->index];
-  uint32_t j = 0, hi = (nd->flags >> 8) - 1;
-  while (j < hi) {
-    uint32_t mid = (j + hi) / 2;
-    if (v < (double)cdf[mid])
-      hi = mid;
-    else
-      j = mid + 1;
-  }
-  *light = t->leaf_lights[nd->index + j];
+  *light = iris_light_tree_leaf_choose(t, leaf, v);
   *pmf = (float)(q * (double)t->pmf_in_leaf[*light]);
   return *pmf > 0.0f;
 }

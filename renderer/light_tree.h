@@ -84,6 +84,9 @@ float iris_light_bounds_importance(const iris_light_bounds *b, iris_vec3 p, iris
  * nothing there can receive light. *pmf is the probability of the choice. */
 bool iris_light_tree_sample(const iris_light_tree *tree, iris_vec3 p, iris_vec3 n, float u,
                             uint32_t *light, float *pmf);
+/* The light of leaf node `leaf` whose cumulative power share first exceeds
+ * v in [0, 1) (its probability within the leaf: pmf_in_leaf). */
+uint32_t iris_light_tree_leaf_choose(const iris_light_tree *tree, uint32_t leaf, double v);
 /* The probability that iris_light_tree_sample at (p, n) chooses `light`:
  * retraces its path with the same arithmetic, so the two agree bit for bit. */
 float iris_light_tree_pmf(const iris_light_tree *tree, iris_vec3 p, iris_vec3 n, uint32_t light);

@@ -168,6 +168,7 @@ static float select_pmf_at(const iris_lights *L, iris_vec3 ref, uint32_t group, 
 
 float iris_lights_select_pmf_at(const iris_lights *L, iris_vec3 ref, iris_vec3 n, uint32_t index) {
   if (index >= L->count) return 0.0f;
+  if (L->learned.pmf) return L->learned.pmf(L->learned.ctx, L, ref, n, index);
   if (L->tree) return iris_light_tree_pmf(L->tree, ref, n, index);
   return select_pmf_at(L, ref, L->entries[index].group, entry_pmf_in_group(L, index));
 }
@@ -553,6 +554,13 @@ void iris_lights_choose(const iris_lights *lights, iris_vec3 ref, iris_vec3 n, f
   c->pmf_group = 0.0f;
   c->pmf_is_entry = false;
   if (lights->count == 0) return;
+  if (lights->learned.choose) {
+    c->pmf_is_entry = true;
+    if (!lights->learned.choose(lights->learned.ctx, lights, ref, n, u_select, &c->light, &c->pmf_group))
+      c->pmf_group = 0.0f;
+    if (c->light < lights->tri_count) __builtin_prefetch(&lights->tris[c->light]);
+    return;
+  }
   if (lights->tree) {
     c->pmf_is_entry = true;
     if (!iris_light_tree_sample(lights->tree, ref, n, u_select, &c->light, &c->pmf_group)) c->pmf_group = 0.0f;
@@ -817,8 +825,9 @@ float iris_lights_pdf_triangle(const iris_lights *lights, iris_vec3 ref, iris_ve
   iris_vec3 to = iris_sub(si->p, ref);
   if (!(t->flags & IRIS_LIGHT_TRI_TWO_SIDED) && iris_dot(to, si->ng) >= 0.0f)
     return 0.0f; /* never sampled from behind */
-  float pmf = lights->tree ? iris_light_tree_pmf(lights->tree, ref, n, i)
-                           : select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group);
+  float pmf = lights->learned.pmf ? lights->learned.pmf(lights->learned.ctx, lights, ref, n, i)
+               : lights->tree   ? iris_light_tree_pmf(lights->tree, ref, n, i)
+                                : select_pmf_at(lights, ref, t->flags >> 8, t->pmf_in_group);
   float omega = iris_lights_triangle_solid_angle(t, ref);
   if (omega > 0.0f) return pmf / omega;
   float d2 = iris_dot(to, to);
@@ -972,7 +981,7 @@ bool iris_lights_sample_emission_with(const iris_lights *lights, const iris_dist
 /* ---- the light tree's view of the entries (renderer/light_tree.h) --------- */
 
 const char *iris_light_sampler_name(iris_light_sampler s) {
-  return s == IRIS_LIGHT_SAMPLER_TREE ? "tree" : "power";
+  return s == IRIS_LIGHT_SAMPLER_LEARNED ? "learned" : s == IRIS_LIGHT_SAMPLER_TREE ? "tree" : "power";
 }
 bool iris_light_sampler_parse(const char *name, iris_light_sampler *out) {
   for (int s = 0; s < IRIS_LIGHT_SAMPLER_COUNT; s++)
@@ -1045,7 +1054,8 @@ iris_status iris_lights_set_sampler(iris_lights *L, iris_light_sampler s, iris_e
     free(L->tree);
     L->tree = NULL;
   }
-  if (s != IRIS_LIGHT_SAMPLER_TREE || L->count == 0) return IRIS_OK;
+  memset(&L->learned, 0, sizeof L->learned); /* the renderer installs it again */
+  if (s == IRIS_LIGHT_SAMPLER_POWER || L->count == 0) return IRIS_OK; /* learned mixes with the tree */
   iris_light_bounds *b = malloc(sizeof *b * L->count);
   L->tree = calloc(1, sizeof *L->tree);
   if (!b || !L->tree) {

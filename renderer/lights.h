@@ -90,6 +90,20 @@ typedef struct iris_light_tri {
 #define IRIS_LIGHT_TRI_TEXTURED 2u
 #define IRIS_LIGHT_TRI_AREA_ONLY 4u /* never by solid angle (iris_lights_set_triangle_sampling) */
 
+/* A light choice learned where the lights are seen (--light-sampler learned;
+ * renderer/guiding/light_select.h): when `choose` is set, next-event
+ * estimation chooses through it and every selection probability (the MIS
+ * weights of emitters and of the environment hit by BSDF sampling) asks
+ * `pmf` at the same point and normal, so the two agree bit for bit. */
+struct iris_lights;
+typedef struct iris_light_learned {
+  const void *ctx;
+  /* false: nothing to choose at (ref, n); else the entry and its probability */
+  bool (*choose)(const void *ctx, const struct iris_lights *L, iris_vec3 ref, iris_vec3 n, float u,
+                 uint32_t *light, float *pmf);
+  float (*pmf)(const void *ctx, const struct iris_lights *L, iris_vec3 ref, iris_vec3 n, uint32_t light);
+} iris_light_learned;
+
 typedef struct iris_lights {
   const iris_scene *scene;
   const iris_accel *accel;
@@ -115,6 +129,7 @@ typedef struct iris_lights {
   double total_power;
   uint64_t id;            /* unique per build (keys the per-thread selection cache) */
   iris_light_tree *tree;  /* --light-sampler tree: NEE chooses through it (owned); NULL: by power */
+  iris_light_learned learned; /* --light-sampler learned, once installed (not owned); zero: none */
 } iris_lights;
 
 /* Builds the light list. A scene without emitters gives count == 0 (renders black
@@ -142,11 +157,14 @@ float iris_lights_select_pmf_at(const iris_lights *lights, iris_vec3 ref, iris_v
 typedef enum iris_light_sampler {
   IRIS_LIGHT_SAMPLER_POWER = 0,
   IRIS_LIGHT_SAMPLER_TREE = 1,
+  IRIS_LIGHT_SAMPLER_LEARNED = 2, /* the tree mixed with what the guide's caches learned
+                                     (renderer/guiding/light_select.h); until the
+                                     renderer installs that (iris_lights.learned): the tree */
   IRIS_LIGHT_SAMPLER_COUNT
 } iris_light_sampler;
 /* The choice of renders that do not say (measured: docs/performance.md, "Light tree"). */
 #define IRIS_LIGHT_SAMPLER_DEFAULT IRIS_LIGHT_SAMPLER_TREE
-const char *iris_light_sampler_name(iris_light_sampler s); /* "power", "tree" */
+const char *iris_light_sampler_name(iris_light_sampler s); /* "power", "tree", "learned" */
 bool iris_light_sampler_parse(const char *name, iris_light_sampler *out);
 /* Switches the NEE light choice (builds or frees the tree; a tree that
  * would be a single leaf is not kept: lights->tree stays NULL and the power

@@ -19,6 +19,7 @@
 #define BASE_BYTES 14e6                 /* iris + libraries + Embree's threads */
 #define PATH_BYTES 240.0                /* one photon path: ~4 stored photons and their kd-tree */
 #define CACHE_BYTES 1400.0              /* one 8x8 cache with its tables */
+#define LIGHT_SELECT_BYTES 129.0        /* one cache's learned light table (guiding/light_select.h) */
 #define FILM_BYTES_PER_PIXEL 62.0       /* sums, counts and the EXR image */
 #define ENV_BYTES_PER_TEXEL 24.0        /* RGB float + sampling tables */
 
@@ -119,7 +120,9 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
     double paths = caches * 200.0 / 20.0 * (1.0 + 0.05 * (double)(light_groups > 1 ? light_groups - 1 : 0));
     if (s->has_environment) paths *= 2.0; /* up to twice with a sky (its share of the power) */
     paths = paths < 100000 ? 100000 : (paths > 4000000 ? 4000000 : paths);
-    out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES);
+    /* learned light selection: with more than one light to choose from */
+    if (emissive_tris + s->light_count > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
+    out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;
   }
   out->film = (uint64_t)(FILM_BYTES_PER_PIXEL * (double)width * height);
   out->base = (uint64_t)BASE_BYTES;

@@ -23,7 +23,8 @@ typedef struct iris_memory_estimate {
   uint64_t accel;    /* BVHs, vertex copies, placement tables, the build's peak extra */
   uint64_t textures; /* decoded RGBA8 textures and the environment map */
   uint64_t lights;   /* emissive triangle tables */
-  uint64_t guide;    /* photons and caches (guided methods and auto) */
+  uint64_t guide;    /* photons and caches (guided methods and auto), light_select included */
+  uint64_t light_select; /* the caches' learned light tables (--light-sampler learned) */
   uint64_t film;     /* film sums and the output images */
   uint64_t base;     /* the process itself (code, libraries, thread stacks) */
   uint64_t total;

@@ -167,7 +167,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   {
     iris_memory_estimate est;
     iris_memory_estimate_scene(scene, b.x1 - b.x0, b.y1 - b.y0,
-                               p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method), &est);
+                               p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method) ||
+                                   p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED,
+                               &est);
     iris_memory_format(&est, mem_line, sizeof mem_line);
     st = iris_memory_check(&est, scene->source_path ? scene->source_path : "scene", err);
     if (st != IRIS_OK) return st;
@@ -206,6 +208,11 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     it.rr_depth = p.rr_depth;
   }
   const bool resolve = p.method == IRIS_METHOD_AUTO;
+  /* --light-sampler learned: the guide's caches learn which lights they see
+   * (a tree of more than one leaf to learn over, a provider that can). */
+  const bool learned = st == IRIS_OK && p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && lights.tree && p.guide &&
+                       p.guide->light_select && p.guide->build_lights && iris_method_uses_nee(resolve ? IRIS_METHOD_MIS : p.method);
+  void *light_state = NULL; /* the guide built for the light choice alone (nee, mis) */
   if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the light tables */
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
@@ -225,7 +232,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
                            p.guide_options, p.time_budget > 0.0 ? 0 : guide_spp,
                            p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, resolve,
-                           p.phase, p.phase_ctx, t0, keep_training ? &res->film : NULL, b};
+                           p.phase, p.phase_ctx, t0, keep_training ? &res->film : NULL, b, learned};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK && resolve) {
@@ -242,6 +249,15 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       if (guide_state && p.guide->destroy) p.guide->destroy(guide_state);
       guide_state = NULL;
     }
+  }
+  if (st == IRIS_OK && learned && guide_state) lights.learned = p.guide->light_select(guide_state);
+  if (st == IRIS_OK && learned && !lights.learned.choose) { /* no guide, or one that skipped the scene */
+    iris_guide_setup gs = {scene, accel, &lights, &textures, &res->camera, &it, p.seed, p.threads,
+                           p.guide_options, p.time_budget > 0.0 ? 0 : p.spp,
+                           p.time_budget > 0.0 ? p.time_budget : 0.0, p.sampler, false,
+                           p.phase, p.phase_ctx, t0, NULL, b, true};
+    st = p.guide->build_lights(&gs, &light_state, err);
+    if (st == IRIS_OK) lights.learned = p.guide->light_select(light_state);
   }
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the guide's last phase */
   if (st == IRIS_OK) {
@@ -365,7 +381,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
   }
   free(stats);
+  memset(&lights.learned, 0, sizeof lights.learned);
   if (guide_state && p.guide && p.guide->destroy) p.guide->destroy(guide_state);
+  if (light_state && p.guide && p.guide->destroy) p.guide->destroy(light_state);
   iris_lights_destroy(&lights);
   iris_textures_destroy(&textures);
   iris_accel_destroy(accel);

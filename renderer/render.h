@@ -60,6 +60,9 @@ typedef struct iris_guide_setup {
    * (docs/guiding.md, "Training samples"). */
   iris_film *film;
   iris_pixel_bounds window;
+  /* --light-sampler learned: the guide also learns which lights its caches
+   * see (renderer/guiding/light_select.h) for iris_guide_provider.light_select. */
+  bool learn_lights;
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;
@@ -73,6 +76,13 @@ typedef struct iris_guide_provider {
    * e.g. "75% of the photons indirect" or "the scene has no lights".
    * `--method auto` resolves to guided-nee when true, to mis when false. */
   bool (*decision)(const void *state, char *why, size_t size);
+  /* Optional (NULL: --light-sampler learned chooses with the tree alone).
+   * build_lights: a guide built only for learned light selection (methods
+   * without a guide of their own: photons and caches, no training);
+   * light_select: the hooks for iris_lights.learned from a guide built with
+   * setup->learn_lights (zero when it learned nothing), valid until destroy. */
+  iris_status (*build_lights)(const iris_guide_setup *setup, void **state, iris_error *err);
+  iris_light_learned (*light_select)(const void *state);
 } iris_guide_provider;
 
 typedef struct iris_render_params {

@@ -6,6 +6,7 @@
 
 #include "scenes/door.h"
 #include "scenes/office.h"
+#include "scenes/rooms.h"
 #include "scenes/sky.h"
 #include "scenes/stress/stress.h"
 
@@ -18,7 +19,9 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
                                     "env-objects", "env-spheres", "sky-room",
                                     /* 400 ceiling lamps (scenes/office.h) */
-                                    "office", NULL};
+                                    "office",
+                                    /* rooms along a corridor, most lamps hidden (scenes/rooms.h) */
+                                    "corridor-rooms", NULL};
 
 const char *const *iris_builtin_names(void) { return NAMES; }
 
@@ -41,6 +44,28 @@ static int32_t add_mesh_instance(iris_scene *scene, iris_mesh *m) {
   inst.mesh = (uint32_t)mi;
   inst.transform = iris_mat4_identity();
   return iris_scene_add_instance(scene, &inst) < 0 ? -1 : mi;
+}
+
+int32_t iris_builtin_add_diffuse(iris_scene *scene, const char *name, float r, float g, float b, float emission,
+                                 const float tint[3]) {
+  iris_material m = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+  m.name = iris_strdup(name);
+  m.color[0] = r;
+  m.color[1] = g;
+  m.color[2] = b;
+  for (int k = 0; k < 3; k++) m.emission[k] = tint[k] * emission;
+  m.emission_two_sided = false;
+  return m.name ? iris_scene_add_material(scene, &m) : -1;
+}
+
+bool iris_builtin_add_lamps(iris_scene *scene, float base, const float tint[3], int32_t lamp[4]) {
+  for (int k = 0; k < 4; k++) {
+    char name[32];
+    snprintf(name, sizeof name, "lamp_%d", 1 << k);
+    lamp[k] = iris_builtin_add_diffuse(scene, name, 0.8f, 0.8f, 0.8f, base * (float)(1 << k), tint);
+    if (lamp[k] < 0) return false;
+  }
+  return true;
 }
 
 int32_t iris_builtin_add_quad(iris_scene *scene, iris_vec3 c, iris_vec3 a, iris_vec3 b, int n,
@@ -332,6 +357,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = iris_sky_room_build(s);
   else if (strcmp(name, "office") == 0)
     st = iris_office_scene_build(s);
+  else if (strcmp(name, "corridor-rooms") == 0)
+    st = iris_rooms_scene_build(s);
   else if (iris_stress_find(name))
     st = iris_stress_build(name, s);
   else

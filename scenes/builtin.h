@@ -31,6 +31,13 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
  * an identity instance. Returns the mesh index or -1 when out of memory. */
 int32_t iris_builtin_add_sphere(iris_scene *scene, iris_vec3 center, float radius, int segments,
                                 int32_t material, const char *name);
+/* Appends a diffuse material of colour (r, g, b) emitting emission x tint
+ * (one-sided); returns its index or -1 when out of memory. */
+int32_t iris_builtin_add_diffuse(iris_scene *scene, const char *name, float r, float g, float b, float emission,
+                                 const float tint[3]);
+/* Appends four lamp materials "lamp_1" .. "lamp_8" (grey 0.8) emitting
+ * base x 1, 2, 4, 8 x tint into lamp[4]; false when out of memory. */
+bool iris_builtin_add_lamps(iris_scene *scene, float base, const float tint[3], int32_t lamp[4]);
 /* Appends the parallelogram c + s*a + t*b, (s, t) in [-1, 1]^2, split into
  * n x n quads, and an identity instance; the front face is on the side of
  * cross(a, b). */

@@ -6,17 +6,11 @@
 
 #include "scenes/builtin.h"
 
+/* The lamps' warm white. */
+static const float TINT[3] = {1.0f, 0.95f, 0.85f};
+
 static int32_t add_material(iris_scene *s, const char *name, float r, float g, float b, float emission) {
-  iris_material m = iris_material_default(IRIS_MATERIAL_DIFFUSE);
-  m.name = iris_strdup(name);
-  m.color[0] = r;
-  m.color[1] = g;
-  m.color[2] = b;
-  m.emission[0] = emission;
-  m.emission[1] = 0.95f * emission;
-  m.emission[2] = 0.85f * emission;
-  m.emission_two_sided = false;
-  return m.name ? iris_scene_add_material(s, &m) : -1;
+  return iris_builtin_add_diffuse(s, name, r, g, b, emission, TINT);
 }
 
 #define LAMPS 20          /* per side */
@@ -29,12 +23,7 @@ iris_status iris_office_scene_build(iris_scene *s) {
   int32_t partition = add_material(s, "partition", 0.35f, 0.45f, 0.55f, 0.0f);
   int32_t off = add_material(s, "lamp_off", 0.8f, 0.8f, 0.8f, 0.0f);
   int32_t lamp[4];
-  for (int k = 0; k < 4; k++) {
-    char name[32];
-    snprintf(name, sizeof name, "lamp_%d", 1 << k);
-    lamp[k] = add_material(s, name, 0.8f, 0.8f, 0.8f, 2.5f * (float)(1 << k));
-    if (lamp[k] < 0) return IRIS_ERR_NOMEM;
-  }
+  if (!iris_builtin_add_lamps(s, 2.5f, TINT, lamp)) return IRIS_ERR_NOMEM;
   if (wall < 0 || floor < 0 || partition < 0 || off < 0) return IRIS_ERR_NOMEM;
   bool ok = true;
   /* The shell; quads are shaded from both sides, fronts face inwards. */

@@ -357,7 +357,9 @@ int iris_cmd_render(int argc, char **argv) {
   if (aov_caches) gp.marks = &marks;
   if (gp.marks || gp.dump_dir) gp.inspect = iris_guiding_inspect;
   /* unset (the scene's method, else auto) and auto may need the guide too */
-  if (iris_method_uses_guiding(p.method) || p.method == IRIS_METHOD_AUTO || p.method == IRIS_METHOD_COUNT) {
+  /* ... and --light-sampler learned (the caches' light tables) for any method */
+  if (iris_method_uses_guiding(p.method) || p.method == IRIS_METHOD_AUTO || p.method == IRIS_METHOD_COUNT ||
+      p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED) {
     p.guide = &iris_guiding_provider;
     p.guide_options = &gp;
     p.config_hash = guiding_params_hash(&gp);

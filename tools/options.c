@@ -48,7 +48,7 @@ iris_env_options iris_env_options_default(void) {
 /* In the order of iris_sampler_kind and iris_triangle_sampling. */
 static const char *const SAMPLER_CHOICES[] = {"sobol", "independent", NULL};
 static const char *const LIGHT_SAMPLING_CHOICES[] = {"solid-angle", "area", NULL};
-static const char *const LIGHT_SAMPLER_CHOICES[] = {"power", "tree", NULL}; /* iris_light_sampler */
+static const char *const LIGHT_SAMPLER_CHOICES[] = {"power", "tree", "learned", NULL}; /* iris_light_sampler */
 static const iris_option RENDER_ROWS[] = {
     OPT("spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, iris_render_options, spp,
         "samples per pixel (default: the scene's, else 64)"),

@@ -801,6 +801,10 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
             rp.adaptive.noise_threshold = p.adaptive[k] == IRIS_ADAPTIVE_FREEZE ? IRIS_BENCH_ADAPTIVE_THRESHOLD : 0.0;
             rp.spp = 1 << 20;
           }
+          if (rp.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && !rp.guide) { /* the caches' light tables */
+            rp.guide = &iris_guiding_provider;
+            rp.guide_options = &gp;
+          }
           rp.time_budget = p.times[t];
           rp.budget_includes_setup = true;
           iris_render_result rr;

@@ -618,7 +618,8 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     rp.max_depth = res->max_depth;
     rp.camera_name = p.camera_name;
     rp.cancel = p.cancel;
-    if (iris_method_uses_guiding(rp.method) || rp.method == IRIS_METHOD_AUTO || rp.method == IRIS_METHOD_COUNT) {
+    if (iris_method_uses_guiding(rp.method) || rp.method == IRIS_METHOD_AUTO || rp.method == IRIS_METHOD_COUNT ||
+        rp.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED) {
       rp.guide = &iris_guiding_provider;
       rp.guide_options = &gp;
     }

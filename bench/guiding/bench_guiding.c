@@ -67,7 +67,15 @@ static void timed_destroy(void *state) { iris_guiding_provider.destroy(state); }
 static bool timed_decision(const void *state, char *why, size_t size) {
   return iris_guiding_provider.decision(state, why, size);
 }
-static const iris_guide_provider timed_provider = {timed_build, timed_destroy, timed_decision};
+static iris_status timed_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
+  double t0 = cpu_seconds();
+  iris_status st = iris_guiding_provider.build_lights(setup, state, err);
+  g_guide_cpu += cpu_seconds() - t0;
+  return st;
+}
+static iris_light_learned timed_light_select(const void *state) { return iris_guiding_provider.light_select(state); }
+static const iris_guide_provider timed_provider = {timed_build, timed_destroy, timed_decision, timed_build_lights,
+                                                   timed_light_select};
 
 int main(int argc, char **argv) {
   if (argc < 3) {

@@ -17,6 +17,9 @@ static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
 #define CACHE_BYTES 66u      /* one cache record */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
+#define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
+#define LIGHTS_HEAD_BYTES 12u /* beta f32 + direct photons u64 */
+#define LIGHTS_CACHE_BYTES (1u + 8u * IRIS_LIGHT_SELECT_SLOTS) /* count u8 + slots (leaf u32, cdf f32) */
 #define REASON_MAX 159u
 
 /* ---- checksum ---------------------------------------------------------------- */
@@ -154,7 +157,8 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
   writer w = {NULL, 0, 0, false};
   put_bytes(&w, MAGIC, sizeof MAGIC);
   put_u32(&w, IRIS_GUIDE_FILE_VERSION);
-  put_u32(&w, 0); /* flags, none yet */
+  const bool lights = !g->stats.skipped && g->lights.count;
+  put_u32(&w, lights ? GUIDE_FLAG_LIGHTS : 0);
   put_u64(&w, scene_hash);
   put_u64(&w, settings_hash);
   put_u64(&w, 0); /* payload size, set below */
@@ -203,6 +207,18 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     for (uint32_t t = 0; t < texels_of(g, c); ++t) {
       put_f32(&w, g->alias[c->table + t].q);
       put_u32(&w, g->alias[c->table + t].alias);
+    }
+  }
+  if (lights) {
+    put_f32(&w, g->lights.beta);
+    put_u64(&w, g->lights.direct_photons);
+    for (size_t i = 0; i < count; ++i) {
+      put_u8(&w, g->lights.count[i]);
+      for (int k = 0; k < IRIS_LIGHT_SELECT_SLOTS; ++k) {
+        const iris_light_select_slot *sl = &g->lights.slots[i * IRIS_LIGHT_SELECT_SLOTS + (size_t)k];
+        put_u32(&w, sl->leaf);
+        put_f32(&w, sl->cdf);
+      }
     }
   }
   if (w.failed) {
@@ -350,7 +366,7 @@ static iris_status refuse(iris_error *err, const char *path, const char *what) {
 
 /* Parses and checks the payload into g (caches, tables, params, stats). */
 static iris_status read_payload(reader *r, const char *path, iris_guiding *g, uint32_t *res_out, float *spacing,
-                                int grid_n[3], float grid_lo[3], iris_error *err) {
+                                int grid_n[3], float grid_lo[3], bool lights, iris_error *err) {
   if (!get_params(r, &g->params) || r->short_read)
     return refuse(err, path, "guide file has invalid guiding parameters (corrupted)");
   if (!get_stats(r, &g->stats) || r->short_read)
@@ -371,8 +387,9 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     if (grid_n[a] < 0 || !isfinite(grid_lo[a]))
       return refuse(err, path, "guide file has an invalid cache grid (corrupted)");
   /* Counts bounded by the bytes that remain before anything is allocated. */
+  const uint64_t light_bytes = lights ? LIGHTS_HEAD_BYTES + count * LIGHTS_CACHE_BYTES : 0;
   if (count > r->left / CACHE_BYTES || texels > r->left / TEXEL_BYTES ||
-      count * CACHE_BYTES + texels * TEXEL_BYTES != r->left)
+      count * CACHE_BYTES + texels * TEXEL_BYTES + light_bytes != r->left)
     return refuse(err, path, "guide file's cache and texel counts do not match its size (corrupted)");
   if (count > UINT32_MAX || texels > UINT32_MAX)
     return refuse(err, path, "guide file has too many caches or texels");
@@ -432,6 +449,23 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
                               i, t);
     }
   }
+  if (lights) { /* checked against the lights' tree when the render attaches them (light_select.h) */
+    iris_light_select *sel = &g->lights;
+    sel->beta = get_f32(r);
+    sel->direct_photons = get_u64(r);
+    sel->cache_count = g->cache_count;
+    sel->count = calloc(g->cache_count ? g->cache_count : 1, 1);
+    sel->slots = calloc((g->cache_count ? g->cache_count : 1) * IRIS_LIGHT_SELECT_SLOTS, sizeof *sel->slots);
+    if (!sel->count || !sel->slots) return iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory");
+    for (size_t i = 0; i < g->cache_count; ++i) {
+      sel->count[i] = get_u8(r);
+      sel->learned_caches += sel->count[i] > 0;
+      for (size_t k = 0; k < IRIS_LIGHT_SELECT_SLOTS; ++k) {
+        sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + k].leaf = get_u32(r);
+        sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + k].cdf = get_f32(r);
+      }
+    }
+  }
   if (r->short_read || r->left != 0) return refuse(err, path, "guide file is truncated");
   return IRIS_OK;
 }
@@ -452,7 +486,7 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
     return refuse(err, path, "not an iris guide file (written by iris render --guide-out)");
   }
   uint32_t version = get_u32(&r);
-  (void)get_u32(&r); /* flags */
+  const uint32_t flags = get_u32(&r);
   uint64_t file_scene = get_u64(&r), file_settings = get_u64(&r), payload = get_u64(&r), sum = get_u64(&r);
   if (r.short_read) {
     free(data);
@@ -494,7 +528,7 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
   uint32_t res = 0;
   float spacing = 0.0f, grid_lo[3];
   int grid_n[3];
-  st = read_payload(&r, path, g, &res, &spacing, grid_n, grid_lo, err);
+  st = read_payload(&r, path, g, &res, &spacing, grid_n, grid_lo, (flags & GUIDE_FLAG_LIGHTS) != 0, err);
   free(data);
   /* Derived and deterministic: rebuilt as iris_guiding_build makes them. */
   if (st == IRIS_OK) st = iris_octmap_create(&g->hemi, (int)res, false, err);
@@ -554,6 +588,8 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   /* training's light samples choose through the tree or by power; the power
    * sampler keeps the hash guides had before the tree */
   if (s->lights && s->lights->tree) h = mix_u64(h, 0x7ee11ULL);
+  /* --light-sampler learned: the file holds the caches' light tables */
+  if (s->learn_lights) h = mix_u64(h, 0x1ea4edULL);
   /* The guiding options as requested (auto values resolve the same way from
    * the same scene and camera). train_spp enters as given: with -1 (auto)
    * the training budget follows the writer's spp/time, which are left out so

@@ -705,6 +705,10 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
                               g->grid.memory_bytes;
     }
   }
+  if (st == IRIS_OK && !g->stats.skipped && s->learn_lights && g->cache_count) {
+    st = iris_light_select_build(&g->lights, g, s->lights, &photons, p->cache_k, s->seed, s->threads, err);
+    g->stats.memory_bytes += g->lights.count ? iris_light_select_bytes(g->cache_count) : 0;
+  }
   g->stats.cache_seconds = iris_time_now() - t1;
   /* Inspection outputs need the photons (counts in the dumps): before freeing them. */
   if (st == IRIS_OK && !g->stats.skipped && p->inspect && (p->dump_dir || p->marks))
@@ -774,6 +778,7 @@ iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setu
 void iris_guiding_destroy(iris_guiding *g) {
   if (!g) return;
   iris_skyvis_destroy(&g->sky);
+  iris_light_select_destroy(&g->lights);
   iris_octmap_destroy(&g->hemi);
   iris_octmap_destroy(&g->sphere);
   iris_kdtree_destroy(&g->tree);
@@ -1010,6 +1015,10 @@ static iris_status provider_guide(const iris_guide_setup *setup, const iris_guid
   }
   iris_status st = p->guide_in ? iris_guiding_load(p->guide_in, scene_hash, settings_hash, setup->threads, g, err)
                                : iris_guiding_build(setup, p, g, err);
+  if (st == IRIS_OK && p->guide_in && (*g)->lights.count &&
+      (!setup->learn_lights || !iris_light_select_attach(&(*g)->lights, *g, setup->lights)))
+    st = iris_error_set(err, IRIS_ERR_PARSE, p->guide_in, 0, NULL,
+                        "guide file's learned light tables do not fit this scene's lights (corrupted)");
   if (st == IRIS_OK && p->guide_in) { /* not in the file: derived from the caches and the scene */
     (*g)->params.use_nee = p->use_nee;
     (*g)->params.sky_regions = p->sky_regions;
@@ -1037,9 +1046,39 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   iris_guiding_describe(g, line, sizeof line);
   if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
   else iris_infof("%s", line);
+  if (g->lights.count)
+    iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons, beta %.2f",
+               (unsigned long long)g->lights.learned_caches, g->lights.cache_count,
+               (unsigned long long)g->lights.direct_photons, (double)g->lights.beta);
   *out = iris_guiding_sampler(g);
   *state = g;
   return IRIS_OK;
+}
+
+/* For methods without a guide of their own: the caches only (built whatever
+ * the skip rules say, no training, no file), for the learned light choice. */
+static iris_status provider_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
+  iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
+                                         : iris_guiding_params_default();
+  p.use_nee = true;
+  p.force = true;
+  p.train_spp = 0;
+  p.pilot_paths = 0;
+  p.sky_probes = 0;
+  p.guide_in = p.guide_out = NULL;
+  p.dump_dir = NULL;
+  p.marks = NULL;
+  iris_direction_sampler unused;
+  iris_guide_setup s = *setup;
+  s.options = &p;
+  s.film = NULL;
+  s.deciding = false;
+  return provider_build(&s, &unused, state, err);
+}
+
+static iris_light_learned provider_light_select(const void *state) {
+  const iris_guiding *g = state;
+  return iris_light_select_hooks(g && !g->stats.skipped ? &g->lights : NULL);
 }
 
 static void provider_destroy(void *state) { iris_guiding_destroy(state); }
@@ -1067,4 +1106,5 @@ static bool provider_decision(const void *state, char *why, size_t size) {
   return true;
 }
 
-const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy, provider_decision};
+const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy, provider_decision,
+                                                   provider_build_lights, provider_light_select};

@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "renderer/guiding/cache.h"
 #include "renderer/guiding/kdtree.h"
+#include "renderer/guiding/light_select.h"
 #include "renderer/guiding/octmap.h"
 #include "renderer/guiding/photons.h"
 #include "renderer/guiding/pickgrid.h"
@@ -143,6 +144,7 @@ typedef struct iris_guiding {
   float alpha_cap;     /* cap on learned selection probabilities: --alpha-max when given, else 0.95 */
   float *photon_hist;  /* during training only: each cache's photon histogram, normalised (pdf layout) */
   iris_skyvis sky;     /* sky visibility per cache (env NULL: none) */
+  iris_light_select lights; /* learned light selection (setup->learn_lights; light_select.h) */
   iris_guiding_stats stats;
 } iris_guiding;
 

@@ -96,6 +96,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.energy = iris_avg3(beta);
       ph.bounce = (uint8_t)(bounce > 255 ? 255 : bounce);
       ph.transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
+      ph.light = e.light;
       block_push(out, &ph);
     }
     iris_direction_sample ds;

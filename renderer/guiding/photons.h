@@ -20,7 +20,7 @@ extern "C" {
 
 #define IRIS_PHOTON_MAX_BOUNCES 32
 
-/* One stored photon (32 bytes + padding). Energy is a single float, the mean
+/* One stored photon (48 bytes). Energy is a single float, the mean
  * of the RGB power (the thesis's choice): the caches only need the relative
  * distribution of incident power over directions, not its colour. */
 typedef struct iris_photon {
@@ -30,6 +30,7 @@ typedef struct iris_photon {
   float energy;     /* mean of the RGB photon power */
   uint8_t bounce;   /* 0: straight from the light (direct illumination) */
   uint8_t transmits;/* the surface has transmission lobes (full-sphere cache) */
+  uint32_t light;   /* the light entry it left (iris_lights; learned light selection) */
 } iris_photon;
 
 typedef struct iris_photon_map {

@@ -327,3 +327,39 @@ bool chi2_self_test(char *msg, size_t msg_size) {
            c.passed ? "PASS" : "fail", c.message);
   return ok;
 }
+
+double chi2_discrete(const double *pmf, const size_t *hits, size_t n, size_t n_samples, size_t got, double *chi_out,
+                     int *dof_out) {
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++) sum += pmf[i];
+  double chi = 0.0, pool_e = 0.0, pool_o = 0.0;
+  int cells = 0;
+  double e_none = (1.0 - fmin(sum, 1.0)) * (double)n_samples, o_none = (double)(n_samples - got);
+  if (e_none >= 5.0) {
+    chi += (o_none - e_none) * (o_none - e_none) / e_none;
+    cells++;
+  } else {
+    pool_e += e_none;
+    pool_o += o_none;
+  }
+  for (size_t i = 0; i < n; i++) {
+    double e = pmf[i] * (double)n_samples;
+    if (e < 5.0) {
+      pool_e += e;
+      pool_o += (double)hits[i];
+      continue;
+    }
+    chi += ((double)hits[i] - e) * ((double)hits[i] - e) / e;
+    cells++;
+  }
+  if (pool_e > 0.0) {
+    chi += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
+    cells++;
+  } else if (pool_o > 0.0) {
+    chi = INFINITY;
+  }
+  int dof = cells - 1;
+  *chi_out = chi;
+  *dof_out = dof;
+  return dof > 0 ? chi2_gamma_q(0.5 * dof, 0.5 * chi) : (chi == 0.0 || cells == 1 ? 1.0 : 0.0);
+}

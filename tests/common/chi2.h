@@ -57,6 +57,14 @@ chi2_result chi2_run(const chi2_domain *domain, chi2_sample_fn sample, chi2_pdf_
 double chi2_integrate(const chi2_domain *domain, chi2_pdf_fn fn, void *ctx, chi2_sample_fn hint,
                       void *hint_ctx, size_t n_hint);
 
+/* Pearson's test of a discrete sampler: hits[i] of n_samples draws chose
+ * outcome i (i < n) of probability pmf[i], the other n_samples - got chose
+ * nothing (probability 1 - sum pmf); cells of expected count < 5 are pooled.
+ * Returns the p-value, with the statistic and degrees of freedom in *chi and
+ * *dof (a pooled cell with draws but no probability: chi = INFINITY). */
+double chi2_discrete(const double *pmf, const size_t *hits, size_t n, size_t n_samples, size_t got, double *chi,
+                     int *dof);
+
 /* Regularised upper incomplete gamma Q(a, x) = Gamma(a, x) / Gamma(a). */
 double chi2_gamma_q(double a, double x);
 

@@ -89,4 +89,16 @@ static inline bool iris_test_render_image(const iris_scene *s, const iris_render
   return ok;
 }
 
+/* iris_test_render of w x h pixels, spp samples, with a method, a light
+ * sampler, a thread count, a seed and a guide provider (NULL: none). */
+static inline bool iris_test_render_light(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads,
+                                          int w, int h, int spp, uint64_t seed, const iris_guide_provider *guide,
+                                          iris_render_result *r) {
+  iris_render_params p = iris_test_params(w, h, spp, m, seed);
+  p.threads = threads;
+  p.light_sampler = ls;
+  p.guide = guide;
+  return iris_test_render(s, &p, r);
+}
+
 #endif

@@ -30,7 +30,7 @@ static inline iris_guiding *test_guide_build(const iris_scene *s, iris_method me
     iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
     it.method = method;
     gp.use_nee = iris_method_uses_nee(method);
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}};
+    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
     if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   } else {
     fprintf(stderr, "scene set-up failed: %s\n", err.message);

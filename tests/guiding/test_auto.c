@@ -39,7 +39,7 @@ static void keep_destroy(void *state) { iris_guiding_provider.destroy(state); }
 static bool keep_decision(const void *state, char *why, size_t size) {
   return iris_guiding_provider.decision(state, why, size);
 }
-static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision};
+static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision, NULL, NULL};
 
 /* Renders `s` with `method` (spp samples, w x h); pilot: -1 auto, 0 none. */
 static bool render(const iris_scene *s, iris_method method, int w, int h, int spp, uint64_t seed, int64_t pilot,

@@ -51,7 +51,7 @@ static iris_status poison_build(const iris_guide_setup *setup, iris_direction_sa
 }
 
 static void test_nan_guard(const iris_scene *s) {
-  static const iris_guide_provider poison = {poison_build, NULL, NULL};
+  static const iris_guide_provider poison = {poison_build, NULL, NULL, NULL, NULL};
   iris_render_params p = iris_render_params_default();
   p.width = 16;
   p.height = 16;

@@ -179,34 +179,9 @@ static void check_point(const iris_light_tree *t, const iris_light_bounds *l, si
   } else {
     printf("set %d point (%g,%g,%g) n (%g,%g,%g): pmfs sum to %.6f\n", set, p.x, p.y, p.z, nrm.x, nrm.y, nrm.z, sum);
     /* Pearson over the lights and "nothing", pooling cells of expected count < 5 */
-    double chi = 0.0, pool_e = 0.0, pool_o = 0.0;
-    int cells = 0;
-    double e_none = (1.0 - fmin(sum, 1.0)) * N_SAMPLES, o_none = (double)(N_SAMPLES - got);
-    if (e_none >= 5.0) {
-      chi += (o_none - e_none) * (o_none - e_none) / e_none;
-      cells++;
-    } else {
-      pool_e += e_none;
-      pool_o += o_none;
-    }
-    for (size_t i = 0; i < n; i++) {
-      double e = pmf[i] * (double)N_SAMPLES;
-      if (e < 5.0) {
-        pool_e += e;
-        pool_o += (double)hits[i];
-        continue;
-      }
-      chi += ((double)hits[i] - e) * ((double)hits[i] - e) / e;
-      cells++;
-    }
-    if (pool_e > 0.0) {
-      chi += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-      cells++;
-    } else if (pool_o > 0.0) {
-      chi = INFINITY;
-    }
-    int dof = cells - 1;
-    double pv = dof > 0 ? chi2_gamma_q(0.5 * dof, 0.5 * chi) : (chi == 0.0 || cells == 1 ? 1.0 : 0.0);
+    double chi;
+    int dof;
+    double pv = chi2_discrete(pmf, hits, n, N_SAMPLES, got, &chi, &dof);
     double sig = 1.0 - pow(1.0 - alpha_total, 1.0 / N_CHI2_TESTS);
     iris_check_record(pv > sig, __FILE__, __LINE__, "set %d point (%g,%g,%g) n (%g,%g,%g): chi2 %.1f dof %d p %.3g < %.3g",
                       set, p.x, p.y, p.z, nrm.x, nrm.y, nrm.z, chi, dof, pv, sig);
@@ -217,10 +192,7 @@ static void check_point(const iris_light_tree *t, const iris_light_bounds *l, si
 
 static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
-  iris_render_params p = iris_test_params(w, h, spp, m, seed);
-  p.threads = threads;
-  p.light_sampler = ls;
-  return iris_test_render(s, &p, r);
+  return iris_test_render_light(s, m, ls, threads, w, h, spp, seed, NULL, r);
 }
 
 int main(void) {
