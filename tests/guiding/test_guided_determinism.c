@@ -37,6 +37,11 @@ static size_t table_floats(const iris_guiding *g) {
 static bool same_guide(const iris_guiding *a, const iris_guiding *b) {
   if (a->cache_count != b->cache_count || a->stats.photons_stored != b->stats.photons_stored) return false;
   size_t n = table_floats(a);
+  if ((a->refine_slot == NULL) != (b->refine_slot == NULL)) return false;
+  if (a->refine_slot && (memcmp(a->refine_slot, b->refine_slot, n) != 0 ||
+                         memcmp(a->refine_sub, b->refine_sub,
+                                sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB * (n / a->hemi.texel_count)) != 0))
+    return false; /* refinement (refine.h) */
   return n == table_floats(b) && memcmp(a->caches, b->caches, a->cache_count * sizeof(iris_cache)) == 0 &&
          memcmp(a->pdf, b->pdf, n * sizeof(float)) == 0 && memcmp(a->alias, b->alias, n * sizeof(iris_cache_alias)) == 0;
 }
