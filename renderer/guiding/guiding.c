@@ -25,8 +25,6 @@
  * other side of a thin wall, the neighbouring wall in a corner) are not
  * splatted: their directions describe another surface's hemisphere. */
 #define PHOTON_NORMAL_COS IRIS_GUIDING_PHOTON_NORMAL_COS
-/* Share of uniform mixed into a refined texel's sub-cells (docs/guiding.md, "Refinement"). */
-#define REFINE_MIX 0.2f
 
 iris_guiding_params iris_guiding_params_default(void) {
   iris_guiding_params p;
@@ -321,7 +319,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       double *prob = (double *)(sq + g->sphere.texel_count), sum = 0.0;
       for (uint32_t t = 0; t < map->texel_count; ++t) sum += hist[t] > 0.0f ? hist[t] : 0.0f;
       for (uint32_t t = 0; t < map->texel_count; ++t) prob[t] = (hist[t] > 0.0f ? hist[t] : 0.0f) / sum;
-      iris_refine_build(map, prob, fine, sq, g->params.refine, REFINE_MIX, g->refine_slot + cache->table,
+      iris_refine_build(map, prob, fine, sq, g->params.refine, IRIS_REFINE_MIX, g->refine_slot + cache->table,
                         iris_guiding_sub(g, cache));
     } else if (g->refine_slot) {
       memset(g->refine_slot + cache->table, 0, map->texel_count);

@@ -80,3 +80,34 @@ int iris_refine_build(const iris_octmap *map, const double *prob, const float *f
   }
   return count;
 }
+
+bool iris_refine_train_add(const iris_octmap *map, const uint8_t *slot, float *acc, uint32_t *count, iris_vec3 wl,
+                           float value) {
+  float l2 = sqrtf(wl.x * wl.x + wl.y * wl.y + wl.z * wl.z), factor;
+  int k;
+  if (!(value > 0.0f) || !isfinite(value) || !(l2 > 0.0f)) return false;
+  int32_t t = iris_cache_cell(map->res, map->sphere, iris_scale(wl, 1.0f / l2), &factor, &k);
+  if (t < 0 || !slot[t]) return false;
+  acc[(size_t)(slot[t] - 1) * IRIS_REFINE_SUB + k] += value;
+  count[slot[t] - 1]++;
+  return true;
+}
+
+void iris_refine_train_rebuild(const iris_octmap *map, const uint8_t *slot, const float *photon_prob,
+                               const float *photon_sub, const float *acc, const uint32_t *count, double prior,
+                               float mix, float *sub) {
+  for (uint32_t t = 0; t < map->texel_count; ++t) {
+    if (!slot[t]) continue;
+    const size_t j = (size_t)(slot[t] - 1);
+    const float *a = acc + j * IRIS_REFINE_SUB, *ph = photon_sub + j * IRIS_REFINE_SUB;
+    double s = 0.0;
+    for (int k = 0; k < IRIS_REFINE_SUB; ++k) s += a[k];
+    if (!(s > 0.0) || !isfinite(s) || count[j] == 0) continue;
+    /* a path sample weighs as a photon: the texel held prior x P(texel) of them */
+    double lambda = (double)count[j] / ((double)count[j] + prior * (double)photon_prob[t]);
+    for (int k = 0; k < IRIS_REFINE_SUB; ++k)
+      sub[j * IRIS_REFINE_SUB + k] =
+          (float)((1.0 - lambda) * ph[k] +
+                  lambda * IRIS_REFINE_SUB * ((1.0 - mix) * a[k] / s + (double)mix / IRIS_REFINE_SUB));
+  }
+}

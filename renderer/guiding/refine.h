@@ -20,6 +20,7 @@ extern "C" {
 #define IRIS_REFINE_S 4 /* sub-cells per texel side (cache.h's iris_cache_cell assumes 4) */
 #define IRIS_REFINE_SUB (IRIS_REFINE_S * IRIS_REFINE_S) /* sub-cells per texel */
 #define IRIS_REFINE_MAX 8                            /* most refined texels per cache */
+#define IRIS_REFINE_MIX 0.2f /* share of uniform in a refined texel's sub-cells (docs/guiding.md) */
 
 /* Index of the fine cell (texel * IRIS_REFINE_SUB + sub-cell, the sub-cell
  * row-major in (u, v) texel coordinates) of local direction d, -1 below a
@@ -40,6 +41,19 @@ bool iris_refine_splat(const iris_octmap *map, float *fine, float *sq, iris_vec3
  * Returns the number refined. */
 int iris_refine_build(const iris_octmap *map, const double *prob, const float *fine, const float *sq, int max,
                       float mix, uint8_t *slot, float *sub);
+
+/* Training (train.c): a path sample of `value` (Li cos / q) at local
+ * direction wl goes to its sub-cell's accumulator acc[max * SUB] and counts in
+ * count[max] when its texel is refined. */
+bool iris_refine_train_add(const iris_octmap *map, const uint8_t *slot, float *acc, uint32_t *count, iris_vec3 wl,
+                           float value);
+/* New sub-tables for one cache's refined texels: the photons' multipliers
+ * (photon_sub) mixed with the path samples' (a fraction `mix` uniform) with
+ * weight n / (n + prior P_photon(texel)), as the coarse tables are. Texels
+ * without samples keep theirs. */
+void iris_refine_train_rebuild(const iris_octmap *map, const uint8_t *slot, const float *photon_prob,
+                               const float *photon_sub, const float *acc, const uint32_t *count, double prior,
+                               float mix, float *sub);
 
 /* Sub-cell choice for a refined texel from u in [0,1): returns k and remaps
  * *u to a uniform number in [0,1) (the position inside the sub-cell). */
