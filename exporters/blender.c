@@ -49,10 +49,16 @@ static const char *const PRELUDE[] = {
     "    ap.add_argument(\"--width\", type=int, default=SETTINGS[\"width\"])",
     "    ap.add_argument(\"--height\", type=int, default=SETTINGS[\"height\"])",
     "    ap.add_argument(\"--max-bounces\", type=int, default=SETTINGS[\"max_depth\"])",
+    "    ap.add_argument(\"--adaptive-threshold\", type=float, default=0.0,",
+    "                    help=\"Cycles' noise threshold (Blender's default 0.01); 0: fixed spp\")",
+    "    ap.add_argument(\"--adaptive-min-samples\", type=int, default=0, help=\"0: automatic\")",
+    "    ap.add_argument(\"--time-limit\", type=float, default=0.0, help=\"seconds; 0: none\")",
     "    ap.add_argument(\"--inventory\", default=None, help=\"JSON file: what Blender's glTF importer created\")",
     "    a = ap.parse_args(argv)",
     "    if a.spp < 1 or a.threads < 1 or a.width < 1 or a.height < 1 or a.max_bounces < 0:",
     "        ap.error(\"--spp, --threads, --width, --height must be >= 1 and --max-bounces >= 0\")",
+    "    if not (a.adaptive_threshold >= 0 and a.time_limit >= 0 and a.adaptive_min_samples >= 0):",
+    "        ap.error(\"--adaptive-threshold, --adaptive-min-samples and --time-limit must be >= 0\")",
     "    return a",
     "",
     "",
@@ -753,7 +759,12 @@ static const char *const PRELUDE[] = {
     "    c.device = \"CPU\"",
     "    c.feature_set = \"SUPPORTED\"",
     "    c.samples = a.spp",
-    "    c.use_adaptive_sampling = False",
+    "    # adaptive sampling as Blender users run it (--adaptive-threshold 0.01), else fixed spp",
+    "    c.use_adaptive_sampling = a.adaptive_threshold > 0",
+    "    if a.adaptive_threshold > 0:",
+    "        c.adaptive_threshold = a.adaptive_threshold",
+    "        c.adaptive_min_samples = a.adaptive_min_samples",
+    "    c.time_limit = a.time_limit",
     "    c.seed = a.seed",
     "    c.use_animated_seed = False",
     "    c.pixel_filter_type = \"BOX\"",
@@ -829,8 +840,11 @@ static const char *const PRELUDE[] = {
     "        sys.exit(1)",
     "    # One parseable line: scene building (of which reading the mesh data), and",
     "    # bpy.ops.render.render (Cycles' sync, BVH build, path tracing, EXR write).",
+    "    c = sc.cycles  # the settings Cycles held, read back",
     "    print(\"IRIS_BLENDER build_seconds=%.3f render_seconds=%.3f spp=%d threads=%d width=%d height=%d \"",
-    "          \"data_seconds=%.3f\" % (t1 - t0, t2 - t1, a.spp, a.threads, a.width, a.height, t_data), flush=True)",
+    "          \"data_seconds=%.3f adaptive=%d adaptive_threshold=%g time_limit=%g\" % (",
+    "              t1 - t0, t2 - t1, a.spp, a.threads, a.width, a.height, t_data,",
+    "              c.use_adaptive_sampling, c.adaptive_threshold, c.time_limit), flush=True)",
     /* END PRELUDE */
 };
 /* clang-format on */
@@ -1277,7 +1291,8 @@ static iris_status write_script(FILE *fp, const iris_scene *scene, const char *s
   fputs("\n# Builds the scene from an empty file and renders it with Cycles using the\n"
         "# fair-comparison settings of iris's docs/export.md. Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
-        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n",
+        "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n"
+        "#           [--adaptive-threshold T [--adaptive-min-samples N]] [--time-limit SECONDS]\n",
         fp);
   iris_blender_put_prelude(fp);
 

@@ -17,7 +17,9 @@ extern "C" {
  * it), all atomically. The script's usage:
  *   blender -b --factory-startup --python-exit-code 1 -P SCRIPT -- --output OUT.exr
  *           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]
- * and it prints "IRIS_BLENDER build_seconds=.. render_seconds=.. ..." on stdout. */
+ *           [--adaptive-threshold T [--adaptive-min-samples N]] [--time-limit SECONDS]
+ * (fixed spp by default; --adaptive-threshold 0.01 is Cycles as Blender users
+ * run it, --spp then the per-pixel cap) and it prints "IRIS_BLENDER build_seconds=.. render_seconds=.. ..." on stdout. */
 iris_status iris_export_blender(const iris_scene *scene, const char *script_path,
                                 const iris_export_params *params, iris_error *err);
 

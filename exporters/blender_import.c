@@ -186,6 +186,7 @@ iris_status iris_export_blender_import(const iris_scene *scene, const char *impo
         "# world with the fair-comparison settings (docs/validation.md, --blender-import). Usage:\n"
         "#   blender -b --factory-startup --python-exit-code 1 -P THIS.py -- --output OUT.exr\n"
         "#           [--spp N] [--threads T] [--seed S] [--width W --height H] [--max-bounces B]\n"
+        "#           [--adaptive-threshold T [--adaptive-min-samples N]] [--time-limit SECONDS]\n"
         "#           [--inventory FILE.json]\n",
         fp);
   iris_blender_put_prelude(fp);

@@ -48,9 +48,15 @@ void iris_film_pixel(const iris_film *film, int x, int y, iris_vec3 *mean, iris_
 
 iris_status iris_film_to_image(const iris_film *film, bool variance, iris_image *out,
                                iris_error *err) {
-  static const char *const names[6] = {"R", "G", "B", "var.R", "var.G", "var.B"};
-  int channels = variance ? 6 : 3;
-  iris_status st = iris_image_create(out, film->width, film->height, channels, names, err);
+  return iris_film_to_image_counts(film, variance, false, out, err);
+}
+
+iris_status iris_film_to_image_counts(const iris_film *film, bool variance, bool counts, iris_image *out,
+                                      iris_error *err) {
+  static const char *const with_var[7] = {"R", "G", "B", "var.R", "var.G", "var.B", "spp"};
+  static const char *const without_var[4] = {"R", "G", "B", "spp"};
+  int channels = (variance ? 6 : 3) + (counts ? 1 : 0);
+  iris_status st = iris_image_create(out, film->width, film->height, channels, variance ? with_var : without_var, err);
   if (st != IRIS_OK) return st;
   for (int y = 0; y < film->height; y++)
     for (int x = 0; x < film->width; x++) {
@@ -59,6 +65,7 @@ iris_status iris_film_to_image(const iris_film *film, bool variance, iris_image 
       float *px = out->data + ((size_t)y * (size_t)film->width + (size_t)x) * (size_t)channels;
       iris_v3_store(m, px);
       if (variance) iris_v3_store(v, px + 3);
+      if (counts) px[channels - 1] = (float)film->count[(size_t)y * (size_t)film->width + (size_t)x];
     }
   return IRIS_OK;
 }

@@ -46,6 +46,10 @@ void iris_film_pixel(const iris_film *film, int x, int y, iris_vec3 *mean, iris_
 /* Image with channels R, G, B and, when `variance`, var.R, var.G, var.B. */
 iris_status iris_film_to_image(const iris_film *film, bool variance, iris_image *out,
                                iris_error *err);
+/* The same, and with `counts` a last channel "spp": each pixel's sample count
+ * (exact in float up to 2^24). */
+iris_status iris_film_to_image_counts(const iris_film *film, bool variance, bool counts, iris_image *out,
+                                      iris_error *err);
 
 #ifdef __cplusplus
 }

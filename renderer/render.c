@@ -109,6 +109,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
                           iris_render_result *res, iris_error *err) {
   memset(res, 0, sizeof *res);
   iris_render_params p = *params_in;
+  const bool adaptive = p.adaptive.rule != IRIS_ADAPTIVE_OFF;
+  if (adaptive && p.spp <= 0) p.spp = IRIS_RENDER_ADAPTIVE_DEFAULT_CAP; /* a cap, not the scene's count */
   iris_render_params_from_scene(&p, scene);
   if (p.threads <= 0) p.threads = iris_parallel_default_threads();
   res->method_requested = p.method;
@@ -150,6 +152,10 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     res->config_hash = iris_hash4(h, p.config_hash, 0x5eedULL, 1);
     if (p.sampler != IRIS_SAMPLER_INDEPENDENT || p.light_sampling != IRIS_TRIANGLE_SAMPLING_SOLID_ANGLE)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.sampler, (uint64_t)p.light_sampling, 0x5a3b1e7ULL);
+    /* adaptive sampling decides each pixel's count: parts must agree on it */
+    if (adaptive)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.adaptive.rule,
+                                    (uint64_t)(p.adaptive.noise_threshold * 1e9), 0xada7ULL);
     /* the power sampler keeps the hash renders had before the light tree */
     if (p.light_sampler != IRIS_LIGHT_SAMPLER_POWER)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_sampler, 0x7ee11ULL, 2);
@@ -248,7 +254,31 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   double t1 = iris_time_now();
   res->setup_seconds = t1 - t0;
 
-  if (st == IRIS_OK && !p.no_passes) {
+  res->adaptive = p.adaptive;
+  if (st == IRIS_OK && !p.no_passes && adaptive) {
+    const bool timed = p.time_budget > 0.0;
+    iris_adaptive_job job = {&it, &res->camera, &res->film, p.seed, p.sample_offset, b.x0, b.y0, b.x1, b.y1,
+                             p.threads, stats, p.spp + res->train_spp,
+                             timed ? p.time_budget - (p.budget_includes_setup ? res->setup_seconds : 0.0) : 0.0,
+                             p.adaptive_progress, p.progress_ctx, p.adaptive};
+    if (timed && job.budget <= 0.0) job.budget = 1e-3; /* at least one round */
+    iris_phase_begin("first-pass", "rendering the first image pass");
+    if (p.phase) p.phase(p.phase_ctx, "rendering the first image pass", iris_time_now() - t0, 0.0);
+    st = iris_adaptive_run(&job, &res->adaptive_outcome, err);
+    if (st == IRIS_OK && res->adaptive_outcome.interrupted) {
+      res->interrupted = true;
+      if (res->adaptive_outcome.rounds == 0) st = iris_cancel_error(err);
+    }
+    res->spp = res->adaptive_outcome.spp_max - res->train_spp;
+    res->seconds = iris_time_now() - t1;
+    for (int i = 0; i < p.threads; i++) {
+      res->stats.paths += stats[i].paths;
+      res->stats.rays += stats[i].rays;
+      res->stats.shadow_rays += stats[i].shadow_rays;
+      res->stats.nan_count += stats[i].nan_count;
+    }
+  }
+  if (st == IRIS_OK && !p.no_passes && !adaptive) {
     const uint64_t pixels = (uint64_t)res->film.width * (uint64_t)res->film.height;
     pass_ctx c;
     memset(&c, 0, sizeof c);
@@ -339,9 +369,10 @@ void iris_render_result_destroy(iris_render_result *r) {
 iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
                                   const char *scene_name, bool variance, iris_error *err) {
   iris_image img;
-  iris_status st = iris_film_to_image(&r->film, variance, &img, err);
+  const bool adaptive = r->adaptive.rule != IRIS_ADAPTIVE_OFF;
+  iris_status st = iris_film_to_image_counts(&r->film, variance, adaptive, &img, err);
   if (st != IRIS_OK) return st;
-  iris_image_meta meta[32];
+  iris_image_meta meta[40];
   size_t n = 0;
 #define META(k, ...) \
   do { \
@@ -371,6 +402,18 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("full_size", "%d,%d", r->camera.width, r->camera.height);
   META("scene_hash", "%016llx", (unsigned long long)r->scene_hash);
   META("config_hash", "%016llx", (unsigned long long)r->config_hash);
+  if (adaptive) {
+    const iris_adaptive_outcome *o = &r->adaptive_outcome;
+    META("adaptive", "%s", iris_adaptive_rule_name(r->adaptive.rule));
+    META("noise_threshold", "%g", r->adaptive.noise_threshold);
+    META("target_error", "%g", r->adaptive.target_error);
+    META("error_estimate", "%.6g", o->error_estimate);
+    META("spp_mean", "%.3f", o->spp_mean);
+    META("spp_range", "%d,%d", o->spp_min, o->spp_max);
+    META("scout_spp_mean", "%.3f", o->scout_spp_mean);
+    META("adaptive_stop", "%s", o->reached_target ? "target" : o->converged ? "threshold"
+                                : o->interrupted ? "interrupted" : "cap");
+  }
 #undef META
   st = iris_exr_write(path, &img, meta, n, err);
   iris_image_destroy(&img);

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "core/error.h"
+#include "renderer/adaptive.h"
 #include "renderer/camera.h"
 #include "renderer/film.h"
 #include "renderer/integrator.h"
@@ -21,6 +22,9 @@ extern "C" {
 #endif
 
 #define IRIS_RENDER_DEFAULT_SPP 64
+/* Adaptive sampling's per-pixel cap when no --spp is given (Blender's default
+ * Max Samples). */
+#define IRIS_RENDER_ADAPTIVE_DEFAULT_CAP 4096
 /* Whether the guide's training samples go into the image by default
  * (iris_render_params.keep_training; docs/guiding.md, "Training samples"). */
 #define IRIS_KEEP_TRAINING_DEFAULT true
@@ -118,6 +122,12 @@ typedef struct iris_render_params {
   /* time_budget covers setup (accel, textures, lights, guide) too: wall-clock
    * budgets for iris bench. At least one pass always runs. Default false. */
   bool budget_includes_setup;
+  /* Adaptive sampling (renderer/adaptive.h; rule OFF: every pixel `spp`).
+   * With it, spp is the per-pixel cap (unset: IRIS_RENDER_ADAPTIVE_DEFAULT_CAP,
+   * not the scene's spp) and time_budget a cap too. */
+  iris_adaptive_params adaptive;
+  /* Called after each adaptive round from the calling thread (may be NULL). */
+  void (*adaptive_progress)(void *ctx, const iris_adaptive_progress *p);
 } iris_render_params;
 
 /* Defaults: everything unset (taken from the scene, else 64 spp, auto, max
@@ -139,7 +149,10 @@ typedef struct iris_render_result {
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
   iris_light_sampler light_sampler;
-  int spp;               /* samples per pixel completed in the image passes */
+  int spp;               /* samples per pixel completed in the image passes; adaptive: the
+                            most any pixel took (its sample indices offset .. offset+spp-1) */
+  iris_adaptive_params adaptive; /* as rendered (rule OFF: uniform) */
+  iris_adaptive_outcome adaptive_outcome;
   int train_spp;         /* training samples per pixel also in the film (keep_training) */
   uint64_t seed;
   int threads;
@@ -158,7 +171,8 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
                         iris_render_result *result, iris_error *err);
 void iris_render_result_destroy(iris_render_result *result);
 
-/* EXR with R, G, B (+ var.R/G/B when `variance`) and iris:version, scene,
+/* EXR with R, G, B (+ var.R/G/B when `variance`; + a per-pixel sample count
+ * channel "spp" when adaptive) and iris:version, scene,
  * method (the resolved one), method_requested, method_reason (auto), spp, seed, render_seconds, interrupted, ... metadata, and what
  * iris merge needs: sample_offset, window, full_size, scene_hash, config_hash. */
 iris_status iris_render_write_exr(const iris_render_result *r, const char *path,

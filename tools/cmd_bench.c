@@ -47,7 +47,10 @@ static void print_help(void) {
       "      --cache DIR      cache of auto references (default ~/.cache/iris/bench)\n"
       "Cycles:\n"
       "      --cycles         also render with Blender Cycles at the spp of each budget's\n"
-      "                       mis run (seed 0); its render time excludes start-up\n"
+      "                       mis run (seed s); its render time excludes start-up\n"
+      "      --cycles-adaptive   also render with Cycles as Blender users run it:\n"
+      "                       adaptive sampling on, each budget its time limit\n"
+      "      --cycles-threshold T   Cycles' noise threshold (default 0.01, Blender's)\n"
       "      --blender EXE    Blender executable (default $IRIS_BLENDER, else blender)\n"
       "Output:\n"
       "  -o, --out DIR        results.csv, results.json, table.md, table.html, images/,\n"
@@ -166,6 +169,13 @@ int iris_cmd_bench(int argc, char **argv) {
     } else if (strcmp(a, "--cycles") == 0) {
       NO_VALUE();
       p.cycles = true;
+    } else if (strcmp(a, "--cycles-adaptive") == 0) {
+      NO_VALUE();
+      p.cycles_adaptive = true;
+    } else if (strcmp(a, "--cycles-threshold") == 0) {
+      NEED_VALUE();
+      if (!iris_cli_parse_float(CMD, a, val, 1e-6, 0.999, &dv)) return IRIS_EXIT_USAGE;
+      p.cycles_threshold = dv;
     } else if (strcmp(a, "--blender") == 0) {
       NEED_VALUE();
       p.blender = val;

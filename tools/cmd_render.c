@@ -30,6 +30,9 @@ typedef struct render_cli {
   bool variance, quiet, json;
   double exposure;
   uint64_t sample_offset;
+  double noise_threshold, target_error;
+  int min_spp;
+  int adaptive; /* iris_adaptive_rule; -1: unset */
 } render_cli;
 
 static const iris_option OUTPUT_ROWS[] = {
@@ -53,6 +56,24 @@ static const iris_option PARTITION_ROWS[] = {
     {"pixel-bounds", 0, IRIS_OPT_STRING, "x0,y0,x1,y1", 0, 0, offsetof(render_cli, pixel_bounds),
      "render only this window of the frame\n(half-open; the output image is the window)", NULL},
 };
+/* In the order of iris_adaptive_rule. */
+static const char *const ADAPTIVE_CHOICES[] = {"off", "freeze", "relmse", NULL};
+static const iris_option ADAPTIVE_ROWS[] = {
+    {"noise-threshold", 0, IRIS_OPT_DOUBLE, "T", 1e-6, 1.0, offsetof(render_cli, noise_threshold),
+     "adaptive sampling: stop a pixel once its noise is below T,\n"
+     "Cycles' scale and meaning (Blender's default 0.01); --spp\n"
+     "(default 4096) and --time are then caps", NULL},
+    {"target-error", 0, IRIS_OPT_DOUBLE, "E", 1e-12, 1e6, offsetof(render_cli, target_error),
+     "adaptive sampling until the image's estimated relMSE is at\n"
+     "most E (--time caps it); the estimate reached is reported", NULL},
+    {"min-spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, offsetof(render_cli, min_spp),
+     "samples every pixel gets first (default as Cycles:\nmax(4, ceil(16 / T^0.3)), 64 at T = 0.01)", NULL},
+    {"adaptive", 0, IRIS_OPT_CHOICE, "RULE", 0, 0, offsetof(render_cli, adaptive),
+     "relmse (default with --noise-threshold/--target-error:\nsamples where they lower the image's "
+     "relMSE most) | freeze\n(Cycles' rule) | off (every pixel the same spp)", ADAPTIVE_CHOICES},
+};
+static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (docs/rendering.md, \"Adaptive sampling\")",
+                                                   ADAPTIVE_ROWS, sizeof ADAPTIVE_ROWS / sizeof ADAPTIVE_ROWS[0]};
 static const iris_option_group OUTPUT_OPTIONS = {"Output and reporting", OUTPUT_ROWS,
                                                  sizeof OUTPUT_ROWS / sizeof OUTPUT_ROWS[0]};
 static const iris_option_group PARTITION_OPTIONS = {
@@ -100,6 +121,19 @@ static void draw_progress(void *ctx, int done, int total, double elapsed, double
   double rate = elapsed > 0 ? (double)done * (double)ps->pixels / elapsed : 0.0;
   fprintf(stderr, "\r[%s] %3d%%  %d/%d spp  %.2f Msamples/s  ETA %.0fs ", b, (int)(frac * 100.0),
           done, total, rate * 1e-6, eta);
+  fflush(stderr);
+  iris_log_progress_drawn();
+}
+
+/* An adaptive round on the progress line: samples so far, the share of pixels
+ * still sampling and the image's estimated relMSE. */
+static void draw_adaptive(void *ctx, const iris_adaptive_progress *a) {
+  progress_state *ps = (progress_state *)ctx;
+  if (!ps->enabled) return;
+  char eta[32] = "";
+  if (a->eta >= 0.0) snprintf(eta, sizeof eta, "  ETA %.0fs", a->eta);
+  fprintf(stderr, "\radaptive round %d: %.1f spp mean, %.1f%% of pixels sampling, est. relMSE %.3g, %.1fs%s ",
+          a->round, a->spp_mean, 100.0 * a->active_share, a->error_estimate, a->elapsed, eta);
   fflush(stderr);
   iris_log_progress_drawn();
 }
@@ -210,6 +244,7 @@ int iris_cmd_render(int argc, char **argv) {
   iris_guiding_marks marks = {0, 0, NULL};
   render_cli rc_opts;
   memset(&rc_opts, 0, sizeof rc_opts);
+  rc_opts.adaptive = -1;
   iris_render_options ro;
   memset(&ro, 0, sizeof ro);
   ro.light_sampler = IRIS_LIGHT_SAMPLER_DEFAULT;
@@ -217,7 +252,8 @@ int iris_cmd_render(int argc, char **argv) {
   iris_gltf_input_options go = {NULL};
   iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0, 0},
                                 {&PARTITION_OPTIONS, &rc_opts, 0, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0, 0},
-                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0}};
+                                {&IRIS_ENV_OPTIONS, &eo, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0},
+                                {&ADAPTIVE_OPTIONS, &rc_opts, 0, 0}};
   const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int operands = 0;
@@ -256,6 +292,27 @@ int iris_cmd_render(int argc, char **argv) {
   if (rc_opts.pixel_bounds && !parse_bounds(rc_opts.pixel_bounds, &p.bounds))
     return iris_cli_usage_error(CMD, "invalid value '%s' for --pixel-bounds (x0,y0,x1,y1 with "
                                      "0 <= x0 < x1 and 0 <= y0 < y1)", rc_opts.pixel_bounds);
+  {
+    /* adaptive sampling: on with a threshold or a target error (relmse unless
+     * --adaptive says otherwise), or with --adaptive freeze|relmse alone (then
+     * at Blender's threshold 0.01) */
+    iris_adaptive_params *ap = &p.adaptive;
+    ap->noise_threshold = rc_opts.noise_threshold;
+    ap->target_error = rc_opts.target_error;
+    ap->min_spp = rc_opts.min_spp;
+    bool asked = ap->noise_threshold > 0.0 || ap->target_error > 0.0;
+    ap->rule = rc_opts.adaptive >= 0 ? (iris_adaptive_rule)rc_opts.adaptive
+               : asked               ? IRIS_ADAPTIVE_RELMSE
+                                     : IRIS_ADAPTIVE_OFF;
+    if (ap->rule != IRIS_ADAPTIVE_OFF && !asked) ap->noise_threshold = 0.01;
+    if (ap->rule == IRIS_ADAPTIVE_OFF && (asked || ap->min_spp > 0))
+      return iris_cli_usage_error(CMD, "--noise-threshold, --target-error and --min-spp need adaptive sampling "
+                                       "(not --adaptive off)");
+    if (ap->rule == IRIS_ADAPTIVE_FREEZE && !(ap->noise_threshold > 0.0))
+      return iris_cli_usage_error(CMD, "--adaptive freeze needs --noise-threshold (it stops pixels there)");
+    if (ap->rule != IRIS_ADAPTIVE_OFF && have_spp && ap->min_spp > p.spp)
+      return iris_cli_usage_error(CMD, "--min-spp %d is above the --spp cap %d", ap->min_spp, p.spp);
+  }
   int erc = iris_env_options_check(CMD, &bind[4], false);
   if (erc != IRIS_EXIT_OK) return erc;
   /* Everything that can be checked is checked before any work starts. */
@@ -265,8 +322,8 @@ int iris_cmd_render(int argc, char **argv) {
   const bool guide_only = !out_exr && !out_png && gp.guide_out;
   if (!out_exr && !out_png && !guide_only)
     return iris_cli_usage_error(CMD, "no output: give -o OUT.exr and/or --png OUT.png");
-  if (have_spp && p.time_budget > 0.0)
-    return iris_cli_usage_error(CMD, "--spp and --time exclude each other");
+  if (have_spp && p.time_budget > 0.0 && p.adaptive.rule == IRIS_ADAPTIVE_OFF)
+    return iris_cli_usage_error(CMD, "--spp and --time exclude each other (both caps only with adaptive sampling)");
   if (out_exr && !ends_with(out_exr, ".exr"))
     return iris_cli_usage_error(CMD, "output '%s' must end in .exr", out_exr);
   if (out_png && !ends_with(out_png, ".png"))
@@ -345,6 +402,7 @@ int iris_cmd_render(int argc, char **argv) {
   p.keep_training = !gp.discard_training;
   p.cancel = iris_cli_stop_flag();
   p.progress = draw_progress;
+  p.adaptive_progress = draw_adaptive;
   p.progress_ctx = &ps;
   p.phase = ps.enabled ? draw_phase : NULL; /* else the guide logs its long training passes */
   p.phase_ctx = &ps;
@@ -380,7 +438,9 @@ int iris_cmd_render(int argc, char **argv) {
   iris_guiding_marks_destroy(&marks);
   if (st != IRIS_OK) rc = iris_cli_report(&err);
 
-  double samples = (double)res.spp * (double)res.film.width * (double)res.film.height;
+  double samples = res.adaptive.rule != IRIS_ADAPTIVE_OFF
+                       ? (double)res.adaptive_outcome.paths
+                       : (double)res.spp * (double)res.film.width * (double)res.film.height;
   double rays = (double)(res.stats.rays + res.stats.shadow_rays);
   if (json) {
     cJSON *o = cJSON_CreateObject();
@@ -415,6 +475,21 @@ int iris_cmd_render(int argc, char **argv) {
     cJSON_AddNumberToObject(o, "shadow_rays", (double)res.stats.shadow_rays);
     cJSON_AddNumberToObject(o, "nan_count", (double)res.stats.nan_count);
     cJSON_AddBoolToObject(o, "interrupted", res.interrupted);
+    if (res.adaptive.rule != IRIS_ADAPTIVE_OFF) {
+      const iris_adaptive_outcome *ao = &res.adaptive_outcome;
+      cJSON *a = cJSON_AddObjectToObject(o, "adaptive");
+      cJSON_AddStringToObject(a, "rule", iris_adaptive_rule_name(res.adaptive.rule));
+      cJSON_AddNumberToObject(a, "noise_threshold", res.adaptive.noise_threshold);
+      cJSON_AddNumberToObject(a, "target_error", res.adaptive.target_error);
+      cJSON_AddNumberToObject(a, "error_estimate", ao->error_estimate);
+      cJSON_AddNumberToObject(a, "spp_mean", ao->spp_mean);
+      cJSON_AddNumberToObject(a, "spp_min", ao->spp_min);
+      cJSON_AddNumberToObject(a, "spp_max", ao->spp_max);
+      cJSON_AddNumberToObject(a, "scout_spp_mean", ao->scout_spp_mean);
+      cJSON_AddNumberToObject(a, "rounds", ao->rounds);
+      cJSON_AddStringToObject(a, "stop", ao->reached_target ? "target" : ao->converged ? "threshold"
+                                         : ao->interrupted ? "interrupted" : "cap");
+    }
     char *text = cJSON_Print(o);
     if (text) printf("%s\n", text);
     free(text);
@@ -428,6 +503,22 @@ int iris_cmd_render(int argc, char **argv) {
                res.seconds, res.seconds > 0 ? samples / res.seconds * 1e-6 : 0.0,
                res.seconds > 0 ? rays / res.seconds * 1e-6 : 0.0,
                res.interrupted ? " (interrupted)" : "");
+    if (res.adaptive.rule != IRIS_ADAPTIVE_OFF) {
+      const iris_adaptive_outcome *ao = &res.adaptive_outcome;
+      char why[96];
+      if (ao->reached_target)
+        snprintf(why, sizeof why, "reached the target %.3g", res.adaptive.target_error);
+      else if (ao->converged)
+        snprintf(why, sizeof why, "every pixel below the noise threshold %g", res.adaptive.noise_threshold);
+      else if (ao->interrupted)
+        snprintf(why, sizeof why, "interrupted");
+      else
+        snprintf(why, sizeof why, "stopped by the %s cap%s", p.time_budget > 0 ? "--time" : "--spp",
+                 res.adaptive.target_error > 0 ? " before the target" : "");
+      iris_infof("adaptive (%s): %.1f spp mean (%d..%d) + %.1f scout spp, estimated relMSE %.3g: %s",
+                 iris_adaptive_rule_name(res.adaptive.rule), ao->spp_mean, ao->spp_min, ao->spp_max,
+                 ao->scout_spp_mean, ao->error_estimate, why);
+    }
     if (res.stats.nan_count)
       iris_warnf("%llu NaN/Inf samples were dropped", (unsigned long long)res.stats.nan_count);
   }

@@ -103,6 +103,7 @@ iris_bench_params iris_bench_params_default(void) {
   for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.keep_training[k] = IRIS_KEEP_TRAINING_DEFAULT;
   p.seeds = 1;
   p.max_depth = -1;
+  p.cycles_threshold = 0.01; /* Blender's default noise threshold */
   for (int k = 0; k < IRIS_BENCH_MAX_METHODS; k++) p.light_samplers[k] = IRIS_LIGHT_SAMPLER_DEFAULT;
   return p;
 }
@@ -482,15 +483,23 @@ static iris_status auto_reference(const iris_bench_params *p, bench_ctx *ctx, be
 
 /* ---- Cycles ------------------------------------------------------------ */
 
-/* One Cycles row per budget and seed s, at the spp the budget's mis run with
- * seed s reached (the first method's when mis is not benched), with Cycles'
- * seed s: the table averages Cycles over the same seeds as iris, so that one
- * lucky or unlucky Cycles image does not decide a comparison. Its time is
- * Blender's render time as the exported script prints it, start-up and scene
- * build excluded. */
+/* Cycles rows, per budget and seed s with Cycles' seed s (the table averages
+ * Cycles over the same seeds as iris, so that one lucky or unlucky Cycles
+ * image does not decide a comparison):
+ * - "cycles": fixed spp, the spp the budget's mis run with seed s reached (the
+ *   first method's when mis is not benched): the physical comparison;
+ * - "cycles-adaptive": Cycles as Blender users run it, adaptive sampling on
+ *   (noise threshold p->cycles_threshold, automatic minimum samples) with the
+ *   budget as Cycles' time limit and no practical spp cap: it stops at the
+ *   budget or earlier where every pixel has converged.
+ * Times are Blender's render time as the exported script prints it, start-up
+ * and scene build excluded. */
+#define CYCLES_ADAPTIVE_SPP_CAP (1 << 20)
+
 static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_scene *bs,
                               iris_bench_scene *sc, iris_bench_result *res, float exposure,
-                              iris_error *err) {
+                              bool adaptive, iris_error *err) {
+  const char *what = adaptive ? "cycles-adaptive" : "cycles";
   char dir[1300], script[1400], exr[1400], log[1400];
   snprintf(dir, sizeof dir, "%.1000s/cycles/%s", p->out_dir, sc->name);
   iris_status st = iris_mkdir_p(dir, err);
@@ -513,8 +522,8 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
   int threads = p->threads > 0 ? p->threads : (int)sysconf(_SC_NPROCESSORS_ONLN);
   for (int run = 0; run < p->time_count * p->seeds; run++) {
     const int t = run / p->seeds, seed = run % p->seeds;
-    int spp = 0;
-    for (size_t i = 0; i < res->row_count; i++) {
+    int spp = adaptive ? CYCLES_ADAPTIVE_SPP_CAP : 0;
+    for (size_t i = 0; i < res->row_count && !adaptive; i++) {
       const iris_bench_row *r = &res->rows[i];
       if (strcmp(r->scene, sc->name) == 0 && strcmp(r->method, base) == 0 && r->seed == (uint64_t)seed &&
           r->budget_s == p->times[t])
@@ -523,18 +532,21 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
     if (spp <= 0) continue;
     if (p->cancel && *p->cancel)
       return iris_error_set(err, IRIS_ERR_INTERRUPTED, NULL, 0, NULL, "interrupted");
-    begin_run(ctx, sc->name, "cycles", 0.0, (uint64_t)seed, p->times[t]);
-    snprintf(exr, sizeof exr, "%s/%gs-seed%d.exr", dir, p->times[t], seed);
-    snprintf(log, sizeof log, "%s/%gs-seed%d.log", dir, p->times[t], seed);
-    char a_spp[32], a_threads[32], a_w[32], a_h[32], a_b[32], a_seed[32];
+    begin_run(ctx, sc->name, what, 0.0, (uint64_t)seed, p->times[t]);
+    snprintf(exr, sizeof exr, "%s/%s-%gs-seed%d.exr", dir, what, p->times[t], seed);
+    snprintf(log, sizeof log, "%s/%s-%gs-seed%d.log", dir, what, p->times[t], seed);
+    char a_spp[32], a_threads[32], a_w[32], a_h[32], a_b[32], a_seed[32], a_thr[32], a_limit[32];
     snprintf(a_seed, sizeof a_seed, "%d", seed);
     snprintf(a_spp, sizeof a_spp, "%d", spp);
     snprintf(a_threads, sizeof a_threads, "%d", threads);
     snprintf(a_w, sizeof a_w, "%d", sc->width);
     snprintf(a_h, sizeof a_h, "%d", sc->height);
     snprintf(a_b, sizeof a_b, "%d", bs->max_depth);
+    snprintf(a_thr, sizeof a_thr, "%.17g", adaptive ? p->cycles_threshold : 0.0);
+    snprintf(a_limit, sizeof a_limit, "%.17g", adaptive ? p->times[t] : 0.0);
     const char *args[] = {"--output", exr, "--spp", a_spp, "--threads", a_threads, "--seed", a_seed,
-                          "--width", a_w, "--height", a_h, "--max-bounces", a_b, NULL};
+                          "--width", a_w, "--height", a_h, "--max-bounces", a_b,
+                          "--adaptive-threshold", a_thr, "--time-limit", a_limit, NULL};
     iris_blender_run_info info;
     st = iris_blender_run(p->blender, script, args, log, &info, err);
     if (st != IRIS_OK) return st;
@@ -550,19 +562,22 @@ static iris_status run_cycles(const iris_bench_params *p, bench_ctx *ctx, bench_
     iris_bench_row row;
     memset(&row, 0, sizeof row);
     snprintf(row.scene, sizeof row.scene, "%s", sc->name);
-    snprintf(row.method, sizeof row.method, "cycles");
+    snprintf(row.method, sizeof row.method, "%s", what);
     row.budget_s = p->times[t];
     row.seed = (uint64_t)seed;
     row.seconds = info.render_seconds;
     row.setup_seconds = info.build_seconds;
-    row.spp = spp;
+    row.spp = adaptive ? 0 : spp; /* adaptive: per pixel, not known from the image */
     fill_metrics(&img, &bs->ref, &row);
     st = add_row(res, &row, err);
     if (st == IRIS_OK && t == p->time_count - 1 && seed == 0)
-      st = write_preview(p->out_dir, sc, "cycles", &img, &bs->ref, exposure, err);
+      st = write_preview(p->out_dir, sc, what, &img, &bs->ref, exposure, err);
     iris_image_destroy(&img);
     if (st != IRIS_OK) return st;
-    res->cycles_done = true;
+    if (adaptive)
+      res->cycles_adaptive_done = true;
+    else
+      res->cycles_done = true;
   }
   return IRIS_OK;
 }
@@ -622,10 +637,14 @@ static iris_status check_params(const iris_bench_params *p, iris_error *err) {
     return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL, "--seeds must be 1 to %d",
                           IRIS_BENCH_MAX_SEEDS);
   if (!p->out_dir) return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL, "no output folder");
-  if (p->cycles && !executable_found(iris_blender_executable(p->blender)))
+  if (p->cycles_adaptive && !(p->cycles_threshold > 0.0 && p->cycles_threshold < 1.0))
+    return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL, "the Cycles noise threshold %g is not in (0, 1)",
+                          p->cycles_threshold);
+  if ((p->cycles || p->cycles_adaptive) && !executable_found(iris_blender_executable(p->blender)))
     return iris_error_set(err, IRIS_ERR_USAGE, NULL, 0, NULL,
-                          "--cycles: Blender '%s' is not installed (Debian's blender package, or "
-                          "set IRIS_BLENDER)", iris_blender_executable(p->blender));
+                          "%s: Blender '%s' is not installed (Debian's blender package, or "
+                          "set IRIS_BLENDER)", p->cycles ? "--cycles" : "--cycles-adaptive",
+                          iris_blender_executable(p->blender));
   return IRIS_OK;
 }
 
@@ -698,7 +717,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
     for (int t = 0; t < p.time_count; t++) per_scene += p.times[t];
     ctx.runs = p.input_count * p.method_count * p.time_count * p.seeds;
     ctx.planned_left = per_scene * p.method_count * p.seeds * p.input_count;
-    if (p.cycles) { /* one Cycles run per budget and seed */
+    for (int k = 0; k < (int)p.cycles + (int)p.cycles_adaptive; k++) { /* one Cycles run per budget and seed */
       ctx.runs += p.input_count * p.time_count * p.seeds;
       ctx.planned_left += per_scene * p.input_count * p.seeds;
     }
@@ -768,7 +787,8 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
             st = write_preview(p.out_dir, sc, label, &img, &bs[i].ref, exposure, err);
           iris_image_destroy(&img);
         }
-    if (st == IRIS_OK && p.cycles) st = run_cycles(&p, &ctx, &bs[i], sc, res, exposure, err);
+    if (st == IRIS_OK && p.cycles) st = run_cycles(&p, &ctx, &bs[i], sc, res, exposure, false, err);
+    if (st == IRIS_OK && p.cycles_adaptive) st = run_cycles(&p, &ctx, &bs[i], sc, res, exposure, true, err);
     if (st == IRIS_OK || st == IRIS_ERR_INTERRUPTED) {
       /* results so far, also after an interruption */
       iris_error e2;
@@ -842,6 +862,7 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddItemToArray(ms, cJSON_CreateString(iris_bench_method_label(p, k, label, sizeof label)));
   }
   if (res->cycles_done) cJSON_AddItemToArray(ms, cJSON_CreateString("cycles"));
+  if (res->cycles_adaptive_done) cJSON_AddItemToArray(ms, cJSON_CreateString("cycles-adaptive"));
   cJSON *ts = cJSON_AddArrayToObject(par, "times");
   double times[IRIS_BENCH_MAX_TIMES];
   memcpy(times, p->times, sizeof times);
@@ -852,7 +873,9 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
   cJSON_AddNumberToObject(par, "relmse_eps", IRIS_METRIC_EPS);
   cJSON_AddNumberToObject(par, "relmse_drop", IRIS_METRIC_DROP);
   cJSON_AddBoolToObject(par, "budget_includes_setup", true);
-  if (res->cycles_done) cJSON_AddStringToObject(par, "cycles_version", res->cycles_version);
+  if (res->cycles_done || res->cycles_adaptive_done)
+    cJSON_AddStringToObject(par, "cycles_version", res->cycles_version);
+  if (res->cycles_adaptive_done) cJSON_AddNumberToObject(par, "cycles_threshold", p->cycles_threshold);
   cJSON *scs = cJSON_AddArrayToObject(o, "scenes");
   for (int i = 0; i < res->scene_count; i++) {
     const iris_bench_scene *sc = &res->scenes[i];

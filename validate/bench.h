@@ -65,7 +65,10 @@ typedef struct iris_bench_params {
                                  the other follows the scene's aspect ratio */
   int threads;                /* <= 0: all cores (iris and Blender) */
   int max_depth;              /* < 0: the scene's, else 64 */
-  bool cycles;                /* also time Blender Cycles */
+  bool cycles;                /* also time Blender Cycles at mis's spp ("cycles" rows) */
+  bool cycles_adaptive;       /* also Cycles as users run it ("cycles-adaptive" rows): adaptive
+                                 sampling at cycles_threshold, each budget its time limit */
+  double cycles_threshold;    /* Cycles' noise threshold (default 0.01, Blender's) */
   const char *blender;        /* NULL: $IRIS_BLENDER, else "blender" */
   double target_relmse;       /* time-to-target column; <= 0: per scene (bench_table.h) */
   const char *out_dir;
@@ -117,7 +120,8 @@ typedef struct iris_bench_scene {
   double reference_relmse; /* the reference's own expected relMSE, from its variance channels
                               (contained in every measured relMSE); < 0 unknown */
   double target_relmse;  /* used for the time-to-target column */
-  char images[IRIS_BENCH_MAX_METHODS + 2][64]; /* preview PNG names in DIR/images: reference, methods, cycles */
+  char images[IRIS_BENCH_MAX_METHODS + 3][64]; /* preview PNG names in DIR/images: reference, methods,
+                                                  cycles, cycles-adaptive */
   int image_count;
 } iris_bench_scene;
 
@@ -126,7 +130,7 @@ typedef struct iris_bench_result {
   size_t row_count, row_capacity;
   iris_bench_scene scenes[IRIS_BENCH_MAX_SCENES];
   int scene_count;
-  bool cycles_done;
+  bool cycles_done, cycles_adaptive_done;
   char cycles_version[64];
   bool charts;             /* the plot script ran */
   bool interrupted;

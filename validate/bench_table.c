@@ -110,9 +110,11 @@ static const char *display_name(const iris_bench_result *res, const char *scene,
 static int collect(const iris_bench_params *p, const iris_bench_result *res, const char *scene,
                    const double *budgets, method_curve *mc) {
   int n = 0;
-  for (int k = 0; k <= p->method_count; k++) {
+  for (int k = 0; k <= p->method_count + 1; k++) {
     char label[64];
-    const char *name = k < p->method_count ? iris_bench_method_label(p, k, label, sizeof label) : "cycles";
+    const char *name = k < p->method_count    ? iris_bench_method_label(p, k, label, sizeof label)
+                       : k == p->method_count ? "cycles"
+                                              : "cycles-adaptive";
     snprintf(mc[n].name, sizeof mc[n].name, "%s", name);
     mc[n].count = iris_bench_curve(res->rows, res->row_count, scene, name, budgets, p->time_count,
                                    mc[n].pts);
@@ -172,6 +174,10 @@ static void cell_relmse(char *buf, size_t size, const method_curve *m, const met
     fmt_seconds(s, sizeof s, pt->seconds);
     snprintf(at, sizeof at, " @ %s, %.0f spp", s, pt->spp);
     speed[0] = 0; /* not at equal time: no equal-time speed-up */
+  } else if (strcmp(m->name, "cycles-adaptive") == 0) {
+    char s[32];
+    fmt_seconds(s, sizeof s, pt->seconds);
+    snprintf(at, sizeof at, " @ %s", s); /* the budget is its time limit; it may stop earlier */
   }
   if (html)
     snprintf(buf, size, "<span title=\"min %.4g, max %.4g over %d seed(s); %.1f s, %.0f spp\">%.4g</span>%s%s",

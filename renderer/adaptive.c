@@ -1,0 +1,487 @@
+/* Adaptive sampling rounds (renderer/adaptive.h). */
+#include "renderer/adaptive.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/cancel.h"
+#include "core/log.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+
+#define TILE 8
+#define SQRT_2_OVER_PI 0.79788456080286535588 /* E|Z| of a standard normal */
+/* Cycles 3.4 multiplies the user's noise threshold by 5 before comparing
+ * (intern/cycles/scene/integrator.cpp, get_adaptive_sampling). */
+#define CYCLES_THRESHOLD_SCALE 5.0
+/* Scouts: at least this many per pixel, and an eighth of what the pixel's
+ * own target asks for, so that scouting costs about 1/9 of the samples. */
+#define SCOUT_MIN 16
+#define SCOUT_SHARE 8
+/* Seed of the scout samples: a stream of their own, independent of the image's. */
+#define SCOUT_SALT 0x5c0a75ULL
+/* The first rounds: at least this many paths each, so that threads keep busy. */
+#define ROUND_PATHS (1u << 17)
+
+static const char *const RULE_NAMES[IRIS_ADAPTIVE_RULE_COUNT] = {"off", "freeze", "relmse"};
+
+const char *iris_adaptive_rule_name(iris_adaptive_rule r) {
+  return (unsigned)r < IRIS_ADAPTIVE_RULE_COUNT ? RULE_NAMES[r] : "?";
+}
+
+bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out) {
+  for (int i = 0; i < IRIS_ADAPTIVE_RULE_COUNT; i++)
+    if (strcmp(s, RULE_NAMES[i]) == 0) {
+      *out = (iris_adaptive_rule)i;
+      return true;
+    }
+  return false;
+}
+
+int iris_adaptive_auto_min_spp(double t) {
+  if (!(t > 0.0)) t = 0.01;
+  int m = (int)ceil(16.0 / pow(t, 0.3));
+  return m < 4 ? 4 : m;
+}
+
+double iris_adaptive_cycles_error(const double mean[3], const double var_of_mean[3]) {
+  double d = 0.0, s = 0.0;
+  for (int c = 0; c < 3; c++) {
+    d += sqrt(var_of_mean[c] > 0.0 ? var_of_mean[c] : 0.0);
+    s += mean[c];
+  }
+  return SQRT_2_OVER_PI * d / (1e-4 + sqrt(s > 0.0 ? s : 0.0));
+}
+
+/* Mean and per-sample variance of a film pixel (index i). */
+static void pixel_stats(const iris_film *f, size_t i, double mean[3], double var[3]) {
+  double n = f->count[i];
+  for (int c = 0; c < 3; c++) {
+    double mu = n > 0 ? f->sum[3 * i + c] / n : 0.0;
+    double s2 = n > 1 ? (f->sum2[3 * i + c] - n * mu * mu) / (n - 1.0) : 0.0;
+    mean[c] = mu;
+    var[c] = s2 > 0.0 ? s2 : 0.0;
+  }
+}
+
+static int cmp_double(const void *a, const void *b) {
+  double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+double iris_adaptive_film_error(const iris_film *film) {
+  size_t n = (size_t)film->width * (size_t)film->height;
+  if (n == 0) return 0.0;
+  double *e = malloc(n * sizeof *e);
+  if (!e) return -1.0;
+  for (size_t i = 0; i < n; i++) {
+    double m[3], v[3], r = 0.0;
+    pixel_stats(film, i, m, v);
+    double cnt = film->count[i];
+    if (cnt > 1)
+      for (int c = 0; c < 3; c++) r += v[c] / cnt / (m[c] * m[c] + IRIS_ADAPTIVE_EPS);
+    e[i] = r / 3.0;
+  }
+  qsort(e, n, sizeof *e, cmp_double);
+  size_t keep = n - (size_t)floor(IRIS_ADAPTIVE_DROP * (double)n);
+  double s = 0.0;
+  for (size_t i = 0; i < keep; i++) s += e[i];
+  free(e);
+  return keep ? s / (double)keep : 0.0;
+}
+
+/* ---- sample passes ---------------------------------------------------------- */
+
+typedef struct pass_ctx {
+  const iris_integrator *it;
+  const iris_pinhole *cam;
+  iris_film *film;
+  uint64_t seed, offset;
+  int x0, y0, x1, y1; /* the film's window */
+  int tiles_x;
+  const uint32_t *take;  /* samples to add per film pixel */
+  const uint32_t *first; /* first sample index per film pixel (before offset) */
+  iris_path_stats *stats;
+} pass_ctx;
+
+static void pass_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  pass_ctx *c = (pass_ctx *)vctx;
+  iris_path_stats local = {0};
+  const int fw = c->x1 - c->x0;
+  for (uint64_t t = begin; t < end; t++) {
+    int tx = c->x0 + (int)(t % (uint64_t)c->tiles_x) * TILE;
+    int ty = c->y0 + (int)(t / (uint64_t)c->tiles_x) * TILE;
+    for (int y = ty; y < ty + TILE && y < c->y1; y++)
+      for (int x = tx; x < tx + TILE && x < c->x1; x++) {
+        size_t i = (size_t)(y - c->y0) * (size_t)fw + (size_t)(x - c->x0);
+        uint64_t pixel = (uint64_t)y * (uint64_t)c->cam->width + (uint64_t)x;
+        uint64_t s0 = c->offset + c->first[i];
+        for (uint64_t s = s0; s < s0 + c->take[i]; s++) {
+          iris_sampler rng = iris_sampler_start_kind(c->it->sampler, c->seed, pixel, s);
+          float ux, uy;
+          iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
+          iris_ray ray = iris_pinhole_ray(c->cam, (float)x + ux, (float)y + uy);
+          iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, &local);
+          iris_film_add(c->film, x - c->x0, y - c->y0, L);
+        }
+      }
+  }
+  iris_path_stats *total = &c->stats[thread];
+  total->paths += local.paths;
+  total->rays += local.rays;
+  total->shadow_rays += local.shadow_rays;
+  total->nan_count += local.nan_count;
+}
+
+static void run_pass(pass_ctx *c, int threads) {
+  c->tiles_x = (c->x1 - c->x0 + TILE - 1) / TILE;
+  int tiles_y = (c->y1 - c->y0 + TILE - 1) / TILE;
+  uint64_t tiles = (uint64_t)c->tiles_x * (uint64_t)tiles_y;
+  iris_parallel_for(tiles, 1, threads, pass_tiles, c);
+}
+
+/* ---- the rounds ------------------------------------------------------------- */
+
+typedef struct state {
+  const iris_adaptive_job *job;
+  int W, H;              /* image window */
+  int hx0, hy0, hx1, hy1; /* scout window: the image window and a 1-pixel halo inside the frame */
+  int HW, HH;
+  iris_film scout;
+  uint32_t *scout_take, *scout_first;
+  uint32_t *take, *first;
+  double *need;     /* per scout pixel: samples its threshold asks for (freeze, threshold) */
+  double *weight;   /* per scout pixel: sqrt(sum_c var_c / (mean_c^2 + eps) / 3) */
+  double *target;   /* per image pixel: this round's target count */
+  uint32_t train;   /* training samples every film pixel held at the start */
+  int min_spp;
+} state;
+
+/* The statistics the decisions are made from: the scouts' (or, for the
+ * biased test variant, the image's own samples). */
+static void decision_stats(const state *s, int hx, int hy, double mean[3], double var[3], double *n) {
+  const iris_adaptive_job *j = s->job;
+  if (j->params.decide_on_image) {
+    int x = hx + s->hx0 - j->x0, y = hy + s->hy0 - j->y0;
+    if (x < 0) x = 0;
+    if (y < 0) y = 0;
+    if (x >= s->W) x = s->W - 1;
+    if (y >= s->H) y = s->H - 1;
+    size_t i = (size_t)y * (size_t)s->W + (size_t)x;
+    pixel_stats(j->film, i, mean, var);
+    *n = j->film->count[i];
+    return;
+  }
+  size_t i = (size_t)hy * (size_t)s->HW + (size_t)hx;
+  pixel_stats(&s->scout, i, mean, var);
+  *n = s->scout.count[i];
+}
+
+/* need and weight of every scout pixel from its own statistics alone. */
+static void per_pixel_needs(state *s) {
+  const double T = s->job->params.noise_threshold;
+  for (int y = 0; y < s->HH; y++)
+    for (int x = 0; x < s->HW; x++) {
+      double m[3], v[3], n;
+      decision_stats(s, x, y, m, v, &n);
+      size_t i = (size_t)y * (size_t)s->HW + (size_t)x;
+      double w = 0.0, sd = 0.0, sum = 0.0;
+      for (int c = 0; c < 3; c++) {
+        w += v[c] / (m[c] * m[c] + IRIS_ADAPTIVE_EPS);
+        sd += sqrt(v[c]);
+        sum += m[c];
+      }
+      s->weight[i] = sqrt(w / 3.0);
+      if (T > 0.0) {
+        /* Cycles' error at N samples, sqrt(2/pi) sd / sqrt(N) / (1e-4 + sqrt(sum)),
+         * below 5 T */
+        double k = SQRT_2_OVER_PI * sd / (CYCLES_THRESHOLD_SCALE * T * (1e-4 + sqrt(sum > 0 ? sum : 0)));
+        s->need[i] = k * k;
+      } else {
+        s->need[i] = INFINITY;
+      }
+    }
+}
+
+/* The 3x3 maximum (inside the scout window) of a scout-pixel field at image pixel (x, y). */
+static double max3(const state *s, const double *f, int x, int y) {
+  int hx = x + s->job->x0 - s->hx0, hy = y + s->job->y0 - s->hy0;
+  double m = 0.0;
+  for (int dy = -1; dy <= 1; dy++)
+    for (int dx = -1; dx <= 1; dx++) {
+      int qx = hx + dx, qy = hy + dy;
+      if (qx < 0 || qy < 0 || qx >= s->HW || qy >= s->HH) continue;
+      double v = f[(size_t)qy * (size_t)s->HW + (size_t)qx];
+      if (v > m) m = v;
+    }
+  return m;
+}
+
+/* Sum over pixels of what targets C * weight (clamped) would add. */
+static double relmse_added(const state *s, double C, const double *cap_need) {
+  const iris_adaptive_job *j = s->job;
+  double add = 0.0;
+  size_t n = (size_t)s->W * (size_t)s->H;
+  for (size_t i = 0; i < n; i++) {
+    double t = C * s->target[i]; /* target[] holds the 3x3 weight here */
+    if (t < s->min_spp) t = s->min_spp;
+    if (cap_need && t > cap_need[i]) t = cap_need[i];
+    if (t > j->spp_cap) t = j->spp_cap;
+    double have = j->film->count[i];
+    if (t > have) add += t - have;
+  }
+  return add;
+}
+
+/* This round's targets (s->target, whole samples) for a round of at most
+ * `budget` samples (<= 0: no limit, the threshold decides). Returns the
+ * samples the round will take. */
+static double plan_round(state *s, double budget, double *cmul) {
+  const iris_adaptive_job *j = s->job;
+  const iris_adaptive_params *p = &j->params;
+  size_t n = (size_t)s->W * (size_t)s->H;
+  per_pixel_needs(s);
+  double *need3 = NULL;
+  if (p->noise_threshold > 0.0) {
+    need3 = malloc(n * sizeof *need3);
+    if (!need3) return -1.0;
+    for (int y = 0; y < s->H; y++)
+      for (int x = 0; x < s->W; x++) {
+        double t = max3(s, s->need, x, y);
+        need3[(size_t)y * (size_t)s->W + (size_t)x] = t < s->min_spp ? s->min_spp : ceil(t);
+      }
+  }
+  if (p->rule == IRIS_ADAPTIVE_FREEZE) {
+    for (size_t i = 0; i < n; i++) s->target[i] = need3 ? need3[i] : j->spp_cap;
+  } else {
+    for (int y = 0; y < s->H; y++)
+      for (int x = 0; x < s->W; x++) s->target[(size_t)y * (size_t)s->W + (size_t)x] = max3(s, s->weight, x, y);
+    /* the largest C whose targets fit the budget (bisection in log C) */
+    double lo = 0.0, hi = 1.0;
+    if (budget > 0.0) {
+      while (relmse_added(s, hi, need3) < budget && hi < 1e30) hi *= 4.0;
+      for (int it = 0; it < 60; it++) {
+        double mid = 0.5 * (lo + hi);
+        if (relmse_added(s, mid, need3) <= budget)
+          lo = mid;
+        else
+          hi = mid;
+      }
+    } else {
+      lo = 1e30; /* no budget: the threshold alone caps */
+    }
+    *cmul = lo;
+    for (size_t i = 0; i < n; i++) {
+      double t = lo * s->target[i];
+      if (t < s->min_spp) t = s->min_spp;
+      if (need3 && t > need3[i]) t = need3[i];
+      s->target[i] = t;
+    }
+  }
+  double total = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    double t = s->target[i];
+    if (t > j->spp_cap) t = j->spp_cap;
+    t = floor(t);
+    double have = j->film->count[i];
+    /* at most double a pixel per round: early scouts are few */
+    double step = have > s->min_spp ? have : s->min_spp;
+    double k = t > have ? t - have : 0.0;
+    if (k > step) k = step;
+    s->take[i] = (uint32_t)k;
+    s->first[i] = j->film->count[i] - s->train;
+    total += k;
+  }
+  free(need3);
+  return total;
+}
+
+/* Scouts up to max(SCOUT_MIN, own need / SCOUT_SHARE) per scout pixel. */
+static double plan_scouts(state *s, double cmul) {
+  const iris_adaptive_job *j = s->job;
+  size_t n = (size_t)s->HW * (size_t)s->HH;
+  double total = 0.0;
+  int cap = j->spp_cap / SCOUT_SHARE;
+  if (cap < SCOUT_MIN) cap = SCOUT_MIN;
+  for (size_t i = 0; i < n; i++) {
+    double own = j->params.rule == IRIS_ADAPTIVE_FREEZE ? s->need[i] : cmul * s->weight[i];
+    if (j->params.noise_threshold > 0.0 && own > s->need[i]) own = s->need[i];
+    double want = own / SCOUT_SHARE;
+    if (!(want >= SCOUT_MIN)) want = SCOUT_MIN; /* also NaN */
+    if (want > cap) want = cap;
+    double have = s->scout.count[i];
+    double k = want > have ? floor(want - have) : 0.0;
+    if (k > have && have > 0) k = have; /* at most double */
+    s->scout_take[i] = (uint32_t)k;
+    s->scout_first[i] = s->scout.count[i];
+    total += k;
+  }
+  return total;
+}
+
+static void run_scouts(state *s) {
+  const iris_adaptive_job *j = s->job;
+  pass_ctx c = {j->it, j->cam, &s->scout, iris_hash4(j->seed, SCOUT_SALT, 0, 0), j->sample_offset,
+                s->hx0, s->hy0, s->hx1, s->hy1, 0, s->scout_take, s->scout_first, j->stats};
+  run_pass(&c, j->threads);
+}
+
+static void run_image(state *s) {
+  const iris_adaptive_job *j = s->job;
+  pass_ctx c = {j->it, j->cam, j->film, j->seed, j->sample_offset, j->x0, j->y0, j->x1, j->y1, 0,
+                s->take, s->first, j->stats};
+  run_pass(&c, j->threads);
+}
+
+static void state_free(state *s) {
+  iris_film_destroy(&s->scout);
+  free(s->scout_take);
+  free(s->scout_first);
+  free(s->take);
+  free(s->first);
+  free(s->need);
+  free(s->weight);
+  free(s->target);
+}
+
+static uint64_t total_paths(const iris_adaptive_job *j) {
+  uint64_t p = 0;
+  for (int i = 0; i < j->threads; i++) p += j->stats[i].paths;
+  return p;
+}
+
+iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome *out, iris_error *err) {
+  memset(out, 0, sizeof *out);
+  const iris_adaptive_params *p = &j->params;
+  state s;
+  memset(&s, 0, sizeof s);
+  s.job = j;
+  s.W = j->x1 - j->x0;
+  s.H = j->y1 - j->y0;
+  s.hx0 = j->x0 > 0 ? j->x0 - 1 : 0;
+  s.hy0 = j->y0 > 0 ? j->y0 - 1 : 0;
+  s.hx1 = j->x1 < j->cam->width ? j->x1 + 1 : j->x1;
+  s.hy1 = j->y1 < j->cam->height ? j->y1 + 1 : j->y1;
+  s.HW = s.hx1 - s.hx0;
+  s.HH = s.hy1 - s.hy0;
+  s.train = j->film->count[0];
+  s.min_spp = p->min_spp > 0 ? p->min_spp : iris_adaptive_auto_min_spp(p->noise_threshold);
+  if (s.min_spp > j->spp_cap) s.min_spp = j->spp_cap;
+  const size_t n = (size_t)s.W * (size_t)s.H, hn = (size_t)s.HW * (size_t)s.HH;
+  iris_status st = iris_film_create(&s.scout, s.HW, s.HH, err);
+  if (st != IRIS_OK) return st;
+  s.scout_take = calloc(hn, sizeof *s.scout_take);
+  s.scout_first = calloc(hn, sizeof *s.scout_first);
+  s.take = calloc(n, sizeof *s.take);
+  s.first = calloc(n, sizeof *s.first);
+  s.need = calloc(hn, sizeof *s.need);
+  s.weight = calloc(hn, sizeof *s.weight);
+  s.target = calloc(n, sizeof *s.target);
+  if (!s.scout_take || !s.scout_first || !s.take || !s.first || !s.need || !s.weight || !s.target) {
+    state_free(&s);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (adaptive sampling)");
+  }
+  const double t0 = iris_time_now();
+  double sec_per_path = 0.0, cmul = 0.0;
+  uint64_t scout_paths = 0, image_paths = 0;
+  double error = -1.0;
+  for (int round = 0;; round++) {
+    if (iris_cancel_requested()) {
+      out->interrupted = true;
+      break;
+    }
+    double elapsed = iris_time_now() - t0;
+    /* this round's budget in paths: the first rounds fixed, then half of
+     * what was done, within what the time budget still allows */
+    double done = (double)image_paths;
+    double budget = done / 2.0 > ROUND_PATHS ? done / 2.0 : ROUND_PATHS;
+    if (j->budget > 0.0 && round > 0) {
+      double left = j->budget - elapsed;
+      double fit = sec_per_path > 0.0 ? left / sec_per_path / (1.0 + 1.0 / SCOUT_SHARE) : budget;
+      if (fit < 0.02 * budget + 1.0) break; /* the budget is spent */
+      if (fit < budget) budget = fit;
+    }
+    double scout_n = 0.0;
+    if (round == 0) {
+      /* uniform first round: min spp of image samples and SCOUT_MIN scouts */
+      for (size_t i = 0; i < n; i++) {
+        uint32_t have = j->film->count[i];
+        s.take[i] = have < (uint32_t)s.min_spp ? (uint32_t)s.min_spp - have : 0;
+        s.first[i] = have - s.train;
+      }
+      for (size_t i = 0; i < hn; i++) {
+        s.scout_take[i] = SCOUT_MIN;
+        s.scout_first[i] = 0;
+      }
+      scout_n = (double)hn * SCOUT_MIN;
+    } else {
+      /* freeze and threshold-capped rounds: no path budget; relmse: the budget */
+      bool budgeted = p->rule == IRIS_ADAPTIVE_RELMSE && !(p->noise_threshold > 0.0 && j->budget <= 0.0 &&
+                                                           !(p->target_error > 0.0));
+      double planned = plan_round(&s, budgeted ? budget : 0.0, &cmul);
+      if (planned < 0.0) {
+        state_free(&s);
+        return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (adaptive sampling)");
+      }
+      if (planned < 1.0) {
+        /* nothing left to do: converged (threshold) or every pixel at the cap */
+        bool capped_all = true;
+        for (size_t i = 0; i < n && capped_all; i++) capped_all = j->film->count[i] >= (uint32_t)j->spp_cap;
+        out->converged = !capped_all || p->noise_threshold > 0.0;
+        out->capped = capped_all && !(p->noise_threshold > 0.0);
+        break;
+      }
+      scout_n = plan_scouts(&s, cmul);
+      if (j->budget > 0.0 && planned > budget * 1.05 && p->rule == IRIS_ADAPTIVE_FREEZE) {
+        /* freeze under a time budget: scale every pixel's step down alike */
+        double f = budget / planned;
+        for (size_t i = 0; i < n; i++) s.take[i] = (uint32_t)ceil(s.take[i] * f);
+      }
+    }
+    double tr = iris_time_now();
+    uint64_t before = total_paths(j);
+    run_image(&s);
+    uint64_t mid = total_paths(j);
+    if (!p->decide_on_image && scout_n > 0.0) run_scouts(&s);
+    uint64_t after = total_paths(j);
+    image_paths += mid - before;
+    scout_paths += after - mid;
+    double dt = iris_time_now() - tr;
+    if (after > before) sec_per_path = dt / (double)(after - before);
+    out->rounds = round + 1;
+    error = iris_adaptive_film_error(j->film);
+    size_t active = 0;
+    for (size_t i = 0; i < n; i++) active += s.take[i] > 0;
+    if (j->progress) {
+      double spp = 0.0;
+      for (size_t i = 0; i < n; i++) spp += j->film->count[i];
+      iris_adaptive_progress pr = {round + 1, spp / (double)n, (double)active / (double)n, error,
+                                   iris_time_now() - t0, -1.0};
+      if (j->budget > 0.0) pr.eta = j->budget - pr.elapsed > 0 ? j->budget - pr.elapsed : 0.0;
+      j->progress(j->progress_ctx, &pr);
+    }
+    if (p->target_error > 0.0 && error >= 0.0 && error <= p->target_error) {
+      out->reached_target = true;
+      break;
+    }
+  }
+  out->error_estimate = error >= 0.0 ? error : iris_adaptive_film_error(j->film);
+  double spp = 0.0;
+  out->spp_min = INT32_MAX;
+  for (size_t i = 0; i < n; i++) {
+    uint32_t c = j->film->count[i];
+    spp += c;
+    if ((int)c < out->spp_min) out->spp_min = (int)c;
+    if ((int)c > out->spp_max) out->spp_max = (int)c;
+  }
+  out->spp_mean = spp / (double)n;
+  double sc = 0.0;
+  for (size_t i = 0; i < hn; i++) sc += s.scout.count[i];
+  out->scout_spp_mean = sc / (double)hn;
+  out->paths = image_paths + scout_paths;
+  out->scout_paths = scout_paths;
+  if (!out->reached_target && !out->converged && !out->interrupted) out->capped = true;
+  state_free(&s);
+  return IRIS_OK;
+}

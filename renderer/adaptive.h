@@ -1,0 +1,122 @@
+/* Adaptive sampling: image passes that give each pixel the samples its own
+ * noise needs (docs/rendering.md, "Adaptive sampling").
+ *
+ * Rounds. Every round first decides each pixel's target sample count, then
+ * renders the missing samples of the pixels below their target, then adds
+ * scout samples. The decisions come only from *scout* samples: uniform
+ * samples with a seed of their own that never enter the image. A pixel's
+ * image sample count is therefore independent of its image samples, and its
+ * mean stays an unbiased estimate (stopping a pixel on its own noisy estimate,
+ * as Cycles does, is not: `decide_on_image` does that, for the tests that
+ * show the bias).
+ *
+ * Two rules set the targets:
+ * - freeze (Cycles' rule): a pixel needs the samples at which its predicted
+ *   Cycles error falls below the noise threshold; it keeps sampling while it
+ *   or one of its 8 neighbours needs more.
+ * - relmse (iris's default): each round's samples go where one more sample
+ *   lowers the image's relMSE most: targets proportional to the pixel's
+ *   sqrt(sum_c var_c / (mean_c^2 + eps)), the 3x3 maximum of it, so that the
+ *   image's estimated relMSE falls fastest; with a noise threshold, no pixel
+ *   is taken past the count the threshold asks for. */
+#ifndef IRIS_RENDERER_ADAPTIVE_H
+#define IRIS_RENDERER_ADAPTIVE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "renderer/camera.h"
+#include "renderer/film.h"
+#include "renderer/integrator.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum iris_adaptive_rule {
+  IRIS_ADAPTIVE_OFF = 0, /* every pixel the same samples */
+  IRIS_ADAPTIVE_FREEZE,  /* Cycles' rule: stop a pixel (and its neighbours) at the threshold */
+  IRIS_ADAPTIVE_RELMSE,  /* samples where they lower the image's relMSE most */
+  IRIS_ADAPTIVE_RULE_COUNT
+} iris_adaptive_rule;
+
+const char *iris_adaptive_rule_name(iris_adaptive_rule r);
+bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out);
+
+/* Cycles 3.4's automatic minimum samples for a noise threshold:
+ * max(4, ceil(16 / T^0.3)) (64 at 0.01). */
+int iris_adaptive_auto_min_spp(double noise_threshold);
+
+/* The relMSE denominator offset and the share of largest per-pixel errors
+ * dropped, as `iris bench` measures against a reference (validate/metrics.h). */
+#define IRIS_ADAPTIVE_EPS 0.01
+#define IRIS_ADAPTIVE_DROP 0.001
+
+typedef struct iris_adaptive_params {
+  iris_adaptive_rule rule;
+  double noise_threshold; /* Cycles' scale (Blender's default 0.01); 0: none */
+  int min_spp;            /* image samples every pixel gets first; 0: automatic */
+  double target_error;    /* stop once the image's estimated relMSE is at most this; 0: none */
+  bool decide_on_image;   /* tests only: decide from the image's own samples (biased) */
+} iris_adaptive_params;
+
+/* Where a round stands, for the progress line. */
+typedef struct iris_adaptive_progress {
+  int round;
+  double spp_mean;      /* image samples per pixel so far (training samples included) */
+  double active_share;  /* share of pixels that took samples in this round */
+  double error_estimate; /* estimated relMSE of the image (IRIS_ADAPTIVE_EPS, DROP) */
+  double elapsed, eta;  /* seconds since the passes started; eta < 0: not known */
+} iris_adaptive_progress;
+
+typedef struct iris_adaptive_job {
+  const iris_integrator *it;
+  const iris_pinhole *cam; /* cam->width/height is the frame */
+  iris_film *film;         /* covers the window; may hold training samples already */
+  uint64_t seed, sample_offset;
+  int x0, y0, x1, y1;      /* the window in full-frame pixels */
+  int threads;
+  iris_path_stats *stats;  /* one per thread */
+  int spp_cap;             /* most image samples of a pixel, training samples included */
+  double budget;           /* seconds for the passes; <= 0: none */
+  void (*progress)(void *ctx, const iris_adaptive_progress *p);
+  void *progress_ctx;
+  iris_adaptive_params params;
+} iris_adaptive_job;
+
+typedef struct iris_adaptive_outcome {
+  int rounds;
+  double spp_mean;        /* mean samples per pixel in the film */
+  int spp_min, spp_max;
+  double scout_spp_mean;  /* scout samples per pixel (not in the image) */
+  double error_estimate;  /* the image's estimated relMSE at the end */
+  bool converged;         /* every pixel reached its threshold target (freeze / threshold) */
+  bool reached_target;    /* target_error > 0 and reached */
+  bool capped;            /* stopped by spp_cap or the budget before the target/threshold */
+  bool interrupted;       /* stopped by a cancel request */
+  uint64_t paths;         /* image and scout paths traced */
+  uint64_t scout_paths;
+} iris_adaptive_outcome;
+
+/* Runs the rounds until the threshold / target is met, the cap or the budget
+ * is reached, or a cancel request (core/cancel.h). At least one round runs. */
+iris_status iris_adaptive_run(const iris_adaptive_job *job, iris_adaptive_outcome *out, iris_error *err);
+
+/* The image's estimated relMSE from a film's per-pixel variance of the mean:
+ * mean over pixels of (1/3) sum_c var_c / (mean_c^2 + IRIS_ADAPTIVE_EPS),
+ * the largest IRIS_ADAPTIVE_DROP share of pixels dropped (as the bench's
+ * metric drops the largest errors). Pixels with fewer than 2 samples count 0. */
+double iris_adaptive_film_error(const iris_film *film);
+
+/* The Cycles-scale noise of a pixel's mean from its mean and variance of the
+ * mean per channel: sqrt(2/pi) sum_c sqrt(var_c) / (1e-4 + sqrt(sum_c mean_c)),
+ * the expected value of Cycles 3.4's |full - half buffer| error; a pixel
+ * converges at error < 5 T (Cycles scales its threshold by 5). */
+double iris_adaptive_cycles_error(const double mean[3], const double var_of_mean[3]);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
