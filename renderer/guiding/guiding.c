@@ -355,7 +355,9 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
    * sun's patch into small solid angles: res 16 there (docs/guiding.md). */
   if (p->cache_res <= 0) p->cache_res = environment_share(s->lights) >= 0.5 ? 16 : 8;
   if (p->cache_k <= 0) p->cache_k = 200;
-  if (p->refine < 0) p->refine = IRIS_REFINE_MAX; /* docs/guiding.md, "Refinement" */
+  /* Off unless asked for: measured no better on door and stress-caustic and
+   * worse on the glazed sky-room (docs/guiding.md, "Refinement"). */
+  if (p->refine < 0) p->refine = 0;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
     /* Enough photons that each cache's k nearest stay local: about 2.5 stored

@@ -72,7 +72,7 @@ typedef struct iris_guiding_params {
   int sky_probes;       /* probe rays per cache and region (--sky-probes; 0: off) */
   float sky_beta;       /* probability of a cache's regions (--sky-beta; 0: off) */
   int refine;           /* most texels per cache refined into 4 x 4 sub-cells where the light is
-                           concentrated (--refine; -1 auto: 8, 0 off; refine.h) */
+                           concentrated (--refine; -1 auto: 0 (measured), 0 off; refine.h) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):

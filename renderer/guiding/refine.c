@@ -11,8 +11,12 @@ _Static_assert(IRIS_REFINE_S == 4, "iris_cache_cell splits texels 4 x 4");
 /* A texel is split when its sub-cells hold at least this many photons'
  * worth (effective count) and their second moment, noise removed, is this
  * many times a uniform texel's (docs/guiding.md, "Refinement"). */
+#ifndef REFINE_MIN_SAMPLES /* overridable at build time for measurements */
 #define REFINE_MIN_SAMPLES 4.0
+#endif
+#ifndef REFINE_MIN_CONCENTRATION
 #define REFINE_MIN_CONCENTRATION 2.0
+#endif
 
 int32_t iris_refine_fine_cell(const iris_octmap *map, iris_vec3 d) {
   float l2 = sqrtf(d.x * d.x + d.y * d.y + d.z * d.z), factor;

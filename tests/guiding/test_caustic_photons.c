@@ -21,6 +21,7 @@ int main(void) {
   gp.photons = 200000;
   gp.train_spp = 0;
   gp.force = true;
+  gp.refine = IRIS_REFINE_MAX; /* off by default (docs/guiding.md, "Refinement") */
   iris_guiding *g = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, 2, 16);
   if (CHECK(g && !g->stats.skipped)) {
     /* Caches on the floor (normal up) within 12 cm of the contact point. */

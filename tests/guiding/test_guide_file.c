@@ -36,6 +36,7 @@ static iris_guiding *build(const char *name, iris_method method, int64_t photons
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = photons;
   gp.force = force;
+  gp.refine = IRIS_REFINE_MAX; /* the file carries the refinement (off by default) */
   iris_guiding *g = test_guide_build(s, method, gp, 3, 2, 4);
   iris_scene_destroy(s);
   return g;
@@ -57,6 +58,11 @@ static bool same_caches(const iris_guiding *a, const iris_guiding *b) {
     uint32_t n = texels(a, x);
     if (memcmp(a->pdf + x->table, b->pdf + y->table, n * sizeof(float)) ||
         memcmp(a->alias + x->table, b->alias + y->table, n * sizeof(iris_cache_alias)))
+      return false;
+    if ((a->refine_slot == NULL) != (b->refine_slot == NULL)) return false;
+    if (a->refine_slot && (memcmp(a->refine_slot + x->table, b->refine_slot + y->table, n) ||
+                           memcmp(iris_guiding_sub(a, x), iris_guiding_sub(b, y),
+                                  sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB)))
       return false;
   }
   return true;

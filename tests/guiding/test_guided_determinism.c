@@ -22,6 +22,7 @@ static iris_guiding *build(const iris_scene *s, int threads, uint64_t seed) {
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 7; /* three training passes (1 + 2 + 4 spp) */
+  gp.refine = IRIS_REFINE_MAX; /* refinement too (off by default), trained */
   return test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, seed, threads, 64);
 }
 
@@ -52,6 +53,7 @@ static bool render(const iris_scene *s, int threads, bool keep, iris_render_resu
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 3; /* the render trains its guide too */
+  gp.refine = IRIS_REFINE_MAX;
   p.width = 40;
   p.height = 30; /* not a multiple of the 8-pixel tiles */
   p.spp = 6;

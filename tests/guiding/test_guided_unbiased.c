@@ -45,6 +45,7 @@ static bool render(const iris_scene *s, const variant *v, int w, int h, int spp,
   gp.splat = v->splat;
   gp.adjoint_rr = !v->plain_rr;
   if (v->train_spp > 0) gp.train_spp = v->train_spp;
+  if (v->train_spp > 0) gp.refine = IRIS_REFINE_MAX; /* the long-trained variants refine (off by default) */
   gp.train_all_light = v->all_light;
   gp.force = true; /* exercise the guide even where the budget would skip it (Veach) */
   if (v->keep) p.keep_training = v->keep > 0;
