@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "scenes/door.h"
+#include "scenes/glazing.h"
 #include "scenes/office.h"
 #include "scenes/rooms.h"
 #include "scenes/sky.h"
@@ -18,6 +19,8 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     "stress-firefly", "stress-glossy-room",
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
                                     "env-objects", "env-spheres", "sky-room",
+                                    /* light through glass (scenes/glazing.h) */
+                                    "sky-room-glazed", "sky-room-pane", "lamp-shade",
                                     /* 400 ceiling lamps (scenes/office.h) */
                                     "office",
                                     /* rooms along a corridor, most lamps hidden (scenes/rooms.h) */
@@ -355,6 +358,12 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = iris_sky_spheres_build(s);
   else if (strcmp(name, "sky-room") == 0)
     st = iris_sky_room_build(s);
+  else if (strcmp(name, "sky-room-glazed") == 0)
+    st = iris_sky_room_glazed_build(s);
+  else if (strcmp(name, "sky-room-pane") == 0)
+    st = iris_sky_room_pane_build(s);
+  else if (strcmp(name, "lamp-shade") == 0)
+    st = iris_lamp_shade_build(s);
   else if (strcmp(name, "office") == 0)
     st = iris_office_scene_build(s);
   else if (strcmp(name, "corridor-rooms") == 0)

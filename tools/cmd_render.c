@@ -188,7 +188,7 @@ static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
                 gp->pdf_floor, gp->alpha_max, gp->cos_min, (double)gp->splat, gp->force,
                 (double)gp->photon_lights, gp->train_spp, gp->train_prior, gp->train_all_light,
                 gp->learn_alpha, gp->adjoint_rr, gp->direct_photons, gp->sky_regions, gp->sky_probes,
-                gp->sky_beta};
+                gp->sky_beta, gp->refine};
   for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
     uint64_t bits;
     memcpy(&bits, &v[i], sizeof bits);

@@ -91,6 +91,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("photons", 0, IRIS_OPT_I64, "N", 1, 1099511627776.0, iris_guiding_params, photons, "photon paths"),
     OPT("caches", 0, IRIS_OPT_I64, "N", 1, 1099511627776.0, iris_guiding_params, caches, "caches"),
     OPT("cache-res", 0, IRIS_OPT_INT, "R", 1, 256, iris_guiding_params, cache_res, "map texels per side"),
+    OPT("refine", 0, IRIS_OPT_INT, "N", 0, 8, iris_guiding_params, refine,
+        "texels per cache split 4 x 4 where the light is\n"
+        "concentrated (default 0: off; at most 8)"),
     OPT("cache-k", 0, IRIS_OPT_INT, "K", 1, 1000000, iris_guiding_params, cache_k, "photons per cache"),
     OPT("pdf-floor", 0, IRIS_OPT_FLOAT, "F", 0, 1, iris_guiding_params, pdf_floor,
         "texel probability floor (default 0.0002)"),

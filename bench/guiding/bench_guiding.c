@@ -1,5 +1,5 @@
 /* bench_guiding SCENE METHOD (--time S | --spp N) [--ref REF.exr] [-o OUT.exr]
- *               [--photons N] [--caches N] [--cache-res R] [--cache-k K]
+ *               [--photons N] [--caches N] [--cache-res R] [--refine N] [--cache-k K]
  *               [--pdf-floor F] [--alpha-max A] [--cos-min C] [--bilinear | --nearest]
  *               [--train-spp N] [--train-prior W] [--train-all-light] [--no-learn-alpha]
  *               [--keep-training | --discard-training]
@@ -98,6 +98,7 @@ int main(int argc, char **argv) {
     else if (!strcmp(a, "--photons")) gp.photons = atoll(v), ++i;
     else if (!strcmp(a, "--caches")) gp.caches = atoll(v), ++i;
     else if (!strcmp(a, "--cache-res")) gp.cache_res = atoi(v), ++i;
+    else if (!strcmp(a, "--refine")) gp.refine = atoi(v), ++i;
     else if (!strcmp(a, "--cache-k")) gp.cache_k = atoi(v), ++i;
     else if (!strcmp(a, "--pdf-floor")) gp.pdf_floor = (float)atof(v), ++i;
     else if (!strcmp(a, "--alpha-max")) gp.alpha_max = (float)atof(v), ++i;

@@ -1,6 +1,8 @@
 /* Cache tables: splatting, pdf with floor, CDF, sampling and pdf lookup. */
 #include "renderer/guiding/cache.h"
 
+#include "renderer/guiding/refine.h"
+
 #include <math.h>
 #include <stdlib.h>
 
@@ -121,6 +123,12 @@ bool iris_cache_build_tables(const iris_octmap *map, const float *hist, float fl
 
 iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const iris_cache_alias *alias,
                             float u0, float u1, float u2, float *pdf_out) {
+  return iris_cache_sample_refined(map, pdf, alias, NULL, NULL, u0, u1, u2, pdf_out);
+}
+
+iris_vec3 iris_cache_sample_refined(const iris_octmap *map, const float *pdf, const iris_cache_alias *alias,
+                                    const uint8_t *slot, const float *sub, float u0, float u1, float u2,
+                                    float *pdf_out) {
   /* Alias table: column floor(u0 n), kept when the fraction is below q. */
   const uint32_t n = map->texel_count;
   float x = u0 * (float)n;
@@ -132,7 +140,17 @@ iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const iris
    * octahedron point q (|q|_1 = 1) normalised is w = q / |q|_2, so
    * 1 / |w|_1^3 = |q|_2^3. */
   uint32_t i = texel % (uint32_t)map->width, j = texel / (uint32_t)map->width;
-  float u = (float)i + u1, v = (float)j + u2;
+  float u, v, m = 1.0f;
+  if (slot && slot[texel]) { /* a refined texel: its sub-cell, then a point in it (refine.h) */
+    const float *mk = sub + (size_t)(slot[texel] - 1) * IRIS_REFINE_SUB;
+    int k = iris_refine_pick(mk, &u1);
+    m = mk[k];
+    u = (float)i + ((float)(k & 3) + u1) * 0.25f;
+    v = (float)j + ((float)(k >> 2) + u2) * 0.25f;
+  } else {
+    u = (float)i + u1;
+    v = (float)j + u2;
+  }
   float a, sign = 1.0f, r = (float)map->res;
   if (i < (uint32_t)map->res) {
     a = 2.0f * u / r - 1.0f;
@@ -145,7 +163,7 @@ iris_vec3 iris_cache_sample(const iris_octmap *map, const float *pdf, const iris
   float pz = sign * fmaxf(0.0f, 1.0f - fabsf(px) - fabsf(py));
   float l2 = sqrtf(px * px + py * py + pz * pz);
   float inv = 1.0f / l2;
-  *pdf_out = pdf[texel] * l2 * l2 * l2;
+  *pdf_out = pdf[texel] * m * l2 * l2 * l2;
   return iris_v3(px * inv, py * inv, pz * inv);
 }
 
@@ -157,8 +175,16 @@ float iris_cache_density_factor(iris_vec3 w) {
 }
 
 float iris_cache_pdf(const iris_octmap *map, const float *pdf, iris_vec3 w) {
+  return iris_cache_pdf_refined(map, pdf, NULL, NULL, w);
+}
+
+float iris_cache_pdf_refined(const iris_octmap *map, const float *pdf, const uint8_t *slot, const float *sub,
+                             iris_vec3 w) {
   float l2 = sqrtf(w.x * w.x + w.y * w.y + w.z * w.z), factor;
+  int k;
   if (!(l2 > 0.0f)) return 0.0f;
-  int32_t t = iris_cache_texel(map->res, map->sphere, iris_scale(w, 1.0f / l2), &factor);
-  return t < 0 ? 0.0f : pdf[t] * factor;
+  int32_t t = iris_cache_cell(map->res, map->sphere, iris_scale(w, 1.0f / l2), &factor, &k);
+  if (t < 0) return 0.0f;
+  float m = slot && slot[t] ? sub[(size_t)(slot[t] - 1) * IRIS_REFINE_SUB + k] : 1.0f;
+  return pdf[t] * factor * m;
 }

@@ -63,21 +63,38 @@ float iris_cache_density_factor(iris_vec3 w);
 float iris_cache_pdf(const iris_octmap *map, const float *pdf, iris_vec3 w);
 
 /* The texel of UNIT local direction w in a res-map (sphere or hemisphere;
- * -1 below a hemisphere map) and *factor = 1 / |w|_1^3, without square roots
- * or libm calls (the render-time pdf lookup; iris_cache_pdf uses it too). */
-static inline int32_t iris_cache_texel(int res, bool sphere, iris_vec3 w, float *factor) {
+ * -1 below a hemisphere map), *sub its sub-cell of a 4 x 4 split of the texel
+ * (refine.h; row-major in texel coordinates) and *factor = 1 / |w|_1^3,
+ * without square roots or libm calls (the render-time pdf lookup). The texel
+ * is the fine cell's divided by 4: scaling by a power of two commutes with
+ * rounding, so it is exactly the texel of the unsplit map. */
+static inline int32_t iris_cache_cell(int res, bool sphere, iris_vec3 w, float *factor, int *sub) {
   if (!sphere && w.z < 0.0f) return -1;
   const float inv = 1.0f / (fabsf(w.x) + fabsf(w.y) + fabsf(w.z));
   *factor = inv * inv * inv;
-  const float x = w.x * inv, y = w.y * inv, h = 0.5f * (float)res;
+  const float x = w.x * inv, y = w.y * inv, h = 2.0f * (float)res; /* 0.5 res texels, x 4 sub-cells */
+  const int fres = 4 * res;
   int i = (int)((x - y + 1.0f) * h), j = (int)((x + y + 1.0f) * h);
   if (w.z < 0.0f) i = (int)((1.0f - (x - y)) * h); /* lower half, mirrored in a */
-  i = i < 0 ? 0 : (i >= res ? res - 1 : i);
-  j = j < 0 ? 0 : (j >= res ? res - 1 : j);
+  i = i < 0 ? 0 : (i >= fres ? fres - 1 : i);
+  j = j < 0 ? 0 : (j >= fres ? fres - 1 : j);
+  *sub = (j & 3) * 4 + (i & 3);
+  i >>= 2;
+  j >>= 2;
   if (w.z < 0.0f) i += res;
   return j * (sphere ? 2 * res : res) + i;
 }
-
+static inline int32_t iris_cache_texel(int res, bool sphere, iris_vec3 w, float *factor) {
+  int sub;
+  return iris_cache_cell(res, sphere, w, factor, &sub);
+}
+/* As iris_cache_sample / iris_cache_pdf with the texels refined where
+ * slot[texel] > 0: sub-table slot - 1 of `sub` (refine.h). slot NULL: none. */
+iris_vec3 iris_cache_sample_refined(const iris_octmap *map, const float *pdf, const iris_cache_alias *alias,
+                                    const uint8_t *slot, const float *sub, float u0, float u1, float u2,
+                                    float *pdf_out);
+float iris_cache_pdf_refined(const iris_octmap *map, const float *pdf, const uint8_t *slot, const float *sub,
+                             iris_vec3 w);
 #ifdef __cplusplus
 }
 #endif

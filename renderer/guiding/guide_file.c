@@ -16,6 +16,7 @@ static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
 #define CACHE_BYTES 66u      /* one cache record */
+#define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
 #define LIGHTS_HEAD_BYTES 12u /* beta f32 + direct photons u64 */
@@ -123,6 +124,7 @@ static void put_params(writer *w, const iris_guiding_params *p) {
   put_f32(w, p->train_prior);
   put_u8(w, p->train_all_light);
   put_u32(w, (uint32_t)p->photon_lights);
+  put_i32(w, p->refine);
 }
 
 static void put_stats(writer *w, const iris_guiding_stats *s) {
@@ -207,6 +209,16 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     for (uint32_t t = 0; t < texels_of(g, c); ++t) {
       put_f32(&w, g->alias[c->table + t].q);
       put_u32(&w, g->alias[c->table + t].alias);
+    }
+  }
+  if (g->params.refine > 0 && g->refine_slot) { /* refinement (refine.h): slots, then sub-tables */
+    for (size_t i = 0; i < count; ++i) {
+      const iris_cache *c = &g->caches[i];
+      put_bytes(&w, g->refine_slot + c->table, texels_of(g, c));
+    }
+    for (size_t i = 0; i < count; ++i) {
+      const float *sub = iris_guiding_sub(g, &g->caches[i]);
+      for (int k = 0; k < IRIS_REFINE_MAX * IRIS_REFINE_SUB; ++k) put_f32(&w, sub[k]);
     }
   }
   if (lights) {
@@ -308,6 +320,7 @@ static bool get_params(reader *r, iris_guiding_params *p) {
   p->train_prior = get_f32(r);
   uint8_t all_light = get_u8(r);
   uint32_t lights = get_u32(r);
+  p->refine = get_i32(r);
   p->train_all_light = all_light != 0;
   p->splat = (iris_splat_mode)splat;
   p->force = force != 0;
@@ -320,7 +333,7 @@ static bool get_params(reader *r, iris_guiding_params *p) {
          p->cache_res >= 1 && p->cache_res <= IRIS_OCTMAP_MAX_RES && p->cache_k >= 1 && isfinite(p->pdf_floor) &&
          p->pdf_floor >= 0.0f && p->pdf_floor <= 1.0f && isfinite(p->alpha_max) && p->alpha_max >= 0.0f &&
          p->alpha_max < 1.0f && isfinite(p->cos_min) && p->cos_min >= -1.0f && p->cos_min <= 1.0f &&
-         p->direct_photons >= -1 && p->direct_photons <= 1;
+         p->direct_photons >= -1 && p->direct_photons <= 1 && p->refine >= 0 && p->refine <= IRIS_REFINE_MAX;
 }
 
 static bool get_stats(reader *r, iris_guiding_stats *s) {
@@ -388,8 +401,11 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
       return refuse(err, path, "guide file has an invalid cache grid (corrupted)");
   /* Counts bounded by the bytes that remain before anything is allocated. */
   const uint64_t light_bytes = lights ? LIGHTS_HEAD_BYTES + count * LIGHTS_CACHE_BYTES : 0;
-  if (count > r->left / CACHE_BYTES || texels > r->left / TEXEL_BYTES ||
-      count * CACHE_BYTES + texels * TEXEL_BYTES + light_bytes != r->left)
+  const bool refined = g->params.refine > 0;
+  const uint64_t cache_bytes = CACHE_BYTES + (refined ? REFINE_CACHE_BYTES : 0);
+  const uint64_t texel_bytes = TEXEL_BYTES + (refined ? 1u : 0u);
+  if (count > r->left / cache_bytes || texels > r->left / texel_bytes ||
+      count * cache_bytes + texels * texel_bytes + light_bytes != r->left)
     return refuse(err, path, "guide file's cache and texel counts do not match its size (corrupted)");
   if (count > UINT32_MAX || texels > UINT32_MAX)
     return refuse(err, path, "guide file has too many caches or texels");
@@ -399,7 +415,12 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
   g->caches = calloc(count ? (size_t)count : 1, sizeof(iris_cache));
   g->pdf = malloc(sizeof(float) * (texels ? (size_t)texels : 1));
   g->alias = malloc(sizeof(iris_cache_alias) * (texels ? (size_t)texels : 1));
-  if (!g->caches || !g->pdf || !g->alias)
+  if (refined) {
+    g->refine_slot = malloc(texels ? (size_t)texels : 1);
+    /* indexed by table / hemisphere texels, as iris_guiding_sub does */
+    g->refine_sub = calloc((size_t)(texels / ((uint64_t)res * res)) + 1, REFINE_CACHE_BYTES);
+  }
+  if (!g->caches || !g->pdf || !g->alias || (refined && (!g->refine_slot || !g->refine_sub)))
     return iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory for %llu caches",
                           (unsigned long long)count);
   g->cache_count = (size_t)count;
@@ -447,6 +468,21 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
       if (!(a->q >= 0.0f && a->q <= 1.0f) || a->alias >= n)
         return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: alias table entry %u out of range (corrupted)",
                               i, t);
+    }
+  }
+  if (refined) {
+    for (size_t t = 0; t < (size_t)texels; ++t) {
+      g->refine_slot[t] = get_u8(r);
+      if (g->refine_slot[t] > g->params.refine)
+        return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "refinement slot of texel %zu out of range (corrupted)", t);
+    }
+    for (size_t i = 0; i < g->cache_count; ++i) {
+      float *sub = g->refine_sub + (size_t)(g->caches[i].table / hemi) * IRIS_REFINE_MAX * IRIS_REFINE_SUB;
+      for (int k = 0; k < IRIS_REFINE_MAX * IRIS_REFINE_SUB; ++k) {
+        sub[k] = get_f32(r);
+        if (!isfinite(sub[k]) || sub[k] < 0.0f || sub[k] > (float)IRIS_REFINE_SUB)
+          return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: refinement table out of range (corrupted)", i);
+      }
     }
   }
   if (lights) { /* checked against the lights' tree when the render attaches them (light_select.h) */
@@ -549,7 +585,9 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
   for (size_t i = 0; i < g->cache_count; ++i) texels += texels_of(g, &g->caches[i]);
   g->stats.memory_bytes = (sizeof(iris_cache) + sizeof(float) * 3 + sizeof(uint32_t) + 1) * g->cache_count +
                           (sizeof(float) + sizeof(iris_cache_alias)) * texels +
-                          sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) + g->grid.memory_bytes;
+                          sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) + g->grid.memory_bytes +
+                          (g->refine_sub ? texels + (size_t)REFINE_CACHE_BYTES * (texels / g->hemi.texel_count + 1) : 0);
+  iris_guiding_count_refined(g);
   *out = g;
   return IRIS_OK;
 }
@@ -615,5 +653,6 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_u64(h, (uint64_t)(int64_t)p->sky_regions);
   h = mix_u64(h, (uint64_t)(int64_t)p->sky_probes);
   h = mix_f32(h, p->sky_beta);
+  h = mix_u64(h, (uint64_t)(int64_t)p->refine);
   return h;
 }

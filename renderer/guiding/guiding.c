@@ -43,6 +43,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.sky_regions = -1;
   p.sky_probes = -1;
   p.sky_beta = -1.0f;
+  p.refine = -1;
   return p;
 }
 
@@ -243,6 +244,7 @@ typedef struct fill_ctx {
   float **hist;     /* per thread, sphere-map sized */
   uint32_t **ids;   /* per thread, 2 * k: ids, then tree slots */
   float **d2;       /* per thread, k */
+  float **fine;     /* per thread, sphere-map sized: fine histogram (refine.h), squares, probabilities (double) */
 } fill_ctx;
 
 /* The photons a cache can use: on a surface facing like the cache's (not the
@@ -281,6 +283,9 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     iris_cache *cache = &g->caches[i];
     const iris_octmap *map = cache->sphere ? &g->sphere : &g->hemi;
     memset(hist, 0, sizeof(float) * map->texel_count);
+    float *fine = g->refine_sub ? c->fine[thread_index] : NULL;
+    float *sq = fine ? fine + IRIS_REFINE_SUB * g->sphere.texel_count : NULL;
+    if (fine) memset(fine, 0, sizeof(float) * (IRIS_REFINE_SUB + 1) * g->sphere.texel_count);
     photon_filter f = {cache->frame.n, cache->sphere != 0};
     uint32_t *slots = ids + c->k;
     uint32_t groups[NORMAL_GROUPS];
@@ -295,6 +300,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       if (iris_dot(ph.n, cache->frame.n) < PHOTON_NORMAL_COS) continue;
       iris_vec3 wl = iris_frame_to_local(&cache->frame, ph.wi);
       bool u = iris_cache_splat(map, hist, wl, ph.energy, g->params.splat);
+      if (u && fine) iris_refine_splat(map, fine, sq, wl, ph.energy);
       used += u;
       if (u) power += ph.energy;
     }
@@ -309,6 +315,15 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     if (!used || !iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + cache->table,
                                           g->alias + cache->table))
       cache->photons = 0;
+    if (fine && cache->photons) { /* split the texels where the light is concentrated */
+      double *prob = (double *)(sq + g->sphere.texel_count), sum = 0.0;
+      for (uint32_t t = 0; t < map->texel_count; ++t) sum += hist[t] > 0.0f ? hist[t] : 0.0f;
+      for (uint32_t t = 0; t < map->texel_count; ++t) prob[t] = (hist[t] > 0.0f ? hist[t] : 0.0f) / sum;
+      iris_refine_build(map, prob, fine, sq, g->params.refine, IRIS_REFINE_MIX, g->refine_slot + cache->table,
+                        iris_guiding_sub(g, cache));
+    } else if (g->refine_slot) {
+      memset(g->refine_slot + cache->table, 0, map->texel_count);
+    }
     if (g->photon_hist && cache->photons) { /* kept for training: normalised */
       double sum = 0.0;
       for (uint32_t t = 0; t < map->texel_count; ++t) sum += hist[t];
@@ -340,6 +355,9 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
    * sun's patch into small solid angles: res 16 there (docs/guiding.md). */
   if (p->cache_res <= 0) p->cache_res = environment_share(s->lights) >= 0.5 ? 16 : 8;
   if (p->cache_k <= 0) p->cache_k = 200;
+  /* Off unless asked for: measured no better on door and stress-caustic and
+   * worse on the glazed sky-room (docs/guiding.md, "Refinement"). */
+  if (p->refine < 0) p->refine = 0;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
     /* Enough photons that each cache's k nearest stay local: about 2.5 stored
@@ -617,6 +635,12 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   }
   g->pdf = malloc(sizeof(float) * (floats ? floats : 1));
   g->alias = malloc(sizeof(iris_cache_alias) * (floats ? floats : 1));
+  if (p->refine > 0 && g->pdf && g->alias) {
+    g->refine_slot = malloc(floats ? floats : 1);
+    g->refine_sub = calloc(IRIS_REFINE_MAX * IRIS_REFINE_SUB * (floats / g->hemi.texel_count + 1), sizeof(float));
+    if (!g->refine_slot || !g->refine_sub)
+      st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
+  }
   if (p->train_spp != 0 && g->pdf && g->alias) {
     g->photon_hist = malloc(sizeof(float) * (floats ? floats : 1));
     if (!g->photon_hist) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for cache tables");
@@ -651,17 +675,20 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
                                  err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
-  fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL};
+  fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL, NULL};
   if (st == IRIS_OK) {
     fc.hist = calloc((size_t)threads, sizeof(float *));
     fc.ids = calloc((size_t)threads, sizeof(uint32_t *));
     fc.d2 = calloc((size_t)threads, sizeof(float *));
-    bool ok = fc.hist && fc.ids && fc.d2;
+    fc.fine = calloc((size_t)threads, sizeof(float *));
+    bool ok = fc.hist && fc.ids && fc.d2 && fc.fine;
     for (int t = 0; ok && t < threads; ++t) {
       fc.hist[t] = malloc(sizeof(float) * g->sphere.texel_count);
       fc.ids[t] = malloc(sizeof(uint32_t) * 2 * (size_t)p->cache_k);
       fc.d2[t] = malloc(sizeof(float) * (size_t)p->cache_k);
-      ok = fc.hist[t] && fc.ids[t] && fc.d2[t];
+      if (g->refine_sub)
+        fc.fine[t] = malloc((sizeof(float) * (IRIS_REFINE_SUB + 1) + sizeof(double)) * g->sphere.texel_count);
+      ok = fc.hist[t] && fc.ids[t] && fc.d2[t] && (!g->refine_sub || fc.fine[t]);
     }
     if (ok) {
       g->cache_count = total;
@@ -674,10 +701,12 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (fc.hist) free(fc.hist[t]);
       if (fc.ids) free(fc.ids[t]);
       if (fc.d2) free(fc.d2[t]);
+      if (fc.fine) free(fc.fine[t]);
     }
     free(fc.hist);
     free(fc.ids);
     free(fc.d2);
+    free(fc.fine);
   }
   if (st == IRIS_OK) {
     /* Keep the caches that received photons; their tables stay where they are. */
@@ -689,6 +718,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     }
     g->cache_count = kept;
     for (size_t i = 0; i < kept; ++i) g->stats.camera_caches += g->caches[i].from_camera;
+    iris_guiding_count_refined(g);
     g->stats.caches = kept;
     if (kept == 0 && !p->force) {
       skip(g, "no cache received photons");
@@ -702,7 +732,10 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       g->stats.memory_bytes = sizeof(iris_cache) * kept + (sizeof(float) + sizeof(iris_cache_alias)) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
                               sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +
-                              g->grid.memory_bytes;
+                              g->grid.memory_bytes +
+                              (g->refine_sub ? floats + sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB *
+                                                            (floats / g->hemi.texel_count + 1)
+                                             : 0);
     }
   }
   if (st == IRIS_OK && !g->stats.skipped && s->learn_lights && g->cache_count) {
@@ -775,6 +808,19 @@ iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setu
   return st;
 }
 
+void iris_guiding_count_refined(iris_guiding *g) {
+  g->stats.refined_texels = g->stats.refined_caches = 0;
+  if (!g->refine_slot) return;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    const iris_cache *c = &g->caches[i];
+    const uint32_t n = c->sphere ? g->sphere.texel_count : g->hemi.texel_count;
+    uint64_t r = 0;
+    for (uint32_t t = 0; t < n; ++t) r += g->refine_slot[c->table + t] != 0;
+    g->stats.refined_texels += r;
+    g->stats.refined_caches += r > 0;
+  }
+}
+
 void iris_guiding_destroy(iris_guiding *g) {
   if (!g) return;
   iris_skyvis_destroy(&g->sky);
@@ -787,6 +833,8 @@ void iris_guiding_destroy(iris_guiding *g) {
   free(g->pdf);
   free(g->alias);
   free(g->photon_hist);
+  free(g->refine_slot);
+  free(g->refine_sub);
   free(g);
 }
 
@@ -817,7 +865,9 @@ float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, 
   for (int i = 0; i < m; ++i) {
     const iris_cache *c = &g->caches[ids[i]];
     const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
-    sum += iris_cache_pdf(map, g->pdf + c->table, iris_frame_to_local(&c->frame, wi));
+    sum += g->refine_slot ? iris_cache_pdf_refined(map, g->pdf + c->table, g->refine_slot + c->table,
+                                                   iris_guiding_sub(g, c), iris_frame_to_local(&c->frame, wi))
+                          : iris_cache_pdf(map, g->pdf + c->table, iris_frame_to_local(&c->frame, wi));
   }
   return m > 0 ? sum / (float)m : 0.0f;
 }
@@ -897,7 +947,9 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   const iris_cache *c = &g->caches[v->ids[j < m ? j : m - 1]];
   const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
   float pdf_one;
-  iris_vec3 wl = iris_cache_sample(map, g->pdf + c->table, g->alias + c->table, u0, u1, u2, &pdf_one);
+  iris_vec3 wl = iris_cache_sample_refined(map, g->pdf + c->table, g->alias + c->table,
+                                           g->refine_slot ? g->refine_slot + c->table : NULL,
+                                           g->refine_slot ? iris_guiding_sub(g, c) : NULL, u0, u1, u2, &pdf_one);
   iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
   iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
   out->wi = wi;
@@ -992,12 +1044,14 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              g->sky.built ? "" : " (too few: the map's own sampling)", g->sky.seconds);
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
-           "camera rays every %d px, %llu empty dropped), %dx%d maps, k=%d, floor %g, %s; "
+           "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "
+           "floor %g, %s; "
            "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s)%s; cache memory %.1f MiB",
            (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
            s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
            (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
-           (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, s->cache_k,
+           (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, (unsigned long long)s->refined_texels,
+           (unsigned long long)s->refined_caches, s->cache_k,
            (double)s->pdf_floor, alpha, s->total_seconds, s->photon_seconds, s->train_spp, s->train_iterations, s->train_seconds, sky,
            (double)s->memory_bytes / (1024.0 * 1024.0));
 }

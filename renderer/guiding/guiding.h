@@ -16,6 +16,7 @@
 #include "renderer/guiding/kdtree.h"
 #include "renderer/guiding/light_select.h"
 #include "renderer/guiding/octmap.h"
+#include "renderer/guiding/refine.h"
 #include "renderer/guiding/photons.h"
 #include "renderer/guiding/pickgrid.h"
 #include "renderer/integrator.h"
@@ -71,6 +72,8 @@ typedef struct iris_guiding_params {
   int sky_regions;      /* map regions across (--sky-regions; down: half as many) */
   int sky_probes;       /* probe rays per cache and region (--sky-probes; 0: off) */
   float sky_beta;       /* probability of a cache's regions (--sky-beta; 0: off) */
+  int refine;           /* most texels per cache refined into 4 x 4 sub-cells where the light is
+                           concentrated (--refine; -1 auto: 0 (measured), 0 off; refine.h) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):
@@ -114,6 +117,7 @@ typedef struct iris_cache {
 typedef struct iris_guiding_stats {
   uint64_t photon_paths, photons_stored, photons_indirect;
   uint64_t caches, camera_caches, empty_caches;
+  uint64_t refined_texels, refined_caches; /* texels split into sub-cells, caches with any (refine.h) */
   int cache_res, cache_k, camera_stride;
   float pdf_floor;
   double photon_seconds, cache_seconds, total_seconds;
@@ -142,15 +146,26 @@ typedef struct iris_guiding {
   float pick_radius2;  /* Algorithm 1 ignores caches farther than this (squared) */
   iris_pick_grid grid; /* candidate caches per cell: Algorithm 1's search without the tree */
   float alpha_cap;     /* cap on learned selection probabilities: --alpha-max when given, else 0.95 */
+  uint8_t *refine_slot; /* per texel (pdf layout): 0, or which of its cache's sub-tables (refine.h) */
+  float *refine_sub;    /* IRIS_REFINE_MAX sub-tables of IRIS_REFINE_SUB per cache, at
+                           iris_guiding_sub(g, cache); NULL: no refinement */
   float *photon_hist;  /* during training only: each cache's photon histogram, normalised (pdf layout) */
   iris_skyvis sky;     /* sky visibility per cache (env NULL: none) */
   iris_light_select lights; /* learned light selection (setup->learn_lights; light_select.h) */
   iris_guiding_stats stats;
 } iris_guiding;
 
+/* The sub-tables of cache c (refine.h): tables are whole multiples of a
+ * hemisphere map, so table / hemi texels numbers the caches. */
+static inline float *iris_guiding_sub(const iris_guiding *g, const iris_cache *c) {
+  return g->refine_sub + (size_t)(c->table / g->hemi.texel_count) * IRIS_REFINE_MAX * IRIS_REFINE_SUB;
+}
+
 iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
                                iris_guiding **out, iris_error *err);
 void iris_guiding_destroy(iris_guiding *g);
+/* Counts the refined texels and caches into g->stats. */
+void iris_guiding_count_refined(iris_guiding *g);
 /* (Re)builds g->sky for the setup's environment map, when the guide is used
  * with light sampling (a guide read from a file gets it here too). */
 iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err);

@@ -174,6 +174,8 @@ typedef struct train_state {
   uint32_t *n;                 /* per cache: samples at vertices it served */
   double *irr;                 /* per cache: sum of Li cos / q over all directions */
   iris_alpha_learner *learner; /* per cache, this pass's samples */
+  float *fine_acc, *photon_sub; /* refinement (refine.h), iris_guiding_sub layout: samples, photons' tables */
+  uint32_t *fine_n;             /* per sub-table: samples */
 } train_state;
 
 /* Adds a tile's samples to the caches whose id is `lane` modulo `lanes`:
@@ -196,6 +198,11 @@ static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer 
        * incident power, also Li cos: the two are the same quantity). */
       float v = t->li * cosc / t->q;
       if (iris_cache_splat(map, ts->acc + c->table, wl, v, g->params.splat)) ts->irr[id] += v;
+      if (ts->fine_acc) {
+        const size_t sub = (size_t)(iris_guiding_sub(g, c) - g->refine_sub);
+        iris_refine_train_add(map, g->refine_slot + c->table, ts->fine_acc + sub, ts->fine_n + sub / IRIS_REFINE_SUB,
+                              wl, v);
+      }
     }
   }
 }
@@ -231,6 +238,11 @@ static void rebuild(iris_guiding *g, const train_state *ts, bool learn, float al
       double lambda = (double)ts->n[i] / ((double)ts->n[i] + prior);
       for (uint32_t t = 0; t < n; ++t) hist[t] = (float)((1.0 - lambda) * ph[t] + lambda * acc[t] / sum);
       iris_cache_build_tables(map, hist, g->params.pdf_floor, g->pdf + c->table, g->alias + c->table);
+      if (ts->fine_acc) {
+        const size_t sub = (size_t)(iris_guiding_sub(g, c) - g->refine_sub);
+        iris_refine_train_rebuild(map, g->refine_slot + c->table, ph, ts->photon_sub + sub, ts->fine_acc + sub,
+                                  ts->fine_n + sub / IRIS_REFINE_SUB, prior, IRIS_REFINE_MIX, g->refine_sub + sub);
+      }
       /* The radiance still to come (Russian roulette): irradiance / pi from
        * the paths, mixed with the photons' estimate the same way. */
       double r = ts->irr[i] / (double)ts->n[i] / 3.14159265358979;
@@ -263,13 +275,21 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   }
   train_state ts = {malloc(caches * sizeof(float)), calloc(floats ? floats : 1, sizeof(float)),
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
-                    calloc(caches, sizeof(iris_alpha_learner))};
+                    calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL};
   if (ts.radiance_photons)
     for (size_t i = 0; i < caches; ++i) ts.radiance_photons[i] = g->caches[i].radiance;
+  const size_t subs = g->refine_slot ? (floats / g->hemi.texel_count + 1) * IRIS_REFINE_MAX : 0;
+  if (subs) { /* refinement: the path samples update the refined texels' sub-cells too */
+    ts.fine_acc = calloc(subs * IRIS_REFINE_SUB, sizeof(float));
+    ts.fine_n = calloc(subs, sizeof(uint32_t));
+    ts.photon_sub = malloc(subs * IRIS_REFINE_SUB * sizeof(float));
+    if (ts.photon_sub) memcpy(ts.photon_sub, g->refine_sub, subs * IRIS_REFINE_SUB * sizeof(float));
+  }
   float *hist = malloc(sizeof(float) * g->sphere.texel_count);
   sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
   iris_status st = IRIS_OK;
-  if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf)
+  if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf ||
+      (subs && (!ts.fine_acc || !ts.fine_n || !ts.photon_sub)))
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
 
   iris_integrator it = *s->integrator;
@@ -351,6 +371,9 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   free(ts.n);
   free(ts.irr);
   free(ts.learner);
+  free(ts.fine_acc);
+  free(ts.fine_n);
+  free(ts.photon_sub);
   free(g->photon_hist);
   g->photon_hist = NULL;
   g->stats.train_spp = done;

@@ -30,17 +30,24 @@ static inline const iris_guide_vertex_state *iris_guide_vertex_get(const iris_gu
 static inline float iris_guide_vertex_cache_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
                                                 iris_vec3 wi) {
   int32_t texel[IRIS_GUIDING_PICK_K] = {-1, -1, -1, -1, -1};
+  int sub[IRIS_GUIDING_PICK_K] = {0, 0, 0, 0, 0};
   float jac[IRIS_GUIDING_PICK_K];
   float sum = 0.0f;
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *c = &g->caches[v->ids[i]];
     if (v->same_as[i] == i) {
-      texel[i] = iris_cache_texel(g->hemi.res, c->sphere, iris_frame_to_local(&c->frame, wi), &jac[i]);
+      texel[i] = iris_cache_cell(g->hemi.res, c->sphere, iris_frame_to_local(&c->frame, wi), &jac[i], &sub[i]);
     } else {
       texel[i] = texel[v->same_as[i]];
       jac[i] = jac[v->same_as[i]];
+      sub[i] = sub[v->same_as[i]];
     }
-    if (texel[i] >= 0) sum += g->pdf[c->table + (uint32_t)texel[i]] * jac[i];
+    if (texel[i] < 0) continue;
+    const uint32_t t = c->table + (uint32_t)texel[i];
+    float d = g->pdf[t] * jac[i];
+    if (g->refine_slot && g->refine_slot[t]) /* a refined texel: its sub-cell's multiplier (refine.h) */
+      d *= iris_guiding_sub(g, c)[(size_t)(g->refine_slot[t] - 1) * IRIS_REFINE_SUB + sub[i]];
+    sum += d;
   }
   return v->m > 0 ? sum / (float)v->m : 0.0f;
 }

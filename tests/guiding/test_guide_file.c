@@ -36,6 +36,7 @@ static iris_guiding *build(const char *name, iris_method method, int64_t photons
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = photons;
   gp.force = force;
+  gp.refine = IRIS_REFINE_MAX; /* the file carries the refinement (off by default) */
   iris_guiding *g = test_guide_build(s, method, gp, 3, 2, 4);
   iris_scene_destroy(s);
   return g;
@@ -57,6 +58,11 @@ static bool same_caches(const iris_guiding *a, const iris_guiding *b) {
     uint32_t n = texels(a, x);
     if (memcmp(a->pdf + x->table, b->pdf + y->table, n * sizeof(float)) ||
         memcmp(a->alias + x->table, b->alias + y->table, n * sizeof(iris_cache_alias)))
+      return false;
+    if ((a->refine_slot == NULL) != (b->refine_slot == NULL)) return false;
+    if (a->refine_slot && (memcmp(a->refine_slot + x->table, b->refine_slot + y->table, n) ||
+                           memcmp(iris_guiding_sub(a, x), iris_guiding_sub(b, y),
+                                  sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB)))
       return false;
   }
   return true;
@@ -226,8 +232,8 @@ static void refusals(const char *dir, iris_guiding *g) {
   }
   iris_check_record(bad == 0, __FILE__, __LINE__, "%d of %d files with a flipped byte loaded", bad, tries);
   memcpy(c, d, n);
-  put32(c + 8, 2);
-  CHECK(refused(dir, c, n, "version 2"));
+  put32(c + 8, IRIS_GUIDE_FILE_VERSION + 1);
+  CHECK(refused(dir, c, n, IRIS_GUIDE_FILE_VERSION == 2 ? "version 3" : "version"));
   memcpy(c, d, n);
   memset(c + n, 0, 16);
   reseal(c, n + 16);
@@ -235,7 +241,11 @@ static void refusals(const char *dir, iris_guiding *g) {
   /* Forged with a valid checksum: locate the sections from the end. */
   size_t tex = 0;
   for (size_t i = 0; i < g->cache_count; ++i) tex += texels(g, &g->caches[i]);
-  const size_t caches_at = n - 66 * g->cache_count - 12 * tex, pdf_at = n - 12 * tex, alias_at = n - 8 * tex;
+  /* refinement (refine.h) after the alias tables: a slot byte per texel, the sub-tables per cache */
+  const size_t refine_bytes = g->refine_slot ? tex + 4 * IRIS_REFINE_MAX * IRIS_REFINE_SUB * g->cache_count : 0;
+  const size_t end = n - refine_bytes, slot_at = end, sub_at = end + tex;
+  const size_t caches_at = end - 66 * g->cache_count - 12 * tex, pdf_at = end - 12 * tex, alias_at = end - 8 * tex;
+  CHECK(g->refine_slot != NULL); /* the default guide is refined: the forgeries below reach its tables */
   const size_t count_at = caches_at - 16, texels_at = caches_at - 8;
   struct forge {
     size_t at;
@@ -257,6 +267,9 @@ static void refusals(const char *dir, iris_guiding *g) {
       {pdf_at + 4 * 19, 4, 0x7f800000u, "not finite"},                 /* inf pdf */
       {alias_at + 8 * 3 + 4, 4, 64, "alias"},                          /* alias index = texel count */
       {alias_at + 8 * 4, 4, 0x3fc00000u, "alias"},                     /* q = 1.5 */
+      {slot_at + 5, 1, IRIS_REFINE_MAX + 1, "refinement slot"},        /* slot past the sub-tables */
+      {sub_at + 4 * 3, 4, 0x7fc00000u, "refinement table"},            /* NaN multiplier */
+      {sub_at + 4 * 7, 4, 0xbf800000u, "refinement table"},            /* multiplier -1 */
   };
   for (size_t f = 0; f < sizeof forges / sizeof forges[0]; ++f) {
     memcpy(c, d, n);

@@ -22,6 +22,7 @@ static iris_guiding *build(const iris_scene *s, int threads, uint64_t seed) {
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 7; /* three training passes (1 + 2 + 4 spp) */
+  gp.refine = IRIS_REFINE_MAX; /* refinement too (off by default), trained */
   return test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, seed, threads, 64);
 }
 
@@ -37,6 +38,11 @@ static size_t table_floats(const iris_guiding *g) {
 static bool same_guide(const iris_guiding *a, const iris_guiding *b) {
   if (a->cache_count != b->cache_count || a->stats.photons_stored != b->stats.photons_stored) return false;
   size_t n = table_floats(a);
+  if ((a->refine_slot == NULL) != (b->refine_slot == NULL)) return false;
+  if (a->refine_slot && (memcmp(a->refine_slot, b->refine_slot, n) != 0 ||
+                         memcmp(a->refine_sub, b->refine_sub,
+                                sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB * (n / a->hemi.texel_count)) != 0))
+    return false; /* refinement (refine.h) */
   return n == table_floats(b) && memcmp(a->caches, b->caches, a->cache_count * sizeof(iris_cache)) == 0 &&
          memcmp(a->pdf, b->pdf, n * sizeof(float)) == 0 && memcmp(a->alias, b->alias, n * sizeof(iris_cache_alias)) == 0;
 }
@@ -48,6 +54,7 @@ static bool render(const iris_scene *s, int threads, bool keep, iris_render_resu
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 3; /* the render trains its guide too */
+  gp.refine = IRIS_REFINE_MAX;
   p.threads = threads;
   iris_test_attach_guide(&p, &gp);
   return iris_test_render(s, &p, r);
