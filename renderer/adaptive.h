@@ -52,6 +52,11 @@ bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out);
 #define IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD 16
 int iris_adaptive_auto_min_spp(double noise_threshold);
 
+/* Memory adaptive sampling adds per pixel of the window: the scout film
+ * (sums, squares, count: 52 bytes) and the per-pixel plans (take, first,
+ * need, weight, target, scouts' take and first: 44), for the memory estimate. */
+#define IRIS_ADAPTIVE_BYTES_PER_PIXEL 96.0
+
 /* The relMSE denominator offset and the share of largest per-pixel errors
  * dropped, as `iris bench` measures against a reference (validate/metrics.h). */
 #define IRIS_ADAPTIVE_EPS 0.01

@@ -170,6 +170,11 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
                                p.method == IRIS_METHOD_AUTO || iris_method_uses_guiding(p.method) ||
                                    p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED,
                                &est);
+    if (adaptive) { /* the scout film (window and halo) and the per-pixel plans */
+      uint64_t extra = (uint64_t)(IRIS_ADAPTIVE_BYTES_PER_PIXEL * (double)(b.x1 - b.x0 + 2) * (double)(b.y1 - b.y0 + 2));
+      est.film += extra;
+      est.total += extra;
+    }
     iris_memory_format(&est, mem_line, sizeof mem_line);
     st = iris_memory_check(&est, scene->source_path ? scene->source_path : "scene", err);
     if (st != IRIS_OK) return st;
