@@ -789,25 +789,6 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   return IRIS_OK;
 }
 
-/* Defaults measured in docs/guiding.md, "Sky visibility". */
-#define SKY_REGIONS 16
-#define SKY_PROBES 2
-#define SKY_BETA 0.75f
-
-iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err) {
-  iris_skyvis_destroy(&g->sky);
-  const iris_guiding_params *p = &g->params;
-  if (!p->use_nee || !setup->lights->envmap || g->stats.skipped || g->cache_count == 0) return IRIS_OK;
-  iris_skyvis_params sp = {p->sky_regions >= 0 ? p->sky_regions : SKY_REGIONS,
-                           p->sky_probes >= 0 ? p->sky_probes : SKY_PROBES,
-                           p->sky_beta >= 0.0f ? p->sky_beta : SKY_BETA};
-  iris_guiding_phase(setup, NULL, "probing the sky from the caches", -1.0);
-  iris_status st = iris_skyvis_build(&g->sky, g->caches, g->cache_count, setup->accel, setup->lights->envmap, &sp,
-                                     setup->seed, setup->threads, err);
-  if (st == IRIS_OK) g->stats.memory_bytes += g->sky.memory_bytes;
-  return st;
-}
-
 void iris_guiding_count_refined(iris_guiding *g) {
   g->stats.refined_texels = g->stats.refined_caches = 0;
   if (!g->refine_slot) return;
@@ -980,23 +961,6 @@ static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
   return v->radiance;
 }
 
-/* Sky visibility (skyvis.h): light sampling of the map from the vertex's tied caches. */
-static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u,
-                                     float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
-  const iris_guiding *g = ctx;
-  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
-  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
-}
-
-static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, float s,
-                                      float t) {
-  const iris_guiding *g = ctx;
-  const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
-  return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
-}
-
 static void guided_prefetch(void *ctx, iris_vec3 p) {
   const iris_guiding *g = ctx;
   if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
@@ -1012,10 +976,7 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.prepare = guided_prepare;
   s.prefetch = guided_prefetch;
   if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
-  if (g->sky.built) {
-    s.sample_environment = guided_sample_environment;
-    s.environment_scale = guided_environment_scale;
-  }
+  iris_guiding_sky_hooks(g, &s);
   return s;
 }
 
@@ -1036,12 +997,8 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              asum / (double)learned, (double)g->params.alpha_max);
   else
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
-  char sky[160] = "";
-  if (g->sky.probed)
-    snprintf(sky, sizeof sky, "; sky seen from the caches: %llu probes, %.0f%% escaped, %zu caches see part of it%s, %.2f s",
-             (unsigned long long)g->sky.probes,
-             g->sky.probes ? 100.0 * (double)g->sky.escaped / (double)g->sky.probes : 0.0, g->sky.part_caches,
-             g->sky.built ? "" : " (too few: the map's own sampling)", g->sky.seconds);
+  char sky[160];
+  iris_skyvis_describe(&g->sky, sky, sizeof sky);
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "
