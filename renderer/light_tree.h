@@ -5,8 +5,8 @@
  * proportion to an estimate of what it gives a shading point, descending the
  * tree with one uniform number. Lights without a position (environment,
  * distant) are chosen beside the tree with a probability of their own. The
- * module knows nothing of scenes: renderer/lights.c hands it one bounds record
- * per light. docs/rendering.md, "Light tree". */
+ * module knows nothing of scenes: renderer/light_build.c hands it one bounds
+ * record per light (iris_lights_bounds). docs/rendering.md, "Light tree". */
 #ifndef IRIS_RENDERER_LIGHT_TREE_H
 #define IRIS_RENDERER_LIGHT_TREE_H
 

@@ -5,7 +5,9 @@
  * MIS needs when a BSDF-sampled ray hits an emitter) and photon emission for
  * the guiding preprocess. Units are radiometric: docs/rendering.md, "Lights".
  * Emissive-triangle radiance is the material's emission (times its emission
- * texture) on the front face, and on both faces when emission_two_sided. */
+ * texture) on the front face, and on both faces when emission_two_sided.
+ * light_build.c builds the list and its tables; lights.c selects, samples and
+ * evaluates. */
 #ifndef IRIS_RENDERER_LIGHTS_H
 #define IRIS_RENDERER_LIGHTS_H
 

@@ -167,8 +167,12 @@ void iris_guiding_destroy(iris_guiding *g);
 /* Counts the refined texels and caches into g->stats. */
 void iris_guiding_count_refined(iris_guiding *g);
 /* (Re)builds g->sky for the setup's environment map, when the guide is used
- * with light sampling (a guide read from a file gets it here too). */
+ * with light sampling (a guide read from a file gets it here too);
+ * skyvis_hooks.c. */
 iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err);
+/* Installs the sampler's environment hooks (sample_environment,
+ * environment_scale) when g->sky is built; skyvis_hooks.c. */
+void iris_guiding_sky_hooks(iris_guiding *g, iris_direction_sampler *s);
 /* Enters a phase of the build (key: core/cancel.h's hook name, NULL: only
  * report) and reports `what` through setup->phase. */
 void iris_guiding_phase(const iris_guide_setup *s, const char *key, const char *what, double eta_first_image);

@@ -2,6 +2,7 @@
 #include "renderer/guiding/skyvis.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -154,6 +155,15 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
   sv->map_height = env->height;
   sv->map_mean = env->mean_luminance;
   return IRIS_OK;
+}
+
+void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size) {
+  if (size) buf[0] = '\0';
+  if (sv->probed)
+    snprintf(buf, size, "; sky seen from the caches: %llu probes, %.0f%% escaped, %zu caches see part of it%s, %.2f s",
+             (unsigned long long)sv->probes,
+             sv->probes ? 100.0 * (double)sv->escaped / (double)sv->probes : 0.0, sv->part_caches,
+             sv->built ? "" : " (too few: the map's own sampling)", sv->seconds);
 }
 
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env) {

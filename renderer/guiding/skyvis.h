@@ -73,6 +73,9 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
                               const iris_envmap *env, const iris_skyvis_params *p, uint64_t seed, int threads,
                               iris_error *err);
 void iris_skyvis_destroy(iris_skyvis *sv);
+/* The probes' counts for the guide's describe line ("; sky seen from the
+ * caches: ..."), "" when they did not run. */
+void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size);
 /* Whether sv was built for env (and is in use). */
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
 

@@ -1,7 +1,7 @@
 /* Guiding's per-vertex state (internal to renderer/guiding/): what
  * guided_prepare picks once per shading point and keeps in
  * iris_shading_point.guide, and the density of the picked caches. Shared by
- * the sampler (guiding.c) and the training passes (train.c), which read the
+ * the sampler (guided_sampler.c) and the training passes (train.c), which read the
  * state back from recorded path vertices. */
 #ifndef IRIS_RENDERER_GUIDING_VERTEX_H
 #define IRIS_RENDERER_GUIDING_VERTEX_H

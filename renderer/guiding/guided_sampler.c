@@ -1,0 +1,171 @@
+/* Rendering with the guide (thesis 5.1-5.2): Algorithm 1's pick of the tied
+ * caches, their pdf, and the one-sample MIS direction sampler
+ * (iris_guiding_sampler) with its per-vertex hooks; docs/guiding.md. The
+ * guide is built in guiding.c. */
+#include "renderer/guiding/guiding.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "renderer/guiding/vertex.h"
+
+#define TIE_EPS 1e-4f
+
+int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t ids[IRIS_GUIDING_PICK_K]) {
+  if (g->cache_count == 0) return 0;
+  uint32_t near[IRIS_GUIDING_PICK_K];
+  float d2[IRIS_GUIDING_PICK_K], cosv[IRIS_GUIDING_PICK_K];
+  /* The grid answers for p's cell centre (O(1)); without a grid (a handful of
+   * caches) the kd-tree answers for p itself. */
+  uint32_t m = g->grid.n[0] ? iris_pick_grid_query(&g->grid, p, near)
+                            : iris_kdtree_knn(&g->tree, p, IRIS_GUIDING_PICK_K, g->pick_radius2, near, d2);
+  float best = -2.0f;
+  for (uint32_t i = 0; i < m; ++i) {
+    cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);
+    best = fmaxf(best, cosv[i]);
+  }
+  if (!(best > g->params.cos_min)) return 0;
+  int count = 0;
+  for (uint32_t i = 0; i < m; ++i)
+    if (cosv[i] >= best - TIE_EPS) ids[count++] = near[i];
+  return count;
+}
+
+float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, iris_vec3 wi) {
+  float sum = 0.0f;
+  for (int i = 0; i < m; ++i) {
+    const iris_cache *c = &g->caches[ids[i]];
+    const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+    sum += g->refine_slot ? iris_cache_pdf_refined(map, g->pdf + c->table, g->refine_slot + c->table,
+                                                   iris_guiding_sub(g, c), iris_frame_to_local(&c->frame, wi))
+                          : iris_cache_pdf(map, g->pdf + c->table, iris_frame_to_local(&c->frame, wi));
+  }
+  return m > 0 ? sum / (float)m : 0.0f;
+}
+
+float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
+  if (sp->delta) return 0.0f;
+  float r = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
+  return fminf(r, g->params.alpha_max);
+}
+
+static void guided_prepare(void *ctx, iris_shading_point *sp) {
+  const iris_guiding *g = ctx;
+  iris_guide_vertex_state *v = (iris_guide_vertex_state *)sp->guide.bytes;
+  v->alpha = iris_guiding_alpha(g, sp);
+  v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
+  if (v->m == 0) v->alpha = 0.0f;
+  v->radiance = -1.0f;
+  if (v->m > 0) {
+    /* Learned selection probabilities (training, docs/guiding.md): the tied
+     * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
+    float r = 0.0f, a = 0.0f;
+    int learned = 0;
+    for (int i = 0; i < v->m; ++i) {
+      const iris_cache *c = &g->caches[v->ids[i]];
+      r += c->radiance;
+      if (c->alpha >= 0.0f) a += c->alpha, learned++;
+    }
+    v->radiance = r / (float)v->m;
+    if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
+  }
+  /* The pdf tables of the tied caches are needed after this vertex's shadow
+   * ray (the light sample's mixture pdf): start loading them now so the ray
+   * hides the memory latency. Not the alias tables: sampling reads one entry,
+   * and loading all of them cost more than it saved (docs/guiding.md). */
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *ci = &g->caches[v->ids[i]];
+    const size_t texels = ci->sphere ? g->sphere.texel_count : g->hemi.texel_count;
+    const char *pdf = (const char *)(g->pdf + ci->table);
+    for (size_t b = 0; b < texels * sizeof(float); b += 64) __builtin_prefetch(pdf + b);
+  }
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *ci = &g->caches[v->ids[i]];
+    v->same_as[i] = (uint8_t)i;
+    for (int j = 0; j < i; ++j) {
+      const iris_cache *cj = &g->caches[v->ids[j]];
+      if (cj->sphere == ci->sphere && memcmp(&cj->frame, &ci->frame, sizeof ci->frame) == 0) {
+        v->same_as[i] = (uint8_t)j;
+        break;
+      }
+    }
+  }
+}
+
+static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
+                          iris_direction_sample *out) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
+  const float alpha = v->alpha;
+  /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
+  if (!(alpha > 0.0f)) return iris_integrator_sample_bsdf(sp, rng, out);
+  float u = iris_sampler_slot(rng, IRIS_SLOT_GUIDE_SELECT);
+  if (u >= alpha) {
+    if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;
+    if (out->delta) { /* only the BSDF strategy reaches a delta lobe */
+      out->pdf *= 1.0f - alpha;
+      return true;
+    }
+    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_cache_pdf(g, v, out->wi);
+    return out->pdf > 0.0f;
+  }
+  /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
+  float uc, u0, u1, u2;
+  iris_sampler_slot2(rng, IRIS_SLOT_GUIDE_CACHE, &uc, &u0); /* cache, texel */
+  iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);   /* position in the texel */
+  int m = v->m;
+  int j = (int)(uc * (float)m);
+  const iris_cache *c = &g->caches[v->ids[j < m ? j : m - 1]];
+  const iris_octmap *map = c->sphere ? &g->sphere : &g->hemi;
+  float pdf_one;
+  iris_vec3 wl = iris_cache_sample_refined(map, g->pdf + c->table, g->alias + c->table,
+                                           g->refine_slot ? g->refine_slot + c->table : NULL,
+                                           g->refine_slot ? iris_guiding_sub(g, c) : NULL, u0, u1, u2, &pdf_one);
+  iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
+  iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
+  out->wi = wi;
+  out->f = iris_integrator_bsdf_eval(sp, wi);
+  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_cache_pdf(g, v, wi);
+  out->delta = false;
+  bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
+  out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
+              ((sp->lobes & IRIS_LOBE_DIFFUSE) ? IRIS_LOBE_DIFFUSE : IRIS_LOBE_GLOSSY);
+  return out->pdf > 0.0f && iris_max3(out->f) > 0.0f;
+}
+
+static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
+  float pb = iris_integrator_bsdf_pdf(sp, wi);
+  if (!(v->alpha > 0.0f)) return pb;
+  return (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_cache_pdf(g, v, wi);
+}
+
+/* Radiance still to come at a prepared vertex, per unit throughput: the tied
+ * caches' estimate (irradiance / pi; the surface's albedo is left out, as in
+ * the pixel estimate it is compared with), for the integrator's Russian
+ * roulette. */
+static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
+  (void)ctx;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
+  return v->radiance;
+}
+
+static void guided_prefetch(void *ctx, iris_vec3 p) {
+  const iris_guiding *g = ctx;
+  if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
+}
+
+iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
+  iris_direction_sampler s;
+  memset(&s, 0, sizeof s);
+  if (!g || g->stats.skipped || g->cache_count == 0) return s;
+  s.ctx = g;
+  s.sample = guided_sample;
+  s.pdf = guided_pdf;
+  s.prepare = guided_prepare;
+  s.prefetch = guided_prefetch;
+  if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
+  iris_guiding_sky_hooks(g, &s);
+  return s;
+}

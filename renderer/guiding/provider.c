@@ -1,0 +1,151 @@
+/* The guide for iris_render (iris_guiding_provider): built, or read from a
+ * file and written to one, described in the log, and its direction sampler
+ * handed to the renderer; the guide's describe line. docs/guiding.md. */
+#include "renderer/guiding/guiding.h"
+
+#include <stdio.h>
+#include <string.h>
+
+#include "core/log.h"
+#include "renderer/guiding/guide_file.h"
+#include "renderer/merge.h"
+
+void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
+  const iris_guiding_stats *s = &g->stats;
+  if (s->skipped) {
+    snprintf(buf, size, "guiding skipped (BSDF sampling instead): %s", s->reason);
+    return;
+  }
+  /* learned selection probabilities: their mean over the caches that learned one */
+  double asum = 0.0;
+  size_t learned = 0;
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].alpha >= 0.0f) asum += g->caches[i].alpha, learned++;
+  char alpha[96];
+  if (learned)
+    snprintf(alpha, sizeof alpha, "alpha learned by %zu caches (mean %.2f), else %g", learned,
+             asum / (double)learned, (double)g->params.alpha_max);
+  else
+    snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
+  char sky[160];
+  iris_skyvis_describe(&g->sky, sky, sizeof sky);
+  snprintf(buf, size,
+           "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
+           "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "
+           "floor %g, %s; "
+           "preprocessing %.2f s (photons %.2f s, training %d spp in %d passes %.2f s)%s; cache memory %.1f MiB",
+           (unsigned long long)s->photon_paths, (unsigned long long)s->photons_stored,
+           s->photons_stored ? 100.0 * (double)s->photons_indirect / (double)s->photons_stored : 0.0,
+           (unsigned long long)s->caches, (unsigned long long)s->camera_caches, s->camera_stride,
+           (unsigned long long)s->empty_caches, s->cache_res, s->cache_res, (unsigned long long)s->refined_texels,
+           (unsigned long long)s->refined_caches, s->cache_k,
+           (double)s->pdf_floor, alpha, s->total_seconds, s->photon_seconds, s->train_spp, s->train_iterations, s->train_seconds, sky,
+           (double)s->memory_bytes / (1024.0 * 1024.0));
+}
+
+/* ---- iris_render provider ---------------------------------------------------- */
+
+/* The guide from a file (--guide-in) or built, and written (--guide-out):
+ * both keyed by the scene hash and the settings hash (guide_file.h). */
+static iris_status provider_guide(const iris_guide_setup *setup, const iris_guiding_params *p, iris_guiding **g,
+                                  iris_error *err) {
+  uint64_t scene_hash = 0, settings_hash = 0;
+  if (p->guide_in || p->guide_out) {
+    scene_hash = iris_merge_scene_hash(setup->scene);
+    settings_hash = iris_guiding_settings_hash(setup, p);
+  }
+  iris_status st = p->guide_in ? iris_guiding_load(p->guide_in, scene_hash, settings_hash, setup->threads, g, err)
+                               : iris_guiding_build(setup, p, g, err);
+  if (st == IRIS_OK && p->guide_in && (*g)->lights.count &&
+      (!setup->learn_lights || !iris_light_select_attach(&(*g)->lights, *g, setup->lights)))
+    st = iris_error_set(err, IRIS_ERR_PARSE, p->guide_in, 0, NULL,
+                        "guide file's learned light tables do not fit this scene's lights (corrupted)");
+  if (st == IRIS_OK && p->guide_in) { /* not in the file: derived from the caches and the scene */
+    (*g)->params.use_nee = p->use_nee;
+    (*g)->params.sky_regions = p->sky_regions;
+    (*g)->params.sky_probes = p->sky_probes;
+    (*g)->params.sky_beta = p->sky_beta;
+    st = iris_guiding_build_sky(*g, setup, err);
+  }
+  if (st == IRIS_OK && p->guide_out) st = iris_guiding_save(*g, p->guide_out, scene_hash, settings_hash, err);
+  if (st != IRIS_OK) {
+    iris_guiding_destroy(*g);
+    *g = NULL;
+  }
+  return st;
+}
+
+static iris_status provider_build(const iris_guide_setup *setup, iris_direction_sampler *out,
+                                  void **state, iris_error *err) {
+  iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
+                                         : iris_guiding_params_default();
+  p.use_nee = setup->integrator && iris_method_uses_nee(setup->integrator->method);
+  iris_guiding *g = NULL;
+  iris_status st = provider_guide(setup, &p, &g, err);
+  if (st != IRIS_OK) return st;
+  char line[768]; /* the describe line at 1080p with the sky: ~470 characters */
+  iris_guiding_describe(g, line, sizeof line);
+  if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
+  else iris_infof("%s", line);
+  if (g->lights.count)
+    iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons, beta %.2f",
+               (unsigned long long)g->lights.learned_caches, g->lights.cache_count,
+               (unsigned long long)g->lights.direct_photons, (double)g->lights.beta);
+  *out = iris_guiding_sampler(g);
+  *state = g;
+  return IRIS_OK;
+}
+
+/* For methods without a guide of their own: the caches only (built whatever
+ * the skip rules say, no training, no file), for the learned light choice. */
+static iris_status provider_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
+  iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
+                                         : iris_guiding_params_default();
+  p.use_nee = true;
+  p.force = true;
+  p.train_spp = 0;
+  p.pilot_paths = 0;
+  p.sky_probes = 0;
+  p.guide_in = p.guide_out = NULL;
+  p.dump_dir = NULL;
+  p.marks = NULL;
+  iris_direction_sampler unused;
+  iris_guide_setup s = *setup;
+  s.options = &p;
+  s.film = NULL;
+  s.deciding = false;
+  return provider_build(&s, &unused, state, err);
+}
+
+static iris_light_learned provider_light_select(const void *state) {
+  const iris_guiding *g = state;
+  return iris_light_select_hooks(g && !g->stats.skipped ? &g->lights : NULL);
+}
+
+static void provider_destroy(void *state) { iris_guiding_destroy(state); }
+
+static bool provider_decision(const void *state, char *why, size_t size) {
+  const iris_guiding *g = state;
+  if (!g) {
+    snprintf(why, size, "no guide");
+    return false;
+  }
+  if (g->stats.skipped) {
+    snprintf(why, size, "%s", g->stats.reason);
+    return false;
+  }
+  if (g->params.force) {
+    snprintf(why, size, "guiding forced");
+    return true;
+  }
+  if (g->stats.seen_indirect_energy >= 0.0) {
+    snprintf(why, size, "%.0f%% of the photon energy on what the camera sees indirect",
+             100.0 * g->stats.seen_indirect_energy);
+    return true;
+  }
+  snprintf(why, size, "%.0f%% of the photons indirect", 100.0 * g->stats.indirect_share);
+  return true;
+}
+
+const iris_guide_provider iris_guiding_provider = {provider_build, provider_destroy, provider_decision,
+                                                   provider_build_lights, provider_light_select};

@@ -1,0 +1,51 @@
+/* The guide's sky visibility (skyvis.h; docs/guiding.md, "Sky visibility"):
+ * g->sky built from the guide's settings and caches, and the direction
+ * sampler's hooks that sample the environment map from a vertex's tied
+ * caches and weigh escaping rays by that density. The probes and the
+ * per-cache tables are skyvis.c's. */
+#include "renderer/guiding/guiding.h"
+#include "renderer/guiding/skyvis.h"
+#include "renderer/guiding/vertex.h"
+
+/* Defaults measured in docs/guiding.md, "Sky visibility". */
+#define SKY_REGIONS 16
+#define SKY_PROBES 2
+#define SKY_BETA 0.75f
+
+iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setup, iris_error *err) {
+  iris_skyvis_destroy(&g->sky);
+  const iris_guiding_params *p = &g->params;
+  if (!p->use_nee || !setup->lights->envmap || g->stats.skipped || g->cache_count == 0) return IRIS_OK;
+  iris_skyvis_params sp = {p->sky_regions >= 0 ? p->sky_regions : SKY_REGIONS,
+                           p->sky_probes >= 0 ? p->sky_probes : SKY_PROBES,
+                           p->sky_beta >= 0.0f ? p->sky_beta : SKY_BETA};
+  iris_guiding_phase(setup, NULL, "probing the sky from the caches", -1.0);
+  iris_status st = iris_skyvis_build(&g->sky, g->caches, g->cache_count, setup->accel, setup->lights->envmap, &sp,
+                                     setup->seed, setup->threads, err);
+  if (st == IRIS_OK) g->stats.memory_bytes += g->sky.memory_bytes;
+  return st;
+}
+
+/* Light sampling of the map from the vertex's tied caches. */
+static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u,
+                                     float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
+  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
+}
+
+static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, float s,
+                                      float t) {
+  const iris_guiding *g = ctx;
+  const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
+  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
+  return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
+}
+
+void iris_guiding_sky_hooks(iris_guiding *g, iris_direction_sampler *s) {
+  if (g->sky.built) {
+    s->sample_environment = guided_sample_environment;
+    s->environment_scale = guided_environment_scale;
+  }
+}
