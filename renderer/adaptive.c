@@ -9,6 +9,7 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/camera_path.h"
 
 #define TILE 8
 #define SQRT_2_OVER_PI 0.79788456080286535588 /* E|Z| of a standard normal */
@@ -121,23 +122,12 @@ static void pass_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
     for (int y = ty; y < ty + TILE && y < c->y1; y++)
       for (int x = tx; x < tx + TILE && x < c->x1; x++) {
         size_t i = (size_t)(y - c->y0) * (size_t)fw + (size_t)(x - c->x0);
-        uint64_t pixel = (uint64_t)y * (uint64_t)c->cam->width + (uint64_t)x;
         uint64_t s0 = c->offset + c->first[i];
-        for (uint64_t s = s0; s < s0 + c->take[i]; s++) {
-          iris_sampler rng = iris_sampler_start_kind(c->it->sampler, c->seed, pixel, s);
-          float ux, uy;
-          iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
-          iris_ray ray = iris_pinhole_ray(c->cam, (float)x + ux, (float)y + uy);
-          iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, &local);
-          iris_film_add(c->film, x - c->x0, y - c->y0, L);
-        }
+        for (uint64_t s = s0; s < s0 + c->take[i]; s++)
+          iris_film_add(c->film, x - c->x0, y - c->y0, iris_camera_path(c->it, c->cam, c->seed, x, y, s, &local));
       }
   }
-  iris_path_stats *total = &c->stats[thread];
-  total->paths += local.paths;
-  total->rays += local.rays;
-  total->shadow_rays += local.shadow_rays;
-  total->nan_count += local.nan_count;
+  iris_path_stats_add(&c->stats[thread], &local);
 }
 
 static void run_pass(pass_ctx *c, int threads) {

@@ -10,6 +10,7 @@
 #include "core/log.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "renderer/camera_path.h"
 #include "renderer/memory.h"
 #include "renderer/merge.h"
 
@@ -48,7 +49,6 @@ typedef struct pass_ctx {
   uint64_t seed;
   uint64_t s0, s1; /* sample indices of this pass */
   int x0, y0, x1, y1; /* the window; the film covers it */
-  int frame_width;    /* pixel indices are full-frame indices */
   int tiles_x;
   iris_path_stats *stats; /* one per thread */
 } pass_ctx;
@@ -63,24 +63,11 @@ static void render_tiles(void *vctx, uint64_t begin, uint64_t end, int thread) {
     int tx = c->x0 + (int)(t % (uint64_t)c->tiles_x) * TILE;
     int ty = c->y0 + (int)(t / (uint64_t)c->tiles_x) * TILE;
     for (int y = ty; y < ty + TILE && y < c->y1; y++)
-      for (int x = tx; x < tx + TILE && x < c->x1; x++) {
-        uint64_t pixel = (uint64_t)y * (uint64_t)c->frame_width + (uint64_t)x;
-        for (uint64_t s = c->s0; s < c->s1; s++) {
-          iris_sampler rng = iris_sampler_start_kind(c->it->sampler, c->seed, pixel, s);
-          float ux, uy;
-          iris_sampler_get2(&rng, IRIS_DIM_PIXEL, &ux, &uy);
-          float fx = (float)x + ux, fy = (float)y + uy;
-          iris_ray ray = iris_pinhole_ray(c->cam, fx, fy);
-          iris_vec3 L = iris_integrator_radiance(c->it, ray, &rng, st);
-          iris_film_add(c->film, x - c->x0, y - c->y0, L);
-        }
-      }
+      for (int x = tx; x < tx + TILE && x < c->x1; x++)
+        for (uint64_t s = c->s0; s < c->s1; s++)
+          iris_film_add(c->film, x - c->x0, y - c->y0, iris_camera_path(c->it, c->cam, c->seed, x, y, s, st));
   }
-  iris_path_stats *total = &c->stats[thread];
-  total->paths += local.paths;
-  total->rays += local.rays;
-  total->shadow_rays += local.shadow_rays;
-  total->nan_count += local.nan_count;
+  iris_path_stats_add(&c->stats[thread], &local);
 }
 
 /* Ends the phase before (a stop request there becomes "interrupted while
@@ -303,12 +290,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     /* the reserved sample range (the cap): a part at the next offset cannot overlap */
     res->spp = p.spp;
     res->seconds = iris_time_now() - t1;
-    for (int i = 0; i < p.threads; i++) {
-      res->stats.paths += stats[i].paths;
-      res->stats.rays += stats[i].rays;
-      res->stats.shadow_rays += stats[i].shadow_rays;
-      res->stats.nan_count += stats[i].nan_count;
-    }
+    for (int i = 0; i < p.threads; i++) iris_path_stats_add(&res->stats, &stats[i]);
   }
   if (st == IRIS_OK && !p.no_passes && !adaptive) {
     const uint64_t pixels = (uint64_t)res->film.width * (uint64_t)res->film.height;
@@ -322,7 +304,6 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     c.y0 = b.y0;
     c.x1 = b.x1;
     c.y1 = b.y1;
-    c.frame_width = res->camera.width;
     c.stats = stats;
     c.tiles_x = (res->film.width + TILE - 1) / TILE;
     int tiles_y = (res->film.height + TILE - 1) / TILE;
@@ -378,12 +359,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
     res->spp = done;
     res->seconds = iris_time_now() - t1;
-    for (int i = 0; i < p.threads; i++) {
-      res->stats.paths += stats[i].paths;
-      res->stats.rays += stats[i].rays;
-      res->stats.shadow_rays += stats[i].shadow_rays;
-      res->stats.nan_count += stats[i].nan_count;
-    }
+    for (int i = 0; i < p.threads; i++) iris_path_stats_add(&res->stats, &stats[i]);
   }
   free(stats);
   memset(&lights.learned, 0, sizeof lights.learned);
