@@ -42,6 +42,10 @@ bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out) {
   return false;
 }
 
+const char *iris_adaptive_stop_name(const iris_adaptive_outcome *o) {
+  return o->reached_target ? "target" : o->converged ? "threshold" : o->interrupted ? "interrupted" : "cap";
+}
+
 int iris_adaptive_auto_min_spp(double t) {
   if (!(t > 0.0)) t = 0.01;
   int m = (int)ceil(16.0 / pow(t, 0.3));

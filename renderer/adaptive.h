@@ -108,6 +108,9 @@ typedef struct iris_adaptive_outcome {
   uint64_t scout_paths;
 } iris_adaptive_outcome;
 
+/* Why the rounds stopped: "target", "threshold", "interrupted" or "cap". */
+const char *iris_adaptive_stop_name(const iris_adaptive_outcome *o);
+
 /* Runs the rounds until the threshold / target is met, the cap or the budget
  * is reached, or a cancel request (core/cancel.h). At least one round runs. */
 iris_status iris_adaptive_run(const iris_adaptive_job *job, iris_adaptive_outcome *out, iris_error *err);

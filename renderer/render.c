@@ -421,8 +421,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
     META("spp_mean", "%.3f", o->spp_mean);
     META("spp_range", "%d,%d", o->spp_min, o->spp_max);
     META("scout_spp_mean", "%.3f", o->scout_spp_mean);
-    META("adaptive_stop", "%s", o->reached_target ? "target" : o->converged ? "threshold"
-                                : o->interrupted ? "interrupted" : "cap");
+    META("adaptive_stop", "%s", iris_adaptive_stop_name(o));
   }
 #undef META
   st = iris_exr_write(path, &img, meta, n, err);

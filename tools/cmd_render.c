@@ -490,8 +490,7 @@ int iris_cmd_render(int argc, char **argv) {
       cJSON_AddNumberToObject(a, "spp_max", ao->spp_max);
       cJSON_AddNumberToObject(a, "scout_spp_mean", ao->scout_spp_mean);
       cJSON_AddNumberToObject(a, "rounds", ao->rounds);
-      cJSON_AddStringToObject(a, "stop", ao->reached_target ? "target" : ao->converged ? "threshold"
-                                         : ao->interrupted ? "interrupted" : "cap");
+      cJSON_AddStringToObject(a, "stop", iris_adaptive_stop_name(ao));
     }
     char *text = cJSON_Print(o);
     if (text) printf("%s\n", text);
