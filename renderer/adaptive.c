@@ -204,22 +204,9 @@ static void per_pixel_needs(state *s) {
     }
 }
 
-/* The 3x3 maximum (inside the scout window) of a scout-pixel field at image pixel (x, y). */
-static double max3(const state *s, const double *f, int x, int y) {
-  int hx = x + s->job->x0 - s->hx0, hy = y + s->job->y0 - s->hy0;
-  double m = 0.0;
-  for (int dy = -1; dy <= 1; dy++)
-    for (int dx = -1; dx <= 1; dx++) {
-      int qx = hx + dx, qy = hy + dy;
-      if (qx < 0 || qy < 0 || qx >= s->HW || qy >= s->HH) continue;
-      double v = f[(size_t)qy * (size_t)s->HW + (size_t)qx];
-      if (v > m) m = v;
-    }
-  return m;
-}
-
-/* The root mean square (inside the scout window) of a field over the 3x3 neighbourhood. */
-static double rms3(const state *s, const double *f, int x, int y) {
+/* A scout-pixel field over the 3x3 neighbourhood (inside the scout window)
+ * of image pixel (x, y): its maximum, or its root mean square (`rms`). */
+static double pool3(const state *s, const double *f, int x, int y, bool rms) {
   int hx = x + s->job->x0 - s->hx0, hy = y + s->job->y0 - s->hy0;
   double m = 0.0;
   int k = 0;
@@ -228,10 +215,13 @@ static double rms3(const state *s, const double *f, int x, int y) {
       int qx = hx + dx, qy = hy + dy;
       if (qx < 0 || qy < 0 || qx >= s->HW || qy >= s->HH) continue;
       double v = f[(size_t)qy * (size_t)s->HW + (size_t)qx];
-      m += v * v;
+      if (rms)
+        m += v * v;
+      else if (v > m)
+        m = v;
       k++;
     }
-  return k ? sqrt(m / k) : 0.0;
+  return !rms ? m : k ? sqrt(m / k) : 0.0;
 }
 
 /* Sum over pixels of what targets C * weight (clamped) would add. */
@@ -264,7 +254,7 @@ static double plan_round(state *s, double budget, double *cmul) {
     if (!need3) return -1.0;
     for (int y = 0; y < s->H; y++)
       for (int x = 0; x < s->W; x++) {
-        double t = max3(s, s->need, x, y);
+        double t = pool3(s, s->need, x, y, false);
         need3[(size_t)y * (size_t)s->W + (size_t)x] = t < s->min_spp ? s->min_spp : ceil(t);
       }
   }
@@ -272,7 +262,7 @@ static double plan_round(state *s, double budget, double *cmul) {
     for (size_t i = 0; i < n; i++) s->target[i] = need3 ? need3[i] : j->spp_cap;
   } else {
     for (int y = 0; y < s->H; y++)
-      for (int x = 0; x < s->W; x++) s->target[(size_t)y * (size_t)s->W + (size_t)x] = rms3(s, s->weight, x, y);
+      for (int x = 0; x < s->W; x++) s->target[(size_t)y * (size_t)s->W + (size_t)x] = pool3(s, s->weight, x, y, true);
     /* the largest C whose targets fit the budget (bisection in log C) */
     double lo = 0.0, hi = 1.0;
     if (budget > 0.0) {
