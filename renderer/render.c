@@ -228,11 +228,38 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
   if (st == IRIS_OK && resolve) {
-    /* --method auto: guided-nee where the guide says it is of use, else mis
+    /* --method auto: guided-nee where the guide says it is of use and it wins
+     * the race (or is forced), else mis
      * without keeping any of the guide (docs/guiding.md, "--method auto"). */
     char why[IRIS_METHOD_REASON_SIZE - 32];
     why[0] = 0;
-    bool use = p.guide->decision(guide_state, why, sizeof why);
+    bool forced = false;
+    bool use = p.guide->decision(guide_state, why, sizeof why, &forced);
+    if (use && !forced && !p.no_passes) {
+      /* the rules leave guided-nee: a race against mis decides (method_race.h) */
+      st = enter_phase(&p, st, "race", "racing mis against guided-nee", t0, err);
+      if (st == IRIS_OK && learned) lights.learned = p.guide->light_select(guide_state);
+      iris_integrator plain = it;
+      plain.method = IRIS_METHOD_MIS;
+      memset(&plain.guide, 0, sizeof plain.guide);
+      it.method = IRIS_METHOD_GUIDED_NEE;
+      if (st == IRIS_OK)
+        st = iris_method_race(&plain, &it, &res->camera, p.seed, p.threads, &res->race, why, sizeof why, err);
+      memset(&lights.learned, 0, sizeof lights.learned);
+      if (st == IRIS_OK) {
+        res->raced = true;
+        use = res->race.guided;
+        const iris_race_outcome *o = &res->race;
+        const double np = (double)o->paths;
+        iris_infof("auto: race of %llu paths each (per path: rays, shadow rays, guide prepares, guide calls; seconds): "
+                   "mis %.2f %.2f %.2f %.2f %.3f s, relative variance %.4g; guided-nee %.2f %.2f %.2f %.2f %.3f s, "
+                   "relative variance %.4g; light guided-nee/mis %.3f (z %.1f)",
+                   (unsigned long long)o->paths, o->rays[0] / np, o->shadow_rays[0] / np, o->prepares[0] / np,
+                   o->guide_calls[0] / np, o->seconds[0], o->relvar[0], o->rays[1] / np, o->shadow_rays[1] / np,
+                   o->prepares[1] / np, o->guide_calls[1] / np, o->seconds[1], o->relvar[1],
+                   o->light[0] > 0.0 ? o->light[1] / o->light[0] : 1.0, o->short_z);
+      }
+    }
     p.method = use ? IRIS_METHOD_GUIDED_NEE : IRIS_METHOD_MIS;
     it.method = p.method;
     snprintf(res->method_reason, sizeof res->method_reason, "auto: %s (%s)", iris_method_name(p.method), why);

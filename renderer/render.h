@@ -15,6 +15,7 @@
 #include "renderer/camera.h"
 #include "renderer/film.h"
 #include "renderer/integrator.h"
+#include "renderer/method_race.h"
 #include "scene/scene.h"
 
 #ifdef __cplusplus
@@ -74,8 +75,10 @@ typedef struct iris_guide_provider {
   /* After build: whether the guide is in use (false: it skipped the scene and
    * the sampler is BSDF sampling), and in `why` a short phrase saying why,
    * e.g. "75% of the photons indirect" or "the scene has no lights".
-   * `--method auto` resolves to guided-nee when true, to mis when false. */
-  bool (*decision)(const void *state, char *why, size_t size);
+   * `--method auto` resolves to mis when false; when true, to guided-nee if
+   * *forced (--force-guiding) and otherwise to the winner of a race of the two
+   * (renderer/method_race.h). */
+  bool (*decision)(const void *state, char *why, size_t size, bool *forced);
   /* Optional (NULL: --light-sampler learned chooses with the tree alone).
    * build_lights: a guide built only for learned light selection (methods
    * without a guide of their own: photons and caches, no training);
@@ -147,7 +150,7 @@ iris_render_params iris_render_params_default(void);
  * settings and then from the defaults. */
 void iris_render_params_from_scene(iris_render_params *p, const iris_scene *scene);
 
-#define IRIS_METHOD_REASON_SIZE 200
+#define IRIS_METHOD_REASON_SIZE 240
 
 typedef struct iris_render_result {
   iris_film film;
@@ -156,6 +159,8 @@ typedef struct iris_render_result {
   iris_method method_requested; /* the one asked for (flag, scene or default): may be auto */
   char method_reason[IRIS_METHOD_REASON_SIZE]; /* auto: "auto: guided-nee (75% of the photons
                                                   indirect)"; otherwise "" */
+  bool raced;                   /* auto ran the race of mis against guided-nee */
+  iris_race_outcome race;       /* its measurements (when raced) */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
   iris_light_sampler light_sampler;

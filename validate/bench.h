@@ -108,7 +108,7 @@ typedef struct iris_bench_row {
   char scene[128];
   char method[64];
   char resolved[32];     /* the method the paths used: auto's choice, else = method */
-  char method_reason[200]; /* auto: "auto: guided-nee (75% of the photons indirect)"; else "" */
+  char method_reason[240]; /* auto: "auto: guided-nee (75% of the photons indirect)"; else "" */
   uint64_t seed;
   double budget_s;       /* the budget; Cycles: the budget of the mis run whose spp it used */
   double seconds;        /* wall-clock of setup + passes; Cycles: render time, start-up excluded */

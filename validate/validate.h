@@ -105,7 +105,7 @@ typedef struct iris_validate_reference {
 typedef struct iris_validate_method {
   iris_method method;       /* as requested (flag, scene, else auto): names the files */
   iris_method resolved;     /* what the paths used (auto's choice) */
-  char method_reason[200];  /* auto: "auto: mis (...)"; else "" */
+  char method_reason[240];  /* auto: "auto: mis (...)"; else "" */
   int spp;
   double seconds;
   double mean[3];

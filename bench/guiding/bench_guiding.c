@@ -64,8 +64,8 @@ static iris_status timed_build(const iris_guide_setup *setup, iris_direction_sam
   return st;
 }
 static void timed_destroy(void *state) { iris_guiding_provider.destroy(state); }
-static bool timed_decision(const void *state, char *why, size_t size) {
-  return iris_guiding_provider.decision(state, why, size);
+static bool timed_decision(const void *state, char *why, size_t size, bool *forced) {
+  return iris_guiding_provider.decision(state, why, size, forced);
 }
 static iris_status timed_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
   double t0 = cpu_seconds();

@@ -124,8 +124,9 @@ static iris_light_learned provider_light_select(const void *state) {
 
 static void provider_destroy(void *state) { iris_guiding_destroy(state); }
 
-static bool provider_decision(const void *state, char *why, size_t size) {
+static bool provider_decision(const void *state, char *why, size_t size, bool *forced) {
   const iris_guiding *g = state;
+  *forced = false;
   if (!g) {
     snprintf(why, size, "no guide");
     return false;
@@ -135,6 +136,7 @@ static bool provider_decision(const void *state, char *why, size_t size) {
     return false;
   }
   if (g->params.force) {
+    *forced = true;
     snprintf(why, size, "guiding forced");
     return true;
   }

@@ -1,0 +1,245 @@
+/* `--method auto`'s race of mis against guided-nee (method_race.h). */
+#include "renderer/method_race.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/cancel.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "renderer/camera_path.h"
+
+/* The guide's operations, counted per thread by wrappers around the guided
+ * integrator's direction sampler (integer sums: deterministic). */
+static _Thread_local uint64_t tl_prepares, tl_calls;
+
+typedef struct counted_guide {
+  iris_direction_sampler inner;
+} counted_guide;
+
+static bool counted_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng, iris_direction_sample *out) {
+  const counted_guide *c = ctx;
+  tl_calls++;
+  return c->inner.sample(c->inner.ctx, sp, rng, out);
+}
+static float counted_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
+  const counted_guide *c = ctx;
+  tl_calls++;
+  return c->inner.pdf(c->inner.ctx, sp, wi);
+}
+static void counted_prepare(void *ctx, iris_shading_point *sp) {
+  const counted_guide *c = ctx;
+  tl_prepares++;
+  c->inner.prepare(c->inner.ctx, sp);
+}
+static float counted_radiance(void *ctx, const iris_shading_point *sp) {
+  const counted_guide *c = ctx;
+  return c->inner.radiance_estimate(c->inner.ctx, sp);
+}
+static void counted_prefetch(void *ctx, iris_vec3 p) {
+  const counted_guide *c = ctx;
+  c->inner.prefetch(c->inner.ctx, p);
+}
+static int counted_environment(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u,
+                               float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
+  const counted_guide *c = ctx;
+  tl_calls++;
+  return c->inner.sample_environment(c->inner.ctx, env, sp, u, u0, u1, wi, pdf, s, t);
+}
+static float counted_scale(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t) {
+  const counted_guide *c = ctx;
+  tl_calls++;
+  return c->inner.environment_scale(c->inner.ctx, env, v, s, t);
+}
+
+static iris_direction_sampler counting(counted_guide *c) {
+  const iris_direction_sampler *g = &c->inner;
+  iris_direction_sampler w = {c,
+                              g->sample ? counted_sample : NULL,
+                              g->pdf ? counted_pdf : NULL,
+                              g->prepare ? counted_prepare : NULL,
+                              g->radiance_estimate ? counted_radiance : NULL,
+                              g->prefetch ? counted_prefetch : NULL,
+                              g->sample_environment ? counted_environment : NULL,
+                              g->environment_scale ? counted_scale : NULL};
+  return w;
+}
+
+typedef struct race_thread {
+  iris_path_stats stats;
+  uint64_t prepares, calls;
+  char pad[64];
+} race_thread;
+
+typedef struct race_ctx {
+  const iris_integrator *it;
+  const iris_pinhole *cam;
+  uint64_t seed;
+  int stride, cols; /* the grid: pixel (stride i + stride/2, stride j + stride/2) */
+  uint64_t spp;
+  double *sum, *sum2; /* 3 per race pixel */
+  race_thread *threads;
+} race_ctx;
+
+static void race_pixels(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  race_ctx *c = vctx;
+  iris_path_stats local = {0};
+  const uint64_t p0 = tl_prepares, c0 = tl_calls;
+  const int half = c->stride / 2;
+  for (uint64_t i = begin; i < end; i++) {
+    int x = (int)(i % (uint64_t)c->cols) * c->stride + half;
+    int y = (int)(i / (uint64_t)c->cols) * c->stride + half;
+    double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
+    for (uint64_t k = 0; k < c->spp; k++) {
+      iris_vec3 L = iris_camera_path(c->it, c->cam, c->seed, x, y, k, &local);
+      const double v[3] = {L.x, L.y, L.z};
+      for (int ch = 0; ch < 3; ch++) {
+        s[ch] += v[ch];
+        s2[ch] += v[ch] * v[ch];
+      }
+    }
+    memcpy(&c->sum[3 * i], s, sizeof s);
+    memcpy(&c->sum2[3 * i], s2, sizeof s2);
+  }
+  iris_path_stats_add(&c->threads[thread].stats, &local);
+  c->threads[thread].prepares += tl_prepares - p0;
+  c->threads[thread].calls += tl_calls - c0;
+}
+
+static int cmp_double(const void *a, const void *b) {
+  const double x = *(const double *)a, y = *(const double *)b;
+  return x < y ? -1 : x > y;
+}
+
+static double luminance(const double *v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
+
+iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
+                             uint64_t seed, int threads, iris_race_outcome *out, char *why, size_t why_size,
+                             iris_error *err) {
+  memset(out, 0, sizeof *out);
+  if (threads < 1) threads = 1;
+  /* the grid covers the whole frame, whatever window is rendered: every part
+   * of a partitioned render runs the same race and makes the same choice */
+  int stride = (int)floor(sqrt((double)cam->width * (double)cam->height / IRIS_RACE_PIXELS));
+  if (stride < 1) stride = 1;
+  const int cols = (cam->width + stride - 1 - stride / 2) / stride, rows = (cam->height + stride - 1 - stride / 2) / stride;
+  const uint64_t n = (uint64_t)cols * (uint64_t)rows;
+  /* small frames: more paths per pixel, the same paths in all */
+  uint64_t spp = (IRIS_RACE_PATHS + n - 1) / n;
+  if (spp < IRIS_RACE_SPP) spp = IRIS_RACE_SPP;
+  if (spp > IRIS_RACE_SPP_MAX) spp = IRIS_RACE_SPP_MAX;
+  double *buf = calloc(12 * n, sizeof *buf);
+  race_thread *per = calloc((size_t)threads, sizeof *per);
+  if (!buf || !per) {
+    free(buf);
+    free(per);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (the method race)");
+  }
+  counted_guide cg = {guided->guide};
+  iris_integrator counted = *guided;
+  counted.guide = counting(&cg);
+  const iris_integrator *its[2] = {mis, &counted};
+  /* an independent sampler: the race measures the variance of one path */
+  iris_integrator race_its[2] = {*its[0], *its[1]};
+  for (int m = 0; m < 2; m++) {
+    race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
+    memset(per, 0, (size_t)threads * sizeof *per);
+    race_ctx c = {&race_its[m], cam, iris_hash4(seed, 0x7ace, (uint64_t)m, 31), stride, cols, spp,
+                  buf + 6 * n * (uint64_t)m, buf + 6 * n * (uint64_t)m + 3 * n, per};
+    double t = iris_time_now();
+    iris_parallel_for(n, 16, threads, race_pixels, &c);
+    out->seconds[m] = iris_time_now() - t;
+    for (int i = 0; i < threads; i++) {
+      out->rays[m] += per[i].stats.rays;
+      out->shadow_rays[m] += per[i].stats.shadow_rays;
+      out->prepares[m] += per[i].prepares;
+      out->guide_calls[m] += per[i].calls;
+    }
+    if (iris_cancel_requested()) {
+      free(buf);
+      free(per);
+      return iris_cancel_error(err);
+    }
+  }
+  out->paths = n * spp;
+  /* Per pixel: each method's sample variance, relative to the two methods'
+   * mean over the pixel's grid neighbours, the pixel itself left out: a
+   * denominator from the pixel's own samples would grow with a rare bright
+   * sample and hide the very tail the race must see. Summed in pixel order. */
+  const double k = (double)spp;
+  double *both = calloc(5 * n, sizeof *both), *terms = both + 3 * n; /* + each method's pixel terms */
+  if (!both) {
+    free(buf);
+    free(per);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (the method race)");
+  }
+  for (uint64_t i = 0; i < 3 * n; i++) {
+    const uint64_t px = i / 3, ch = i % 3;
+    both[i] = 0.5 * (buf[3 * px + ch] + buf[6 * n + 3 * px + ch]) / k; /* sums of mis, of guided-nee */
+  }
+  double rv[2] = {0, 0}, light[2] = {0, 0}, dvar = 0.0;
+  for (uint64_t i = 0; i < n; i++) {
+    const int cx = (int)(i % (uint64_t)cols), cy = (int)(i / (uint64_t)cols);
+    double ref[3] = {0, 0, 0};
+    int nb = 0;
+    for (int dy = -1; dy <= 1; dy++)
+      for (int dx = -1; dx <= 1; dx++) {
+        const int x = cx + dx, y = cy + dy;
+        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= cols || y >= rows) continue;
+        const double *b = both + 3 * ((uint64_t)y * (uint64_t)cols + (uint64_t)x);
+        for (int ch = 0; ch < 3; ch++) ref[ch] += b[ch];
+        nb++;
+      }
+    for (int ch = 0; ch < 3; ch++) ref[ch] = nb > 0 ? ref[ch] / nb : both[3 * i + ch];
+    for (int m = 0; m < 2; m++) {
+      const double *s = buf + 6 * n * (uint64_t)m + 3 * i, *s2 = s + 3 * n;
+      double mean[3], var[3], r = 0.0;
+      for (int ch = 0; ch < 3; ch++) {
+        mean[ch] = s[ch] / k;
+        double v = (s2[ch] - s[ch] * s[ch] / k) / (k - 1.0);
+        var[ch] = v > 0.0 ? v : 0.0;
+        r += var[ch] / (ref[ch] * ref[ch] + 0.01);
+      }
+      terms[(uint64_t)m * n + i] = r / 3.0;
+      light[m] += luminance(mean);
+      dvar += luminance(var) / k; /* the luminance's variance, channels taken as independent: a bound */
+    }
+  }
+  /* as iris bench's relMSE, the 0.1% largest pixel terms left out */
+  const uint64_t keep = n - (uint64_t)(IRIS_RACE_TRIM * (double)n);
+  for (int m = 0; m < 2; m++) {
+    qsort(terms + (uint64_t)m * n, n, sizeof *terms, cmp_double);
+    for (uint64_t i = 0; i < keep; i++) rv[m] += terms[(uint64_t)m * n + i];
+  }
+  free(both);
+  for (int m = 0; m < 2; m++) {
+    out->relvar[m] = rv[m] / (double)keep;
+    out->light[m] = light[m] / (double)n;
+    out->cost[m] = ((double)out->rays[m] + IRIS_RACE_COST_SHADOW * (double)out->shadow_rays[m] +
+                    IRIS_RACE_COST_PREPARE * (double)out->prepares[m] +
+                    IRIS_RACE_COST_GUIDE_CALL * (double)out->guide_calls[m]) /
+                   (double)out->paths;
+  }
+  free(buf);
+  free(per);
+  out->short_z = dvar > 0.0 ? (light[1] - light[0]) / sqrt(dvar) : 0.0;
+  const double work[2] = {out->relvar[0] * out->cost[0], out->relvar[1] * out->cost[1]};
+  out->speedup = work[1] > 0.0 ? work[0] / work[1] : (work[0] > 0.0 ? INFINITY : 1.0);
+  const double shortfall = light[1] > 0.0 ? 1.0 - light[0] / light[1] : 0.0;
+  if (out->short_z > IRIS_RACE_SHORT_Z) {
+    out->guided = true;
+    snprintf(why, why_size, "the race: mis found %.0f%% less light than guided-nee (%.1f standard errors): paths too rare to measure",
+             100.0 * shortfall, out->short_z);
+  } else if (out->short_z < -IRIS_RACE_SHORT_Z) {
+    out->guided = false;
+    snprintf(why, why_size, "the race: guided-nee found %.0f%% less light than mis (%.1f standard errors): paths too rare to measure",
+             100.0 * (light[0] > 0.0 ? 1.0 - light[1] / light[0] : 0.0), -out->short_z);
+  } else {
+    out->guided = out->speedup > 1.0;
+    snprintf(why, why_size, "the race: guided-nee %.2fx mis per unit of work (relative variance %.3g against %.3g, cost %.1f against %.1f rays per path)",
+             out->speedup, out->relvar[1], out->relvar[0], out->cost[1], out->cost[0]);
+  }
+  return IRIS_OK;
+}

@@ -1,0 +1,62 @@
+/* `--method auto` by measurement (docs/guiding.md, "--method auto"): a short,
+ * deterministic race of mis against guided-nee on a fixed grid of pixels of
+ * the whole frame, after the guide is built. Each method traces the same
+ * number of camera paths with its own seed (none of them enters the image);
+ * the race measures each method's relative variance per sample and its cost
+ * per sample in a deterministic model (rays and guide look-ups, weighted by
+ * per-operation times measured once: no clock decides), and whether one
+ * method found significantly less light than the other (an estimator that is
+ * short of light has paths too rare for the race to see, so its variance is
+ * underestimated). Private to renderer/. */
+#ifndef IRIS_RENDERER_METHOD_RACE_H
+#define IRIS_RENDERER_METHOD_RACE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "renderer/camera.h"
+#include "renderer/integrator.h"
+
+/* The model's cost of one operation, in closest-hit rays (docs/guiding.md,
+ * "--method auto", where they were measured). */
+#define IRIS_RACE_COST_SHADOW 0.9
+#define IRIS_RACE_COST_PREPARE 0.4
+#define IRIS_RACE_COST_GUIDE_CALL 0.05
+/* Camera paths per method: at least IRIS_RACE_PIXELS pixels of a strided grid
+ * over the frame (all pixels of a smaller frame), IRIS_RACE_SPP paths each, or
+ * more (up to IRIS_RACE_SPP_MAX) until the race holds IRIS_RACE_PATHS paths. */
+#define IRIS_RACE_PIXELS 16384
+#define IRIS_RACE_SPP 4
+#define IRIS_RACE_SPP_MAX 256
+#define IRIS_RACE_PATHS 65536
+/* The share of the race's pixels with the largest terms left out of its
+ * relative variance, as iris bench's relMSE leaves out the largest errors. */
+#define IRIS_RACE_TRIM 0.001
+/* A method whose race image holds this many standard errors less light than
+ * the other's loses, whatever its measured variance. */
+#define IRIS_RACE_SHORT_Z 4.0
+
+typedef struct iris_race_outcome {
+  /* [0] mis, [1] guided-nee */
+  double relvar[2];    /* mean over the race's pixels of (1/3) sum_c s_c^2 / (m_c^2 + 0.01):
+                          the relMSE of one sample per pixel */
+  double cost[2];      /* modelled cost per path, in closest-hit rays */
+  double seconds[2];   /* measured (reported, never decides) */
+  uint64_t rays[2], shadow_rays[2], prepares[2], guide_calls[2];
+  double light[2];     /* mean luminance of the race pixels */
+  double short_z;      /* (light[1] - light[0]) in standard errors: > 0 mis is short */
+  uint64_t paths;      /* per method */
+  double speedup;      /* guided-nee's efficiency over mis's (relvar x cost), before the light check */
+  bool guided;         /* the winner */
+} iris_race_outcome;
+
+/* Races `mis` (an integrator with method mis) against `guided` (guided-nee,
+ * its guide set) on camera `cam`. Deterministic for a given seed whatever the
+ * thread count. A stop request gives IRIS_ERR_INTERRUPTED. `why` receives the
+ * reason in words ("guided-nee 1.8x mis per unit of work ..."). */
+iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
+                             uint64_t seed, int threads, iris_race_outcome *out, char *why, size_t why_size,
+                             iris_error *err);
+
+#endif

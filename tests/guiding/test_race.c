@@ -1,0 +1,198 @@
+/* --method auto's race (renderer/method_race.h; docs/guiding.md, "--method auto"):
+ *  - its relative variance of one path is the one a long render measures
+ *    (door, mis: within 0.7-1.4x of 256 samples per pixel with the same
+ *    statistic), where denominators from the pixel's own samples would hide
+ *    the tail (and fail this);
+ *  - a racer short of light loses, whatever its variance: mis limited to
+ *    direct light against full mis on door (and the other way round), with
+ *    the reason saying so; two equal racers are never called short;
+ *  - the cost model counts rays, shadow rays and the guide's work as
+ *    documented, deterministic: the same outcome, bit for bit, on 1 and 2
+ *    threads and for a window of the frame (auto on door). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "render_run.h"
+#include "renderer/accel.h"
+#include "renderer/guiding/guiding.h"
+#include "renderer/lights.h"
+#include "renderer/method_race.h"
+#include "renderer/render.h"
+#include "renderer/texture.h"
+#include "scenes/builtin.h"
+
+typedef struct world {
+  iris_scene *s;
+  iris_accel *accel;
+  iris_textures tex;
+  iris_lights lights;
+  iris_pinhole cam;
+} world;
+
+static bool world_build(world *w, const char *name, int width, int height) {
+  memset(w, 0, sizeof *w);
+  iris_error err;
+  iris_error_clear(&err);
+  iris_status st = iris_builtin_create(name, &w->s, &err);
+  if (st == IRIS_OK) st = iris_pinhole_setup(w->s, NULL, width, height, &w->cam, &err);
+  if (st == IRIS_OK) st = iris_accel_build(w->s, &w->accel, &err);
+  if (st == IRIS_OK) st = iris_textures_load(w->s, &w->tex, &err);
+  if (st == IRIS_OK) st = iris_lights_build(w->s, w->accel, &w->tex, &w->lights, &err);
+  CHECK_OK(st, &err);
+  return st == IRIS_OK;
+}
+
+static void world_destroy(world *w) {
+  iris_lights_destroy(&w->lights);
+  iris_textures_destroy(&w->tex);
+  iris_accel_destroy(w->accel);
+  iris_scene_destroy(w->s);
+}
+
+static bool race(const world *w, const iris_integrator *a, const iris_integrator *b, int threads,
+                 iris_race_outcome *o, char *why, size_t size) {
+  iris_error err;
+  iris_error_clear(&err);
+  iris_status st = iris_method_race(a, b, &w->cam, 5, threads, o, why, size, &err);
+  CHECK_OK(st, &err);
+  return st == IRIS_OK;
+}
+
+/* The race's statistic from a long mis render of the same frame. */
+static double long_relvar(const world *w, const iris_integrator *it, int spp) {
+  iris_render_params p = iris_test_params(w->cam.width, w->cam.height, spp, IRIS_METHOD_MIS, 77);
+  p.sampler = IRIS_SAMPLER_INDEPENDENT;
+  p.threads = 2;
+  p.max_depth = it->max_depth;
+  iris_render_result r;
+  if (!iris_test_render(w->s, &p, &r)) return NAN;
+  const int W = r.film.width, H = r.film.height;
+  const size_t n = (size_t)W * (size_t)H;
+  double *terms = malloc(n * sizeof *terms);
+  if (!terms) return NAN;
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      double ref[3] = {0, 0, 0};
+      int nb = 0;
+      for (int dy = -1; dy <= 1; dy++)
+        for (int dx = -1; dx <= 1; dx++) {
+          int xx = x + dx, yy = y + dy;
+          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+          iris_vec3 m, v;
+          iris_film_pixel(&r.film, xx, yy, &m, &v);
+          ref[0] += m.x, ref[1] += m.y, ref[2] += m.z;
+          nb++;
+        }
+      iris_vec3 m, v;
+      iris_film_pixel(&r.film, x, y, &m, &v);
+      const double var[3] = {v.x * spp, v.y * spp, v.z * spp};
+      double t = 0.0;
+      for (int c = 0; c < 3; c++) t += var[c] / ((ref[c] / nb) * (ref[c] / nb) + 0.01);
+      terms[(size_t)y * (size_t)W + (size_t)x] = t / 3.0;
+    }
+  /* the race leaves out its 0.1% largest terms: so does this (insertion of the few largest) */
+  const size_t drop = (size_t)(IRIS_RACE_TRIM * (double)n);
+  for (size_t k = 0; k < drop; k++) {
+    size_t big = 0;
+    for (size_t i = 1; i < n; i++)
+      if (terms[i] > terms[big]) big = i;
+    terms[big] = -1.0;
+  }
+  double sum = 0.0;
+  for (size_t i = 0; i < n; i++)
+    if (terms[i] >= 0.0) sum += terms[i];
+  free(terms);
+  iris_render_result_destroy(&r);
+  return sum / (double)(n - drop);
+}
+
+static void test_statistic_and_light(void) {
+  world w;
+  if (!world_build(&w, "door", 128, 96)) return; /* 6 race paths per pixel */
+  iris_integrator full = iris_integrator_default(w.s, w.accel, &w.lights, &w.tex);
+  full.method = IRIS_METHOD_MIS;
+  iris_integrator direct = full;
+  direct.max_depth = 0;
+  char why[256];
+  iris_race_outcome o;
+  /* two equal racers: the same statistic as a long render; neither short */
+  if (race(&w, &full, &full, 2, &o, why, sizeof why)) {
+    double truth = long_relvar(&w, &full, 256);
+    printf("door mis: race relative variance %.4g and %.4g, 256 spp %.4g (%llu paths); light z %.2f; %s\n",
+           o.relvar[0], o.relvar[1], truth, (unsigned long long)o.paths, o.short_z, why);
+    for (int m = 0; m < 2; m++)
+      iris_check_record(o.relvar[m] > 0.7 * truth && o.relvar[m] < 1.4 * truth, __FILE__, __LINE__,
+                        "racer %d's relative variance %.4g is not within 0.7-1.4x of the long render's %.4g", m,
+                        o.relvar[m], truth);
+    CHECK(fabs(o.short_z) < IRIS_RACE_SHORT_Z);
+    CHECK(o.paths >= IRIS_RACE_PATHS);
+    CHECK(strstr(why, "per unit of work") != NULL);
+    /* mis has no guide: the cost is rays and shadow rays alone */
+    CHECK_EQ_INT(o.prepares[0], 0);
+    CHECK(fabs(o.cost[0] - ((double)o.rays[0] + IRIS_RACE_COST_SHADOW * (double)o.shadow_rays[0]) / (double)o.paths) <
+          1e-9 * o.cost[0]);
+  }
+  /* direct light only is short of door's light (it is mostly indirect) */
+  if (race(&w, &direct, &full, 2, &o, why, sizeof why)) {
+    printf("door direct vs full: light %.4g vs %.4g, z %.1f; %s\n", o.light[0], o.light[1], o.short_z, why);
+    CHECK(o.short_z > IRIS_RACE_SHORT_Z);
+    CHECK(o.guided); /* the second racer wins */
+    CHECK(strstr(why, "less light") != NULL);
+    CHECK(o.relvar[0] < o.relvar[1] || o.cost[0] < o.cost[1]); /* on variance and cost alone it would have won */
+  }
+  if (race(&w, &full, &direct, 2, &o, why, sizeof why)) {
+    CHECK(o.short_z < -IRIS_RACE_SHORT_Z);
+    CHECK(!o.guided);
+    CHECK(strstr(why, "less light") != NULL);
+  }
+  world_destroy(&w);
+}
+
+/* auto on door: the race decides, the same on 1 and 2 threads and in a window. */
+static void test_deterministic(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  iris_error_clear(&err);
+  if (!CHECK(iris_builtin_create("door", &s, &err) == IRIS_OK)) return;
+  iris_guiding_params gp = iris_guiding_params_default();
+  iris_render_result r[3];
+  bool ok[3];
+  for (int k = 0; k < 3; k++) {
+    iris_render_params p = iris_test_params(48, 36, 1, IRIS_METHOD_AUTO, 9);
+    p.guide = &iris_guiding_provider; /* iris_test_attach_guide leaves auto without one */
+    p.guide_options = &gp;
+    p.threads = k == 0 ? 1 : 2;
+    if (k == 2) p.bounds = (iris_pixel_bounds){8, 4, 30, 20};
+    ok[k] = CHECK(iris_test_render(s, &p, &r[k]));
+  }
+  if (ok[0] && ok[1] && ok[2]) {
+    printf("door auto: %s\n", r[0].method_reason);
+    CHECK(r[0].raced);
+    CHECK_EQ_STR(iris_method_name(r[0].method), "guided-nee");
+    for (int k = 1; k < 3; k++) {
+      CHECK(r[k].raced);
+      CHECK_EQ_STR(r[k].method_reason, r[0].method_reason);
+      for (int m = 0; m < 2; m++) {
+        CHECK(r[k].race.relvar[m] == r[0].race.relvar[m]);
+        CHECK(r[k].race.cost[m] == r[0].race.cost[m]);
+        CHECK(r[k].race.light[m] == r[0].race.light[m]);
+        CHECK_EQ_INT(r[k].race.rays[m], r[0].race.rays[m]);
+        CHECK_EQ_INT(r[k].race.prepares[m], r[0].race.prepares[m]);
+        CHECK_EQ_INT(r[k].race.guide_calls[m], r[0].race.guide_calls[m]);
+      }
+    }
+    CHECK(r[0].race.prepares[1] > 0); /* guided-nee's guide work is counted */
+  }
+  for (int k = 0; k < 3; k++)
+    if (ok[k]) iris_render_result_destroy(&r[k]);
+  iris_scene_destroy(s);
+}
+
+int main(void) {
+  test_statistic_and_light();
+  test_deterministic();
+  return iris_check_summary("guiding.race");
+}
