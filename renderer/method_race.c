@@ -78,7 +78,7 @@ typedef struct race_ctx {
   const iris_pinhole *cam;
   uint64_t seed;
   int stride, cols; /* the grid: pixel (stride i + stride/2, stride j + stride/2) */
-  uint64_t spp;
+  uint64_t s0, s1;    /* the round's sample indices */
   double *sum, *sum2; /* 3 per race pixel */
   race_thread *threads;
 } race_ctx;
@@ -91,8 +91,10 @@ static void race_pixels(void *vctx, uint64_t begin, uint64_t end, int thread) {
   for (uint64_t i = begin; i < end; i++) {
     int x = (int)(i % (uint64_t)c->cols) * c->stride + half;
     int y = (int)(i / (uint64_t)c->cols) * c->stride + half;
-    double s[3] = {0, 0, 0}, s2[3] = {0, 0, 0};
-    for (uint64_t k = 0; k < c->spp; k++) {
+    double s[3], s2[3];
+    memcpy(s, &c->sum[3 * i], sizeof s);
+    memcpy(s2, &c->sum2[3 * i], sizeof s2);
+    for (uint64_t k = c->s0; k < c->s1; k++) {
       iris_vec3 L = iris_camera_path(c->it, c->cam, c->seed, x, y, k, &local);
       const double v[3] = {L.x, L.y, L.z};
       for (int ch = 0; ch < 3; ch++) {
@@ -116,8 +118,8 @@ static int cmp_double(const void *a, const void *b) {
 static double luminance(const double *v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
 
 iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
-                             uint64_t seed, int threads, iris_race_outcome *out, char *why, size_t why_size,
-                             iris_error *err) {
+                             uint64_t seed, int threads, double time_cap, iris_race_outcome *out, char *why,
+                             size_t why_size, iris_error *err) {
   memset(out, 0, sizeof *out);
   if (threads < 1) threads = 1;
   /* the grid covers the whole frame, whatever window is rendered: every part
@@ -143,26 +145,36 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
   const iris_integrator *its[2] = {mis, &counted};
   /* an independent sampler: the race measures the variance of one path */
   iris_integrator race_its[2] = {*its[0], *its[1]};
-  for (int m = 0; m < 2; m++) {
-    race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
-    memset(per, 0, (size_t)threads * sizeof *per);
-    race_ctx c = {&race_its[m], cam, iris_hash4(seed, 0x7ace, (uint64_t)m, 31), stride, cols, spp,
-                  buf + 6 * n * (uint64_t)m, buf + 6 * n * (uint64_t)m + 3 * n, per};
-    double t = iris_time_now();
-    iris_parallel_for(n, 16, threads, race_pixels, &c);
-    out->seconds[m] = iris_time_now() - t;
-    for (int i = 0; i < threads; i++) {
-      out->rays[m] += per[i].stats.rays;
-      out->shadow_rays[m] += per[i].stats.shadow_rays;
-      out->prepares[m] += per[i].prepares;
-      out->guide_calls[m] += per[i].calls;
+  for (int m = 0; m < 2; m++) race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
+  /* rounds of IRIS_RACE_ROUND_SPP paths per pixel, the methods in turn, until
+   * spp; under a time cap also until the race has used it (after one round) */
+  const double t0 = iris_time_now();
+  uint64_t done = 0;
+  while (done < spp) {
+    const uint64_t r = spp - done < IRIS_RACE_ROUND_SPP ? spp - done : IRIS_RACE_ROUND_SPP;
+    for (int m = 0; m < 2; m++) {
+      memset(per, 0, (size_t)threads * sizeof *per);
+      race_ctx c = {&race_its[m], cam, iris_hash4(seed, 0x7ace, (uint64_t)m, 31), stride, cols, done, done + r,
+                    buf + 6 * n * (uint64_t)m, buf + 6 * n * (uint64_t)m + 3 * n, per};
+      double t = iris_time_now();
+      iris_parallel_for(n, 16, threads, race_pixels, &c);
+      out->seconds[m] += iris_time_now() - t;
+      for (int i = 0; i < threads; i++) {
+        out->rays[m] += per[i].stats.rays;
+        out->shadow_rays[m] += per[i].stats.shadow_rays;
+        out->prepares[m] += per[i].prepares;
+        out->guide_calls[m] += per[i].calls;
+      }
+      if (iris_cancel_requested()) {
+        free(buf);
+        free(per);
+        return iris_cancel_error(err);
+      }
     }
-    if (iris_cancel_requested()) {
-      free(buf);
-      free(per);
-      return iris_cancel_error(err);
-    }
+    done += r;
+    if (time_cap > 0.0 && iris_time_now() - t0 >= time_cap) break;
   }
+  spp = done;
   out->paths = n * spp;
   /* Per pixel: each method's sample variance, relative to the two methods'
    * mean over the pixel's grid neighbours, the pixel itself left out: a

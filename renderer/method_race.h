@@ -30,6 +30,11 @@
 #define IRIS_RACE_SPP 4
 #define IRIS_RACE_SPP_MAX 256
 #define IRIS_RACE_PATHS 65536
+/* The race runs in rounds of this many paths per pixel (>= 2: each round
+ * alone gives a variance); a time cap ends it after the round that reaches
+ * it. Under `--time` the cap is IRIS_RACE_BUDGET_SHARE of the budget. */
+#define IRIS_RACE_ROUND_SPP 2
+#define IRIS_RACE_BUDGET_SHARE 0.05
 /* The share of the race's pixels with the largest terms left out of its
  * relative variance, as iris bench's relMSE leaves out the largest errors. */
 #define IRIS_RACE_TRIM 0.001
@@ -52,11 +57,14 @@ typedef struct iris_race_outcome {
 } iris_race_outcome;
 
 /* Races `mis` (an integrator with method mis) against `guided` (guided-nee,
- * its guide set) on camera `cam`. Deterministic for a given seed whatever the
- * thread count. A stop request gives IRIS_ERR_INTERRUPTED. `why` receives the
- * reason in words ("guided-nee 1.8x mis per unit of work ..."). */
+ * its guide set) on camera `cam`. Without a time cap (time_cap <= 0)
+ * deterministic for a given seed and frame, whatever the thread count or the
+ * window rendered; with one, the rounds run depend on the machine (as a
+ * `--time` render's samples do). A stop request gives IRIS_ERR_INTERRUPTED.
+ * `why` receives the reason in words ("guided-nee 1.8x mis per unit of work
+ * ..."). */
 iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
-                             uint64_t seed, int threads, iris_race_outcome *out, char *why, size_t why_size,
-                             iris_error *err);
+                             uint64_t seed, int threads, double time_cap, iris_race_outcome *out, char *why,
+                             size_t why_size, iris_error *err);
 
 #endif

@@ -244,7 +244,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       memset(&plain.guide, 0, sizeof plain.guide);
       it.method = IRIS_METHOD_GUIDED_NEE;
       if (st == IRIS_OK)
-        st = iris_method_race(&plain, &it, &res->camera, p.seed, p.threads, &res->race, why, sizeof why, err);
+        st = iris_method_race(&plain, &it, &res->camera, p.seed, p.threads,
+                              p.time_budget > 0.0 ? IRIS_RACE_BUDGET_SHARE * p.time_budget : 0.0, &res->race, why,
+                              sizeof why, err);
       memset(&lights.learned, 0, sizeof lights.learned);
       if (st == IRIS_OK) {
         res->raced = true;

@@ -56,7 +56,7 @@ static bool race(const world *w, const iris_integrator *a, const iris_integrator
                  iris_race_outcome *o, char *why, size_t size) {
   iris_error err;
   iris_error_clear(&err);
-  iris_status st = iris_method_race(a, b, &w->cam, 5, threads, o, why, size, &err);
+  iris_status st = iris_method_race(a, b, &w->cam, 5, threads, 0.0, o, why, size, &err);
   CHECK_OK(st, &err);
   return st == IRIS_OK;
 }
