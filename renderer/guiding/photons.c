@@ -101,9 +101,11 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
     }
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    /* f |cos| / pdf for every lobe: a delta lobe's f carries 1/|cos wi|
+     * (bsdf.c), so its weight is the lobe's colour, as on camera paths;
+     * weighting it by f alone gained 1/|cos| at every glass interface. */
     float cosv = fabsf(iris_dot(ds.wi, sp.frame.n));
-    iris_vec3 w = ds.delta ? ds.f : iris_scale(ds.f, cosv);
-    beta = iris_scale(iris_mul(beta, w), 1.0f / ds.pdf);
+    beta = iris_scale(iris_mul(beta, iris_scale(ds.f, cosv)), 1.0f / ds.pdf);
     if (!iris_isfinite3(beta)) return;
     /* Russian roulette on the throughput relative to the emitted power. */
     if (bounce >= 2) {
