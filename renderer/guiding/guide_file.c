@@ -15,7 +15,7 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES 66u      /* one cache record */
+#define CACHE_BYTES 70u      /* one cache record */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
@@ -198,6 +198,7 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     put_f32(&w, c->alpha);
     put_u8(&w, c->sphere);
     put_u8(&w, c->from_camera);
+    put_f32(&w, c->sky_through);
     at += texels_of(g, c);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -439,10 +440,11 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     uint8_t sph = get_u8(r), cam = get_u8(r);
     c->sphere = sph;
     c->from_camera = cam;
+    c->sky_through = get_f32(r);
     if (!finite3(c->p) || !finite3(c->frame.s) || !finite3(c->frame.t) || !finite3(c->frame.n))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: position or frame is not finite (corrupted)", i);
     if (sph > 1 || cam > 1 || c->photons == 0 || !isfinite(c->radiance) || c->radiance < 0.0f ||
-        !isfinite(c->alpha) || c->alpha > 1.0f)
+        !isfinite(c->alpha) || c->alpha > 1.0f || !(c->sky_through >= 0.0f && c->sky_through <= 1.0f))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid values (corrupted)", i);
     /* Tables are stored back to back in cache order: exactly one offset is right. */
     uint32_t n = sph ? sphere : hemi;

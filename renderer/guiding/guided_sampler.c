@@ -56,17 +56,23 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
   if (v->m == 0) v->alpha = 0.0f;
   v->radiance = -1.0f;
+  v->sky = 0.0f;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
      * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
-    float r = 0.0f, a = 0.0f;
+    float r = 0.0f, a = 0.0f, sky = 0.0f;
     int learned = 0;
     for (int i = 0; i < v->m; ++i) {
       const iris_cache *c = &g->caches[v->ids[i]];
       r += c->radiance;
+      sky += c->sky_through;
       if (c->alpha >= 0.0f) a += c->alpha, learned++;
     }
     v->radiance = r / (float)v->m;
+    /* Sky behind glass: the share of the tied caches' photon energy that came
+     * straight through glass from the map, which the map's own density finds
+     * (the sun within its texels) and light sampling cannot reach. */
+    v->sky = g->env ? sky / (float)v->m : 0.0f;
     if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
   }
   /* The pdf tables of the tied caches are needed after this vertex's shadow
@@ -92,6 +98,20 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   }
 }
 
+/* A direction drawn by the guide's strategy: the BSDF's value and the mixture's density. */
+static bool guided_finish(const iris_guiding *g, const iris_shading_point *sp, const iris_guide_vertex_state *v,
+                          float alpha, iris_vec3 wi, iris_direction_sample *out) {
+  iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
+  out->wi = wi;
+  out->f = iris_integrator_bsdf_eval(sp, wi);
+  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_guide_pdf(g, v, wi);
+  out->delta = false;
+  bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
+  out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
+              ((sp->lobes & IRIS_LOBE_DIFFUSE) ? IRIS_LOBE_DIFFUSE : IRIS_LOBE_GLOSSY);
+  return out->pdf > 0.0f && iris_max3(out->f) > 0.0f;
+}
+
 static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler *rng,
                           iris_direction_sample *out) {
   const iris_guiding *g = ctx;
@@ -106,8 +126,17 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
       out->pdf *= 1.0f - alpha;
       return true;
     }
-    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_cache_pdf(g, v, out->wi);
+    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_guide_pdf(g, v, out->wi);
     return out->pdf > 0.0f;
+  }
+  /* Sky behind glass: the guide's share alpha split between the map (sky) and the caches. */
+  const float us = u / alpha;
+  if (us < v->sky) {
+    float u1, u2, pdf_map;
+    iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
+    iris_vec3 wi;
+    if (!iris_envmap_sample(g->env, u1, u2, &wi, &pdf_map, NULL)) return false;
+    return guided_finish(g, sp, v, alpha, wi, out);
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
   float uc, u0, u1, u2;
@@ -121,16 +150,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   iris_vec3 wl = iris_cache_sample_refined(map, g->pdf + c->table, g->alias + c->table,
                                            g->refine_slot ? g->refine_slot + c->table : NULL,
                                            g->refine_slot ? iris_guiding_sub(g, c) : NULL, u0, u1, u2, &pdf_one);
-  iris_vec3 wi = iris_normalize(iris_frame_to_world(&c->frame, wl));
-  iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
-  out->wi = wi;
-  out->f = iris_integrator_bsdf_eval(sp, wi);
-  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_cache_pdf(g, v, wi);
-  out->delta = false;
-  bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
-  out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
-              ((sp->lobes & IRIS_LOBE_DIFFUSE) ? IRIS_LOBE_DIFFUSE : IRIS_LOBE_GLOSSY);
-  return out->pdf > 0.0f && iris_max3(out->f) > 0.0f;
+  return guided_finish(g, sp, v, alpha, iris_normalize(iris_frame_to_world(&c->frame, wl)), out);
 }
 
 static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
@@ -138,7 +158,7 @@ static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
   const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   float pb = iris_integrator_bsdf_pdf(sp, wi);
   if (!(v->alpha > 0.0f)) return pb;
-  return (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_cache_pdf(g, v, wi);
+  return (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_guide_pdf(g, v, wi);
 }
 
 /* Radiance still to come at a prepared vertex, per unit throughput: the tied

@@ -290,7 +290,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
                                                    photon_usable, &f, ids, d2, slots);
     uint32_t used = 0;
-    double power = 0.0;
+    double power = 0.0, through = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
       photon_dirs ph;
       memcpy(&ph, c->photon_tree->payload + (size_t)slots[j] * sizeof ph, sizeof ph);
@@ -300,8 +300,10 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       if (u && fine) iris_refine_splat(map, fine, sq, wl, ph.energy);
       used += u;
       if (u) power += ph.energy;
+      if (u && c->photons->photons[ids[j]].sky_through) through += ph.energy;
     }
     cache->photons = used;
+    cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
     /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
      * sum of powers / (paths * pi r_k^2); radiance of a white diffuse surface =
      * irradiance / pi. The photons cover the disc to the k-th nearest. */
@@ -769,6 +771,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   g->stats.camera_stride = stride;
   g->stats.pdf_floor = g->params.pdf_floor;
   g->stats.pilot_share = g->stats.indirect_share = g->stats.seen_indirect_energy = -1.0;
+  g->env = setup->lights->envmap; /* training samples the sky behind glass */
   iris_status st = iris_octmap_create(&g->hemi, g->params.cache_res, false, err);
   if (st == IRIS_OK) st = iris_octmap_create(&g->sphere, g->params.cache_res, true, err);
   if (st == IRIS_OK) {
@@ -782,6 +785,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
     return st;
   }
   g->stats.total_seconds = iris_time_now() - t0;
+  g->env = NULL; /* lent for the build's training; the provider lends it for rendering */
   *out = g;
   return IRIS_OK;
 }

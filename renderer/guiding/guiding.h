@@ -110,6 +110,9 @@ typedef struct iris_cache {
                         radiance a diffuse white surface here reflects (Russian roulette);
                         refined by training */
   float alpha;       /* learned cache-sampling probability (< 0: not learned, alpha_max) */
+  float sky_through; /* share of its photons' energy that came from the environment
+                        straight through glass (photons.h): the probability with which
+                        its guided samples follow the map instead ("Sky behind glass") */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
 } iris_cache;
@@ -151,6 +154,9 @@ typedef struct iris_guiding {
                            iris_guiding_sub(g, cache); NULL: no refinement */
   float *photon_hist;  /* during training only: each cache's photon histogram, normalised (pdf layout) */
   iris_skyvis sky;     /* sky visibility per cache (env NULL: none) */
+  const iris_envmap *env; /* the lights' map, sampled for caches with sky_through > 0: borrowed,
+                             set by the build for training and by the provider for rendering
+                             (NULL: none, and guided sampling ignores sky_through) */
   iris_light_select lights; /* learned light selection (setup->learn_lights; light_select.h) */
   iris_guiding_stats stats;
 } iris_guiding;

@@ -9,6 +9,9 @@
 #include "core/rng.h"
 
 #define BLOCK_PATHS 4096u
+/* cos of the largest angle between a photon's arrival and emission directions
+ * that still counts as travelling straight through glass (0.5 degrees) */
+#define SKY_THROUGH_COS 0.99996f
 /* Stream offset that keeps photon random numbers apart from camera pixels. */
 #define PHOTON_SAMPLE_INDEX 0x70686f746f6eULL
 
@@ -77,6 +80,10 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
   iris_vec3 beta = e.power;
   if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;
   iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
+  /* Until the first non-delta vertex: whether a photon of the map still
+   * travels along its emission direction having passed only delta vertices
+   * (SKY_THROUGH_COS: a flat slab's faces are parallel). */
+  bool specular_only = s->lights->envmap && s->lights->environment >= 0 && e.light == (uint32_t)s->lights->environment;
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -97,13 +104,17 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.bounce = (uint8_t)(bounce > 255 ? 255 : bounce);
       ph.transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
       ph.light = e.light;
+      ph.sky_through = specular_only && bounce > 0 && iris_dot(wo, e.dir) < -SKY_THROUGH_COS;
       block_push(out, &ph);
+      specular_only = false;
     }
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    /* f |cos| / pdf for every lobe: a delta lobe's f carries 1/|cos wi|
+     * (bsdf.c), so its weight is the lobe's colour, as on camera paths;
+     * weighting it by f alone gained 1/|cos| at every glass interface. */
     float cosv = fabsf(iris_dot(ds.wi, sp.frame.n));
-    iris_vec3 w = ds.delta ? ds.f : iris_scale(ds.f, cosv);
-    beta = iris_scale(iris_mul(beta, w), 1.0f / ds.pdf);
+    beta = iris_scale(iris_mul(beta, iris_scale(ds.f, cosv)), 1.0f / ds.pdf);
     if (!iris_isfinite3(beta)) return;
     /* Russian roulette on the throughput relative to the emitted power. */
     if (bounce >= 2) {

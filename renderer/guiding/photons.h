@@ -30,6 +30,10 @@ typedef struct iris_photon {
   float energy;     /* mean of the RGB photon power */
   uint8_t bounce;   /* 0: straight from the light (direct illumination) */
   uint8_t transmits;/* the surface has transmission lobes (full-sphere cache) */
+  uint8_t sky_through; /* from the environment map after delta vertices only (bounce > 0),
+                          arriving along its emission direction (through a flat glass slab):
+                          light that sampling the map as a direction finds and light
+                          sampling cannot (docs/guiding.md, "Sky behind glass") */
   uint32_t light;   /* the light entry it left (iris_lights; learned light selection) */
 } iris_photon;
 

@@ -27,8 +27,18 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              asum / (double)learned, (double)g->params.alpha_max);
   else
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
-  char sky[160];
+  char sky[256];
   iris_skyvis_describe(&g->sky, sky, sizeof sky);
+  /* caches that sample the map for sky light behind glass ("Sky behind glass") */
+  double tsum = 0.0;
+  size_t through = 0;
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].sky_through > 0.0f) tsum += g->caches[i].sky_through, through++;
+  if (through) {
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; sky behind glass: %zu caches (mean share %.2f)", through,
+             tsum / (double)through);
+  }
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "
@@ -91,6 +101,7 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
     iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons, beta %.2f",
                (unsigned long long)g->lights.learned_caches, g->lights.cache_count,
                (unsigned long long)g->lights.direct_photons, (double)g->lights.beta);
+  g->env = setup->lights->envmap; /* the map the caches' sky behind glass is sampled from */
   *out = iris_guiding_sampler(g);
   *state = g;
   return IRIS_OK;

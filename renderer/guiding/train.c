@@ -128,7 +128,7 @@ static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_en
     t.h = h / 3.0f;
     t.q = pv->pdf;
     t.pb = pv->pdf_bsdf;
-    t.pc = iris_guide_vertex_cache_pdf(c->g, v, pv->wi);
+    t.pc = iris_guide_vertex_guide_pdf(c->g, v, pv->wi);
     if (!isfinite(t.li) || !isfinite(t.h) || !(t.q > 0.0f)) continue;
     if (!buffer_push(out, &t)) return false;
   }

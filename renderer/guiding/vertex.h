@@ -16,6 +16,7 @@
 typedef struct iris_guide_vertex_state {
   float alpha;                          /* cache-sampling probability; 0: BSDF only */
   float radiance;                       /* tied caches' mean radiance estimate; < 0 none */
+  float sky;                            /* of the guide's share alpha, the map's (sky behind glass) */
   int32_t m;                            /* tied caches */
   uint32_t ids[IRIS_GUIDING_PICK_K];
   uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
@@ -50,6 +51,15 @@ static inline float iris_guide_vertex_cache_pdf(const iris_guiding *g, const iri
     sum += d;
   }
   return v->m > 0 ? sum / (float)v->m : 0.0f;
+}
+
+/* Density of the guide's strategy: the tied caches', mixed with the map's
+ * where sky light arrives through glass (docs/guiding.md, "Sky behind glass"). */
+static inline float iris_guide_vertex_guide_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
+                                                iris_vec3 wi) {
+  float pc = iris_guide_vertex_cache_pdf(g, v, wi);
+  if (!(v->sky > 0.0f)) return pc;
+  return (1.0f - v->sky) * pc + v->sky * iris_envmap_pdf(g->env, wi);
 }
 
 #endif
