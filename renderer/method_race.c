@@ -221,9 +221,15 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
   }
   /* as iris bench's relMSE, the 0.1% largest pixel terms left out */
   const uint64_t keep = n - (uint64_t)(IRIS_RACE_TRIM * (double)n);
+  double all[2] = {0, 0};
   for (int m = 0; m < 2; m++) {
     qsort(terms + (uint64_t)m * n, n, sizeof *terms, cmp_double);
-    for (uint64_t i = 0; i < keep; i++) rv[m] += terms[(uint64_t)m * n + i];
+    for (uint64_t i = 0; i < n; i++) {
+      if (i == keep) rv[m] = all[m];
+      all[m] += terms[(uint64_t)m * n + i];
+    }
+    if (keep == n) rv[m] = all[m];
+    out->tail_share[m] = all[m] > 0.0 ? 1.0 - rv[m] / all[m] : 0.0;
   }
   free(both);
   for (int m = 0; m < 2; m++) {
@@ -240,7 +246,15 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
   const double work[2] = {out->relvar[0] * out->cost[0], out->relvar[1] * out->cost[1]};
   out->speedup = work[1] > 0.0 ? work[0] / work[1] : (work[0] > 0.0 ? INFINITY : 1.0);
   const double shortfall = light[1] > 0.0 ? 1.0 - light[0] / light[1] : 0.0;
-  if (out->short_z > IRIS_RACE_SHORT_Z) {
+  const int tailed = out->tail_share[0] >= out->tail_share[1] ? 0 : 1;
+  if (out->tail_share[tailed] > IRIS_RACE_TAIL_MAX) {
+    /* a few pixels hold the variance: the race cannot measure it (sky-room-glazed:
+     * untrimmed ratios from 0.02x to 16x between seeds); the rules' guided-nee stands */
+    out->guided = true;
+    out->unmeasurable = true;
+    snprintf(why, why_size, "the race cannot tell: %.2g%% of its pixels hold %.0f%% of %s's variance; the photon rules' choice stands",
+             100.0 * IRIS_RACE_TRIM, 100.0 * out->tail_share[tailed], tailed ? "guided-nee" : "mis");
+  } else if (out->short_z > IRIS_RACE_SHORT_Z) {
     out->guided = true;
     snprintf(why, why_size, "the race: mis found %.0f%% less light than guided-nee (%.1f standard errors): paths too rare to measure",
              100.0 * shortfall, out->short_z);

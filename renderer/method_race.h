@@ -38,6 +38,9 @@
 /* The share of the race's pixels with the largest terms left out of its
  * relative variance, as iris bench's relMSE leaves out the largest errors. */
 #define IRIS_RACE_TRIM 0.001
+/* When those pixels hold more than this share of either method's variance,
+ * the race cannot measure it and guided-nee (the photon rules' choice) stands. */
+#define IRIS_RACE_TAIL_MAX 0.5
 /* A method whose race image holds this many standard errors less light than
  * the other's loses, whatever its measured variance. */
 #define IRIS_RACE_SHORT_Z 4.0
@@ -52,7 +55,9 @@ typedef struct iris_race_outcome {
   double light[2];     /* mean luminance of the race pixels */
   double short_z;      /* (light[1] - light[0]) in standard errors: > 0 mis is short */
   uint64_t paths;      /* per method */
+  double tail_share[2]; /* the share of each method's variance in the IRIS_RACE_TRIM pixels left out */
   double speedup;      /* guided-nee's efficiency over mis's (relvar x cost), before the light check */
+  bool unmeasurable;   /* tail_share above IRIS_RACE_TAIL_MAX: the rules' guided-nee stands */
   bool guided;         /* the winner */
 } iris_race_outcome;
 
