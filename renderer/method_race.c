@@ -115,6 +115,27 @@ static int cmp_double(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
+void iris_race_neighbour_mean(const double *means, int cols, int rows, int x, int y, double ref[3]) {
+  int nb = 0;
+  ref[0] = ref[1] = ref[2] = 0.0;
+  for (int dy = -1; dy <= 1; dy++)
+    for (int dx = -1; dx <= 1; dx++) {
+      const int xx = x + dx, yy = y + dy;
+      if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= cols || yy >= rows) continue;
+      const double *b = means + 3 * ((size_t)yy * (size_t)cols + (size_t)xx);
+      for (int ch = 0; ch < 3; ch++) ref[ch] += b[ch];
+      nb++;
+    }
+  const double *self = means + 3 * ((size_t)y * (size_t)cols + (size_t)x);
+  for (int ch = 0; ch < 3; ch++) ref[ch] = nb > 0 ? ref[ch] / nb : self[ch];
+}
+
+double iris_race_term(const double var[3], const double ref[3]) {
+  double r = 0.0;
+  for (int ch = 0; ch < 3; ch++) r += var[ch] / (ref[ch] * ref[ch] + 0.01);
+  return r / 3.0;
+}
+
 static double luminance(const double *v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
 
 iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
@@ -193,28 +214,17 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
   }
   double rv[2] = {0, 0}, light[2] = {0, 0}, dvar = 0.0;
   for (uint64_t i = 0; i < n; i++) {
-    const int cx = (int)(i % (uint64_t)cols), cy = (int)(i / (uint64_t)cols);
-    double ref[3] = {0, 0, 0};
-    int nb = 0;
-    for (int dy = -1; dy <= 1; dy++)
-      for (int dx = -1; dx <= 1; dx++) {
-        const int x = cx + dx, y = cy + dy;
-        if ((dx == 0 && dy == 0) || x < 0 || y < 0 || x >= cols || y >= rows) continue;
-        const double *b = both + 3 * ((uint64_t)y * (uint64_t)cols + (uint64_t)x);
-        for (int ch = 0; ch < 3; ch++) ref[ch] += b[ch];
-        nb++;
-      }
-    for (int ch = 0; ch < 3; ch++) ref[ch] = nb > 0 ? ref[ch] / nb : both[3 * i + ch];
+    double ref[3];
+    iris_race_neighbour_mean(both, cols, rows, (int)(i % (uint64_t)cols), (int)(i / (uint64_t)cols), ref);
     for (int m = 0; m < 2; m++) {
       const double *s = buf + 6 * n * (uint64_t)m + 3 * i, *s2 = s + 3 * n;
-      double mean[3], var[3], r = 0.0;
+      double mean[3], var[3];
       for (int ch = 0; ch < 3; ch++) {
         mean[ch] = s[ch] / k;
         double v = (s2[ch] - s[ch] * s[ch] / k) / (k - 1.0);
         var[ch] = v > 0.0 ? v : 0.0;
-        r += var[ch] / (ref[ch] * ref[ch] + 0.01);
       }
-      terms[(uint64_t)m * n + i] = r / 3.0;
+      terms[(uint64_t)m * n + i] = iris_race_term(var, ref);
       light[m] += luminance(mean);
       dvar += luminance(var) / k; /* the luminance's variance, channels taken as independent: a bound */
     }

@@ -61,6 +61,14 @@ typedef struct iris_race_outcome {
   bool guided;         /* the winner */
 } iris_race_outcome;
 
+/* The race's statistic, for iris_method_race and for whoever checks it
+ * against longer renders: the mean of `means` (3 per cell of a cols x rows
+ * grid) over the 8 neighbours of cell (x, y), the cell itself left out (its
+ * own value when it has no neighbour), and one pixel's term, (1/3) sum_c
+ * var_c / (ref_c^2 + 0.01), var_c the variance of one sample. */
+void iris_race_neighbour_mean(const double *means, int cols, int rows, int x, int y, double ref[3]);
+double iris_race_term(const double var[3], const double ref[3]);
+
 /* Races `mis` (an integrator with method mis) against `guided` (guided-nee,
  * its guide set) on camera `cam`. Without a time cap (time_cap <= 0)
  * deterministic for a given seed and frame, whatever the thread count or the

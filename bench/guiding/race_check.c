@@ -59,22 +59,13 @@ static double relvar(const iris_film *f, const double *both, bool trim) {
   if (!terms) return NAN;
   for (int y = 0; y < h; y++)
     for (int x = 0; x < w; x++) {
-      double ref[3] = {0, 0, 0};
-      int nb = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int xx = x + dx, yy = y + dy;
-          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-          for (int c = 0; c < 3; c++) ref[c] += both[3 * ((size_t)yy * (size_t)w + (size_t)xx) + (size_t)c];
-          nb++;
-        }
+      double ref[3];
+      iris_race_neighbour_mean(both, w, h, x, y, ref);
       iris_vec3 mean, var;
       iris_film_pixel(f, x, y, &mean, &var);
       const double n = f->count[(size_t)y * (size_t)w + (size_t)x];
       const double v[3] = {var.x * n, var.y * n, var.z * n}; /* one sample's variance */
-      double r = 0.0;
-      for (int c = 0; c < 3; c++) r += v[c] / ((ref[c] / nb) * (ref[c] / nb) + 0.01);
-      terms[(size_t)y * (size_t)w + (size_t)x] = r / 3.0;
+      terms[(size_t)y * (size_t)w + (size_t)x] = iris_race_term(v, ref);
     }
   const size_t n = (size_t)w * (size_t)h;
   size_t keep = n;

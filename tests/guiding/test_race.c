@@ -74,28 +74,29 @@ static double long_relvar(const world *w, const iris_integrator *it, int spp) {
   if (!iris_test_render(w->s, &p, &r)) return NAN;
   const int W = r.film.width, H = r.film.height;
   const size_t n = (size_t)W * (size_t)H;
-  double *terms = malloc(n * sizeof *terms);
-  if (!terms) return NAN;
+  double *terms = malloc(n * sizeof *terms), *means = malloc(3 * n * sizeof *means);
+  if (!terms || !means) {
+    free(terms);
+    free(means);
+    return NAN;
+  }
   for (int y = 0; y < H; y++)
     for (int x = 0; x < W; x++) {
-      double ref[3] = {0, 0, 0};
-      int nb = 0;
-      for (int dy = -1; dy <= 1; dy++)
-        for (int dx = -1; dx <= 1; dx++) {
-          int xx = x + dx, yy = y + dy;
-          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
-          iris_vec3 m, v;
-          iris_film_pixel(&r.film, xx, yy, &m, &v);
-          ref[0] += m.x, ref[1] += m.y, ref[2] += m.z;
-          nb++;
-        }
       iris_vec3 m, v;
       iris_film_pixel(&r.film, x, y, &m, &v);
-      const double var[3] = {v.x * spp, v.y * spp, v.z * spp};
-      double t = 0.0;
-      for (int c = 0; c < 3; c++) t += var[c] / ((ref[c] / nb) * (ref[c] / nb) + 0.01);
-      terms[(size_t)y * (size_t)W + (size_t)x] = t / 3.0;
+      double *o = means + 3 * ((size_t)y * (size_t)W + (size_t)x);
+      o[0] = m.x, o[1] = m.y, o[2] = m.z;
     }
+  for (int y = 0; y < H; y++)
+    for (int x = 0; x < W; x++) {
+      double ref[3];
+      iris_race_neighbour_mean(means, W, H, x, y, ref);
+      iris_vec3 m, v;
+      iris_film_pixel(&r.film, x, y, &m, &v);
+      const double var[3] = {v.x * spp, v.y * spp, v.z * spp}; /* one sample's */
+      terms[(size_t)y * (size_t)W + (size_t)x] = iris_race_term(var, ref);
+    }
+  free(means);
   /* the race leaves out its 0.1% largest terms: so does this (insertion of the few largest) */
   const size_t drop = (size_t)(IRIS_RACE_TRIM * (double)n);
   for (size_t k = 0; k < drop; k++) {
