@@ -29,7 +29,7 @@
 #define IRIS_RACE_PIXELS 16384
 #define IRIS_RACE_SPP 4
 #define IRIS_RACE_SPP_MAX 256
-#define IRIS_RACE_PATHS 65536
+#define IRIS_RACE_PATHS 32768
 /* The race runs in rounds of this many paths per pixel (>= 2: each round
  * alone gives a variance); a time cap ends it after the round that reaches
  * it. Under `--time` the cap is IRIS_RACE_BUDGET_SHARE of the budget. */
