@@ -136,6 +136,18 @@ double iris_race_term(const double var[3], const double ref[3]) {
   return r / 3.0;
 }
 
+double iris_race_trimmed_mean(double *terms, size_t n, double *tail_share) {
+  const size_t keep = n - (size_t)(IRIS_RACE_TRIM * (double)n);
+  qsort(terms, n, sizeof *terms, cmp_double);
+  double kept = 0.0, all = 0.0;
+  for (size_t i = 0; i < n; i++) {
+    if (i < keep) kept += terms[i];
+    all += terms[i];
+  }
+  if (tail_share) *tail_share = all > 0.0 ? 1.0 - kept / all : 0.0;
+  return keep > 0 ? kept / (double)keep : 0.0;
+}
+
 static double luminance(const double *v) { return 0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]; }
 
 iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
@@ -163,9 +175,8 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
   counted_guide cg = {guided->guide};
   iris_integrator counted = *guided;
   counted.guide = counting(&cg);
-  const iris_integrator *its[2] = {mis, &counted};
   /* an independent sampler: the race measures the variance of one path */
-  iris_integrator race_its[2] = {*its[0], *its[1]};
+  iris_integrator race_its[2] = {*mis, counted};
   for (int m = 0; m < 2; m++) race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
   /* rounds of IRIS_RACE_ROUND_SPP paths per pixel, the methods in turn, until
    * spp; under a time cap also until the race has used it (after one round) */
@@ -212,7 +223,7 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     const uint64_t px = i / 3, ch = i % 3;
     both[i] = 0.5 * (buf[3 * px + ch] + buf[6 * n + 3 * px + ch]) / k; /* sums of mis, of guided-nee */
   }
-  double rv[2] = {0, 0}, light[2] = {0, 0}, dvar = 0.0;
+  double light[2] = {0, 0}, dvar = 0.0;
   for (uint64_t i = 0; i < n; i++) {
     double ref[3];
     iris_race_neighbour_mean(both, cols, rows, (int)(i % (uint64_t)cols), (int)(i / (uint64_t)cols), ref);
@@ -230,20 +241,10 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     }
   }
   /* as iris bench's relMSE, the 0.1% largest pixel terms left out */
-  const uint64_t keep = n - (uint64_t)(IRIS_RACE_TRIM * (double)n);
-  double all[2] = {0, 0};
-  for (int m = 0; m < 2; m++) {
-    qsort(terms + (uint64_t)m * n, n, sizeof *terms, cmp_double);
-    for (uint64_t i = 0; i < n; i++) {
-      if (i == keep) rv[m] = all[m];
-      all[m] += terms[(uint64_t)m * n + i];
-    }
-    if (keep == n) rv[m] = all[m];
-    out->tail_share[m] = all[m] > 0.0 ? 1.0 - rv[m] / all[m] : 0.0;
-  }
+  for (int m = 0; m < 2; m++)
+    out->relvar[m] = iris_race_trimmed_mean(terms + (uint64_t)m * n, n, &out->tail_share[m]);
   free(both);
   for (int m = 0; m < 2; m++) {
-    out->relvar[m] = rv[m] / (double)keep;
     out->light[m] = light[m] / (double)n;
     out->cost[m] = ((double)out->rays[m] + IRIS_RACE_COST_SHADOW * (double)out->shadow_rays[m] +
                     IRIS_RACE_COST_PREPARE * (double)out->prepares[m] +

@@ -68,6 +68,10 @@ typedef struct iris_race_outcome {
  * var_c / (ref_c^2 + 0.01), var_c the variance of one sample. */
 void iris_race_neighbour_mean(const double *means, int cols, int rows, int x, int y, double ref[3]);
 double iris_race_term(const double var[3], const double ref[3]);
+/* The mean of the n terms after leaving out the IRIS_RACE_TRIM share with the
+ * largest values (sorts `terms`); *tail_share (may be NULL) gets the share of
+ * the sum those held. */
+double iris_race_trimmed_mean(double *terms, size_t n, double *tail_share);
 
 /* Races `mis` (an integrator with method mis) against `guided` (guided-nee,
  * its guide set) on camera `cam`. Without a time cap (time_cap <= 0)

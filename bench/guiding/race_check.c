@@ -45,11 +45,6 @@ static bool render(const iris_scene *s, iris_method m, int w, int h, int spp, in
   return true;
 }
 
-static int cmp_double(const void *a, const void *b) {
-  double x = *(const double *)a, y = *(const double *)b;
-  return x < y ? -1 : x > y;
-}
-
 /* The race's statistic over the whole film, with denominators from `both`;
  * with `trim`, after dropping the 0.1% largest pixel terms, as iris bench's
  * relMSE drops the 0.1% largest errors. */
@@ -68,15 +63,15 @@ static double relvar(const iris_film *f, const double *both, bool trim) {
       terms[(size_t)y * (size_t)w + (size_t)x] = iris_race_term(v, ref);
     }
   const size_t n = (size_t)w * (size_t)h;
-  size_t keep = n;
+  double mean;
   if (trim) {
-    qsort(terms, n, sizeof *terms, cmp_double);
-    keep = n - (size_t)(0.001 * (double)n);
+    mean = iris_race_trimmed_mean(terms, n, NULL);
+  } else {
+    mean = 0.0;
+    for (size_t i = 0; i < n; i++) mean += terms[i] / (double)n;
   }
-  double sum = 0.0;
-  for (size_t i = 0; i < keep; i++) sum += terms[i];
   free(terms);
-  return sum / (double)keep;
+  return mean;
 }
 
 int main(int argc, char **argv) {
