@@ -60,7 +60,7 @@ static inline float iris_avg3(iris_vec3 a) { return (a.x + a.y + a.z) * (1.0f / 
 static inline bool iris_isfinite3(iris_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 static inline float iris_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
 static inline float iris_sqr(float v) { return v * v; }
-static inline float iris_safe_sqrt(float v) { return sqrtf(fmaxf(v, 0.0f)); }
+static inline float iris_safe_sqrt(float v) { return sqrtf(v > 0.0f ? v : 0.0f); } /* NaN -> 0, as fmaxf, without its call */
 
 /* Duff et al. 2017 branchless orthonormal basis around a unit normal. */
 static inline iris_frame iris_frame_from_normal(iris_vec3 n) {

@@ -262,6 +262,60 @@ static uint32_t build_node(builder *B, item *it, size_t n, int depth, uint64_t b
   return index;
 }
 
+/* Lane k of wide node w holds binary node nd, reached by the branches
+ * `path` (bit j: the second child at the j-th step) of `len` steps. */
+static void wide_lane(const iris_light_tree *t, iris_light_tree_wide *w, int k, const iris_light_tree_node *nd,
+                      uint32_t path, uint32_t len) {
+  for (int a = 0; a < 3; a++) {
+    w->lo[a][k] = nd->lo[a];
+    w->hi[a][k] = nd->hi[a];
+    w->w[a][k] = nd->w[a];
+  }
+  w->radius[k] = nd->radius;
+  w->cos_o[k] = nd->cos_o;
+  w->sin_o[k] = nd->sin_o;
+  w->cos_e[k] = nd->cos_e;
+  w->phi[k] = nd->phi;
+  w->phi_r2[k] = nd->phi / fmaxf(nd->radius * nd->radius, FLT_MIN);
+  bool two = nd->flags & IRIS_LIGHT_NODE_TWO_SIDED;
+  w->two_sided[k] = two ? 1.0f : 0.0f;
+  w->one_normal[k] = nd->cos_o >= 1.0f && nd->cos_e >= 0.0f && !two ? 1.0f : 0.0f;
+  w->node[k] = (uint32_t)(nd - t->nodes);
+  w->path[k] = (uint8_t)path;
+  w->len[k] = (uint8_t)len;
+}
+
+/* The lanes under binary node c, reached by `path` of `len` steps: c itself
+ * once it is a leaf or IRIS_LIGHT_WIDE_LEVELS steps down, else its children's. */
+static void wide_gather(const iris_light_tree *t, iris_light_tree_wide *w, uint32_t *lane_node, int *k, uint32_t c,
+                        uint32_t path, uint32_t len) {
+  const iris_light_tree_node *nd = &t->nodes[c];
+  if ((nd->flags & IRIS_LIGHT_NODE_LEAF) || len == IRIS_LIGHT_WIDE_LEVELS) {
+    lane_node[*k] = c;
+    wide_lane(t, w, (*k)++, nd, path, len);
+    return;
+  }
+  wide_gather(t, w, lane_node, k, c + 1, path, len + 1);
+  wide_gather(t, w, lane_node, k, nd->index, path | 1u << len, len + 1);
+}
+
+/* The wide node of binary interior node i (see iris_light_tree_wide),
+ * depth first; returns its index. */
+static uint32_t build_wide(iris_light_tree *t, uint32_t i) {
+  uint32_t at = (uint32_t)t->wide_count++;
+  memset(&t->wide[at], 0, sizeof t->wide[at]);
+  uint32_t lane_node[IRIS_LIGHT_WIDE];
+  int k = 0;
+  wide_gather(t, &t->wide[at], lane_node, &k, i + 1, 0u, 1u);
+  wide_gather(t, &t->wide[at], lane_node, &k, t->nodes[i].index, 1u, 1u);
+  for (int j = 0; j < k; j++) {
+    uint32_t g = lane_node[j];
+    uint32_t child = (t->nodes[g].flags & IRIS_LIGHT_NODE_LEAF) ? IRIS_LIGHT_WIDE_LEAF | g : build_wide(t, g);
+    t->wide[at].child[j] = child;
+  }
+  return at;
+}
+
 static bool bounds_usable(const iris_light_bounds *b) {
   if (!(b->phi > 0.0f) || !isfinite(b->phi)) return false;
   if (b->infinite) return true;
@@ -320,6 +374,15 @@ iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count,
     builder B = {out, 0, 0, leaf_radius};
     build_node(&B, items, f, 0, 0);
     out->node_count = B.next;
+    if (!(out->nodes[0].flags & IRIS_LIGHT_NODE_LEAF)) {
+      out->wide = aligned_alloc(64, sizeof *out->wide * out->node_count);
+      if (!out->wide) {
+        free(items);
+        iris_light_tree_destroy(out);
+        return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for the light tree");
+      }
+      build_wide(out, 0);
+    }
   }
   free(items);
   return IRIS_OK;
@@ -328,6 +391,7 @@ iris_status iris_light_tree_build(const iris_light_bounds *lights, size_t count,
 void iris_light_tree_destroy(iris_light_tree *t) {
   if (!t) return;
   free(t->nodes);
+  free(t->wide);
   free(t->leaf_lights);
   free(t->leaf_cdf);
   free(t->pmf_in_leaf);
@@ -349,38 +413,178 @@ static double infinite_share(const iris_light_tree *t, iris_vec3 p, iris_vec3 n)
   return t->infinite_sum / (t->infinite_sum + root);
 }
 
+/* node_importance for the four lanes of a wide node at once, the same
+ * formula without branches: both the inside and the outside case are
+ * computed and one is kept. SSE where the compiler has it (every x86-64),
+ * else the same arithmetic lane by lane. */
+#if defined(__SSE2__)
+#include <emmintrin.h>
+static inline __m128 sel4(__m128 m, __m128 a, __m128 b) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b)); }
+static inline __m128 sqrt0(__m128 v) { return _mm_sqrt_ps(_mm_max_ps(v, _mm_setzero_ps())); } /* NaN -> 0 */
+static void importance4(const iris_light_tree_wide *w, int o, iris_vec3 p, iris_vec3 n, float *out) {
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), half = _mm_set1_ps(0.5f);
+  const __m128 px = _mm_set1_ps(p.x), py = _mm_set1_ps(p.y), pz = _mm_set1_ps(p.z);
+  const __m128 nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), nz = _mm_set1_ps(n.z);
+  const bool has_n = n.x != 0.0f || n.y != 0.0f || n.z != 0.0f;
+  __m128 lx = _mm_load_ps(w->lo[0] + o), ly = _mm_load_ps(w->lo[1] + o), lz = _mm_load_ps(w->lo[2] + o);
+  __m128 hx = _mm_load_ps(w->hi[0] + o), hy = _mm_load_ps(w->hi[1] + o), hz = _mm_load_ps(w->hi[2] + o);
+  __m128 wx = _mm_load_ps(w->w[0] + o), wy = _mm_load_ps(w->w[1] + o), wz = _mm_load_ps(w->w[2] + o);
+  __m128 phi = _mm_load_ps(w->phi + o), r = _mm_load_ps(w->radius + o), r2 = _mm_mul_ps(r, r);
+  __m128 tx = _mm_sub_ps(px, _mm_mul_ps(half, _mm_add_ps(lx, hx)));
+  __m128 ty = _mm_sub_ps(py, _mm_mul_ps(half, _mm_add_ps(ly, hy)));
+  __m128 tz = _mm_sub_ps(pz, _mm_mul_ps(half, _mm_add_ps(lz, hz)));
+  __m128 dist2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(tx, tx), _mm_mul_ps(ty, ty)), _mm_mul_ps(tz, tz));
+  /* inside the bounding sphere: the box's half-spaces */
+  __m128 front = _mm_add_ps(
+      _mm_add_ps(_mm_mul_ps(wx, _mm_sub_ps(px, sel4(_mm_cmpgt_ps(wx, zero), lx, hx))),
+                 _mm_mul_ps(wy, _mm_sub_ps(py, sel4(_mm_cmpgt_ps(wy, zero), ly, hy)))),
+      _mm_mul_ps(wz, _mm_sub_ps(pz, sel4(_mm_cmpgt_ps(wz, zero), lz, hz))));
+  __m128 in_dead = _mm_and_ps(_mm_cmpgt_ps(_mm_load_ps(w->one_normal + o), zero), _mm_cmple_ps(front, zero));
+  if (has_n) {
+    __m128 above = _mm_add_ps(
+        _mm_add_ps(_mm_mul_ps(nx, _mm_sub_ps(sel4(_mm_cmpgt_ps(nx, zero), hx, lx), px)),
+                   _mm_mul_ps(ny, _mm_sub_ps(sel4(_mm_cmpgt_ps(ny, zero), hy, ly), py))),
+        _mm_mul_ps(nz, _mm_sub_ps(sel4(_mm_cmpgt_ps(nz, zero), hz, lz), pz)));
+    in_dead = _mm_or_ps(in_dead, _mm_cmple_ps(above, zero));
+  }
+  __m128 in_imp = _mm_andnot_ps(in_dead, _mm_load_ps(w->phi_r2 + o));
+  /* outside: the cone bounds */
+  __m128 d2 = _mm_max_ps(dist2, _mm_set1_ps(FLT_MIN));
+  __m128 inv_d = _mm_div_ps(one, _mm_sqrt_ps(d2));
+  __m128 ux = _mm_mul_ps(tx, inv_d), uy = _mm_mul_ps(ty, inv_d), uz = _mm_mul_ps(tz, inv_d);
+  __m128 sin_b = _mm_mul_ps(r, inv_d);
+  __m128 cos_b = sqrt0(_mm_sub_ps(one, _mm_mul_ps(sin_b, sin_b)));
+  __m128 cos_w = _mm_add_ps(_mm_add_ps(_mm_mul_ps(wx, ux), _mm_mul_ps(wy, uy)), _mm_mul_ps(wz, uz));
+  __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+  cos_w = sel4(_mm_cmpgt_ps(_mm_load_ps(w->two_sided + o), zero), _mm_and_ps(cos_w, abs_mask), cos_w);
+  __m128 sin_w = sqrt0(_mm_sub_ps(one, _mm_mul_ps(cos_w, cos_w)));
+  __m128 cos_o = _mm_load_ps(w->cos_o + o), sin_o = _mm_load_ps(w->sin_o + o);
+  __m128 in_cone = _mm_cmpgt_ps(cos_w, cos_o);
+  __m128 cos_x = sel4(in_cone, one, _mm_add_ps(_mm_mul_ps(cos_w, cos_o), _mm_mul_ps(sin_w, sin_o)));
+  __m128 sin_x = sel4(in_cone, zero, _mm_sub_ps(_mm_mul_ps(sin_w, cos_o), _mm_mul_ps(cos_w, sin_o)));
+  __m128 cos_p = sel4(_mm_cmpgt_ps(cos_x, cos_b), one, _mm_add_ps(_mm_mul_ps(cos_x, cos_b), _mm_mul_ps(sin_x, sin_b)));
+  __m128 out_dead = _mm_cmple_ps(cos_p, _mm_load_ps(w->cos_e + o));
+  __m128 out_imp = _mm_mul_ps(_mm_mul_ps(phi, cos_p), _mm_mul_ps(inv_d, inv_d));
+  if (has_n) {
+    __m128 cos_i = _mm_sub_ps(zero, _mm_add_ps(_mm_add_ps(_mm_mul_ps(ux, nx), _mm_mul_ps(uy, ny)), _mm_mul_ps(uz, nz)));
+    __m128 sin_i = sqrt0(_mm_sub_ps(one, _mm_mul_ps(cos_i, cos_i)));
+    __m128 cos_pi =
+        sel4(_mm_cmpgt_ps(cos_i, cos_b), one, _mm_add_ps(_mm_mul_ps(cos_i, cos_b), _mm_mul_ps(sin_i, sin_b)));
+    out_dead = _mm_or_ps(out_dead, _mm_cmple_ps(cos_pi, zero));
+    out_imp = _mm_mul_ps(out_imp, cos_pi);
+  }
+  out_imp = _mm_andnot_ps(out_dead, out_imp);
+  __m128 imp = sel4(_mm_cmpgt_ps(dist2, r2), out_imp, in_imp);
+  /* phi > 0 and imp > 0 (false for NaN), at most FLT_MAX */
+  imp = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(phi, zero), _mm_cmpgt_ps(imp, zero)), _mm_min_ps(imp, _mm_set1_ps(FLT_MAX)));
+  _mm_storeu_ps(out, imp);
+}
+static void wide_importance(const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n, float out[IRIS_LIGHT_WIDE]) {
+  for (int o = 0; o < IRIS_LIGHT_WIDE; o += 4) importance4(w, o, p, n, out + o);
+}
+#else
+static void wide_importance(const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n, float out[IRIS_LIGHT_WIDE]) {
+  const bool has_n = n.x != 0.0f || n.y != 0.0f || n.z != 0.0f;
+  for (int k = 0; k < IRIS_LIGHT_WIDE; k++) {
+    float lx = w->lo[0][k], ly = w->lo[1][k], lz = w->lo[2][k];
+    float hx = w->hi[0][k], hy = w->hi[1][k], hz = w->hi[2][k];
+    float wx = w->w[0][k], wy = w->w[1][k], wz = w->w[2][k];
+    float phi = w->phi[k], r = w->radius[k], r2 = r * r;
+    float tx = p.x - 0.5f * (lx + hx), ty = p.y - 0.5f * (ly + hy), tz = p.z - 0.5f * (lz + hz);
+    float dist2 = tx * tx + ty * ty + tz * tz;
+    float front = wx * (p.x - (wx > 0.0f ? lx : hx)) + wy * (p.y - (wy > 0.0f ? ly : hy)) +
+                  wz * (p.z - (wz > 0.0f ? lz : hz));
+    float above = n.x * ((n.x > 0.0f ? hx : lx) - p.x) + n.y * ((n.y > 0.0f ? hy : ly) - p.y) +
+                  n.z * ((n.z > 0.0f ? hz : lz) - p.z);
+    bool in_dead = (w->one_normal[k] > 0.0f && front <= 0.0f) || (has_n && above <= 0.0f);
+    float in_imp = in_dead ? 0.0f : w->phi_r2[k];
+    float d2 = dist2 > FLT_MIN ? dist2 : FLT_MIN;
+    float inv_d = 1.0f / sqrtf(d2);
+    float ux = tx * inv_d, uy = ty * inv_d, uz = tz * inv_d;
+    float sin_b = r * inv_d, cos_b = iris_safe_sqrt(1.0f - sin_b * sin_b);
+    float cos_w = wx * ux + wy * uy + wz * uz;
+    if (w->two_sided[k] > 0.0f) cos_w = fabsf(cos_w);
+    float sin_w = iris_safe_sqrt(1.0f - cos_w * cos_w);
+    float cos_o = w->cos_o[k], sin_o = w->sin_o[k];
+    bool in_cone = cos_w > cos_o;
+    float cos_x = in_cone ? 1.0f : cos_w * cos_o + sin_w * sin_o;
+    float sin_x = in_cone ? 0.0f : sin_w * cos_o - cos_w * sin_o;
+    float cos_p = cos_x > cos_b ? 1.0f : cos_x * cos_b + sin_x * sin_b;
+    bool out_dead = cos_p <= w->cos_e[k];
+    float out_imp = phi * cos_p * (inv_d * inv_d);
+    if (has_n) {
+      float cos_i = -(ux * n.x + uy * n.y + uz * n.z), sin_i = iris_safe_sqrt(1.0f - cos_i * cos_i);
+      float cos_pi = cos_i > cos_b ? 1.0f : cos_i * cos_b + sin_i * sin_b;
+      out_dead = out_dead || cos_pi <= 0.0f;
+      out_imp *= cos_pi;
+    }
+    float imp = dist2 > r2 ? (out_dead ? 0.0f : out_imp) : in_imp;
+    imp = phi > 0.0f && imp > 0.0f ? imp : 0.0f; /* NaN too */
+    out[k] = imp < FLT_MAX ? imp : FLT_MAX;
+  }
+}
+#endif
+
+float iris_light_tree_node_importance(const iris_light_tree_node *node, iris_vec3 p, iris_vec3 n) {
+  return node_importance(node, p, n);
+}
+
+void iris_light_tree_wide_importance(const iris_light_tree *t, size_t wide, iris_vec3 p, iris_vec3 n,
+                                     float out[IRIS_LIGHT_WIDE]) {
+  wide_importance(&t->wide[wide], p, n, out);
+}
+
 /* THE descent, for sampling (bits == NULL: follows *u, rescaled at each
- * node) and for the pmf (follows the light's path bits): the same calls and
- * arithmetic either way. Returns the leaf reached, or UINT32_MAX when a
- * node on the way has nothing to give; multiplies *pmf by each branch's
- * probability. */
+ * step) and for the pmf (follows the light's path bits): the same calls and
+ * arithmetic either way. Returns the binary leaf reached, or UINT32_MAX when
+ * a step on the way has nothing to give; multiplies *pmf by each branch's
+ * probability (a lane's importance over the lanes' sum). */
 static uint32_t descend(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, double *u, const uint64_t *bits,
                         double *pmf) {
+  if (!t->wide) { /* the root is a leaf */
+    if (!(node_importance(&t->nodes[0], p, n) > 0.0f)) return UINT32_MAX;
+    return 0;
+  }
   uint32_t i = 0;
-  for (int depth = 0;; depth++) {
-    const iris_light_tree_node *nd = &t->nodes[i];
-    if (nd->flags & IRIS_LIGHT_NODE_LEAF) {
-      if (i == 0 && !(node_importance(nd, p, n) > 0.0f)) return UINT32_MAX;
-      return i;
-    }
-    double c0 = node_importance(&t->nodes[i + 1], p, n), c1 = node_importance(&t->nodes[nd->index], p, n);
-    double sum = c0 + c1;
+  for (int depth = 0;;) {
+    const iris_light_tree_wide *w = &t->wide[i];
+    float c[IRIS_LIGHT_WIDE];
+    wide_importance(w, p, n, c);
+    double sum = 0.0;
+    for (int k = 0; k < IRIS_LIGHT_WIDE; k++) sum += c[k];
     if (!(sum > 0.0)) return UINT32_MAX;
     double inv = 1.0 / sum;
-    double p0 = c0 * inv, p1 = c1 * inv;
-    bool second;
+    int take = -1;
     if (bits) {
-      second = depth < 64 && ((*bits >> depth) & 1u);
+      uint32_t next = depth < 64 ? (uint32_t)(*bits >> depth) : 0u; /* the light's next branches */
+      for (int k = 0; k < IRIS_LIGHT_WIDE && take < 0; k++)
+        if (w->phi[k] > 0.0f && (next & ((1u << w->len[k]) - 1u)) == w->path[k]) take = k;
+      if (take < 0) return UINT32_MAX;
     } else {
-      second = !(*u < p0);
-      *u = second ? (*u - p0) / p1 : *u / p0;
+      double below = 0.0;
+      int last = -1;
+      for (int k = 0; k < IRIS_LIGHT_WIDE && take < 0; k++) {
+        double pk = c[k] * inv;
+        if (!(pk > 0.0)) continue;
+        last = k;
+        if (*u < below + pk) take = k;
+        else below += pk;
+      }
+      if (take < 0) { /* rounding: u at the top of the last branch */
+        take = last;
+        below -= c[last] * inv;
+      }
+      *u = (*u - below) / (c[take] * inv);
       if (!(*u < 1.0)) *u = 0x1.fffffffffffffp-1;
       if (!(*u >= 0.0)) *u = 0.0;
     }
-    double pb = second ? p1 : p0;
+    double pb = c[take] * inv;
     if (!(pb > 0.0)) return UINT32_MAX;
     *pmf *= pb;
-    i = second ? nd->index : i + 1;
+    depth += w->len[take];
+    uint32_t child = w->child[take];
+    if (child & IRIS_LIGHT_WIDE_LEAF) return child & ~IRIS_LIGHT_WIDE_LEAF;
+    i = child;
   }
 }
 

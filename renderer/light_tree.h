@@ -47,9 +47,33 @@ typedef struct iris_light_tree_node {
 #define IRIS_LIGHT_NODE_LEAF 1u
 #define IRIS_LIGHT_NODE_TWO_SIDED 2u
 
+/* The descent's view of the binary tree: from each interior node, the nodes
+ * up to IRIS_LIGHT_WIDE_LEVELS levels down (or the leaves above them) side
+ * by side, so one step of the descent takes up to that many binary levels
+ * and weighs up to IRIS_LIGHT_WIDE nodes at once, their bounds in a
+ * structure of arrays so their importances are one vectorised computation.
+ * Lane k's node is reached by the branches path[k] (bit j: the second child
+ * at the j-th level) of len[k] levels; an empty lane has phi 0. */
+#define IRIS_LIGHT_WIDE_LEVELS 2
+#define IRIS_LIGHT_WIDE (1 << IRIS_LIGHT_WIDE_LEVELS)
+typedef struct iris_light_tree_wide {
+  _Alignas(64) float lo[3][IRIS_LIGHT_WIDE], hi[3][IRIS_LIGHT_WIDE], radius[IRIS_LIGHT_WIDE];
+  float w[3][IRIS_LIGHT_WIDE];
+  float cos_o[IRIS_LIGHT_WIDE], sin_o[IRIS_LIGHT_WIDE], cos_e[IRIS_LIGHT_WIDE], phi[IRIS_LIGHT_WIDE];
+  float phi_r2[IRIS_LIGHT_WIDE]; /* the importance inside the bounding sphere, phi / radius^2 */
+  float two_sided[IRIS_LIGHT_WIDE]; /* 1: |cos| to the normals, else 0 */
+  float one_normal[IRIS_LIGHT_WIDE]; /* 1: one-sided emitters of one normal (the box's half-space test) */
+  uint32_t child[IRIS_LIGHT_WIDE]; /* IRIS_LIGHT_WIDE_LEAF | a binary leaf's index, or a wide node's */
+  uint32_t node[IRIS_LIGHT_WIDE];  /* the lane's binary node (for tests and inspection) */
+  uint8_t path[IRIS_LIGHT_WIDE], len[IRIS_LIGHT_WIDE];
+} iris_light_tree_wide;
+#define IRIS_LIGHT_WIDE_LEAF 0x80000000u
+
 typedef struct iris_light_tree {
   iris_light_tree_node *nodes; /* depth first; node 0 is the root (64-byte aligned) */
   size_t node_count;
+  iris_light_tree_wide *wide;  /* what the descent reads; wide[0] is the root's (none when the root is a leaf) */
+  size_t wide_count;
   uint64_t *bits;              /* per light: its leaf's path from the root (bit k: second child at depth k) */
   uint32_t *leaf_lights;       /* the lights of the leaves, leaf by leaf */
   float *leaf_cdf;             /* beside them: cumulative power share within the leaf */
@@ -79,6 +103,11 @@ void iris_light_tree_destroy(iris_light_tree *tree);
  * bound on the receiver's cosine (0 when every light of b is behind n or
  * emits away from p). */
 float iris_light_bounds_importance(const iris_light_bounds *b, iris_vec3 p, iris_vec3 n);
+/* The same importance for a node of the tree, and for the lanes of wide
+ * node `wide` at once (the descent's vectorised form; tests compare the two). */
+float iris_light_tree_node_importance(const iris_light_tree_node *node, iris_vec3 p, iris_vec3 n);
+void iris_light_tree_wide_importance(const iris_light_tree *tree, size_t wide, iris_vec3 p, iris_vec3 n,
+                                     float out[IRIS_LIGHT_WIDE]);
 
 /* Chooses a light at (p, n) with one uniform number u in [0, 1); false when
  * nothing there can receive light. *pmf is the probability of the choice. */

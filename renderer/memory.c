@@ -15,7 +15,7 @@
 #define BUILD_BYTES_PER_TRIANGLE 24.0   /* Embree's transient build arrays at the peak */
 #define COPY_BYTES_PER_VERTEX 12.0      /* iris's padded vertex copy */
 #define BYTES_PER_PLACEMENT 240.0       /* Embree instance + iris placement table + box */
-#define BYTES_PER_EMISSIVE_TRIANGLE 180.0
+#define BYTES_PER_EMISSIVE_TRIANGLE 280.0 /* tables and tree; +100 for the descent's wide nodes (384 B, ~1 per 2 leaves) */
 #define BASE_BYTES 14e6                 /* iris + libraries + Embree's threads */
 #define PATH_BYTES 240.0                /* one photon path: ~4 stored photons and their kd-tree */
 #define CACHE_BYTES 1400.0              /* one 8x8 cache with its tables */

@@ -10,6 +10,8 @@
  *  - zero-power lights are never chosen and have pmf 0; one light; 4096
  *    identical lights at one point; lights behind every receiver; lights
  *    beside infinite ones;
+ *  - the descent's vectorised importance of each wide node's lanes equals
+ *    the scalar importance of their binary nodes;
  *  - the build is deterministic; through iris_lights, the entries' pmfs of a
  *    built-in scene sum to one within the dead ends' share (< 5%);
  *  - renders: mis with the tree and with the power sampler, and nee with the
@@ -190,6 +192,44 @@ static void check_point(const iris_light_tree *t, const iris_light_bounds *l, si
   free(hits);
 }
 
+/* The descent's vectorised importance of every lane of every wide node
+ * equals the scalar importance of the lane's binary node, at the test points
+ * and at random ones (with and without a normal), and the wide nodes cover
+ * the binary tree: every lane is a child or grandchild of its node's origin. */
+static void check_wide(const iris_light_tree *t, int set) {
+  if (!t->wide) return;
+  uint64_t rs = 777 + (uint64_t)set;
+  size_t bad = 0, zero_mismatch = 0, lanes = 0;
+  for (int q = 0; q < 200; q++) {
+    iris_vec3 p, n;
+    if (q < N_POINTS) {
+      make_point(q, &p, &n);
+    } else {
+      p = iris_v3((float)(30 * uniform(&rs) - 15), (float)(30 * uniform(&rs) - 15), (float)(8 * uniform(&rs) - 2));
+      n = iris_normalize(iris_v3((float)(uniform(&rs) - 0.5), (float)(uniform(&rs) - 0.5), (float)(uniform(&rs) - 0.5)));
+    }
+    if (q % 2) n = iris_v3(0, 0, 0);
+    for (size_t wi = 0; wi < t->wide_count; wi++) {
+      float got[IRIS_LIGHT_WIDE];
+      iris_light_tree_wide_importance(t, wi, p, n, got);
+      for (int k = 0; k < IRIS_LIGHT_WIDE; k++) {
+        const iris_light_tree_wide *w = &t->wide[wi];
+        if (!(w->phi[k] > 0.0f)) {
+          bad += got[k] != 0.0f;
+          continue;
+        }
+        lanes++;
+        float want = iris_light_tree_node_importance(&t->nodes[w->node[k]], p, n);
+        if ((want > 0.0f) != (got[k] > 0.0f)) zero_mismatch++;
+        else if (fabsf(want - got[k]) > 1e-5f * fmaxf(want, got[k])) bad++;
+      }
+    }
+  }
+  iris_check_record(bad == 0 && zero_mismatch == 0 && lanes > 0, __FILE__, __LINE__,
+                    "set %d: %zu of %zu wide lanes' importances differ from the node's, %zu only in being 0", set, bad,
+                    lanes, zero_mismatch);
+}
+
 static bool render(const iris_scene *s, iris_method m, iris_light_sampler ls, int threads, int w, int h, int spp,
                    uint64_t seed, iris_render_result *r) {
   return iris_test_render_light(s, m, ls, threads, w, h, spp, seed, NULL, r);
@@ -207,8 +247,11 @@ int main(void) {
       CHECK(t.node_count == t2.node_count &&
             memcmp(t.nodes, t2.nodes, t.node_count * sizeof *t.nodes) == 0 &&
             memcmp(t.bits, t2.bits, n * sizeof *t.bits) == 0);
+      CHECK(t.wide_count == t2.wide_count &&
+            (!t.wide || memcmp(t.wide, t2.wide, t.wide_count * sizeof *t.wide) == 0));
       iris_light_tree_destroy(&t2);
     }
+    check_wide(&t, set);
     for (int k = 0; k < N_POINTS; k++)
       for (int with_n = 0; with_n < 2; with_n++) {
         iris_vec3 p, nrm;
@@ -233,8 +276,8 @@ int main(void) {
 
   /* Through iris_lights on built-in scenes: the entries' pmfs sum to one. */
   {
-    const char *names[2] = {"cornell-box", "veach-mis"};
-    for (int c = 0; c < 2; c++) {
+    const char *names[3] = {"cornell-box", "veach-mis", "office"};
+    for (int c = 0; c < 3; c++) {
       iris_scene *s = NULL;
       iris_error err;
       iris_accel *accel = NULL;
@@ -245,11 +288,12 @@ int main(void) {
       CHECK_OK(iris_accel_build(s, &accel, &err), &err);
       CHECK_OK(iris_lights_build(s, accel, &tex, &lights, &err), &err);
       CHECK_OK(iris_lights_set_sampler(&lights, IRIS_LIGHT_SAMPLER_TREE, &err), &err);
-      CHECK((lights.tree != NULL) == (c == 1)); /* Cornell's light is one leaf: no tree kept */
+      CHECK((lights.tree != NULL) == (c != 0)); /* Cornell's light is one leaf: no tree kept */
       if (lights.tree) {
         size_t leaves = 0;
         for (size_t i = 0; i < lights.tree->node_count; i++) leaves += lights.tree->nodes[i].flags & IRIS_LIGHT_NODE_LEAF;
-        printf("%s: %zu lights, %zu nodes, %zu leaves\n", names[c], lights.count, lights.tree->node_count, leaves);
+        printf("%s: %zu lights, %zu nodes, %zu leaves, %zu wide nodes of %zu bytes\n", names[c], lights.count,
+               lights.tree->node_count, leaves, lights.tree->wide_count, sizeof *lights.tree->wide);
       }
       iris_vec3 refs[3] = {iris_v3(0, 0.5f, 0.5f), iris_v3(0.1f, -0.3f, 1.2f), iris_v3(3, 2, 1)};
       for (int i = 0; i < 3; i++) {
