@@ -38,8 +38,10 @@
 /* The share of the race's pixels with the largest terms left out of its
  * relative variance, as iris bench's relMSE leaves out the largest errors. */
 #define IRIS_RACE_TRIM 0.001
-/* When those pixels hold more than this share of either method's variance,
- * the race cannot measure it and guided-nee (the photon rules' choice) stands. */
+/* When those pixels hold more than this share of either method's variance
+ * and the scene has smooth (delta) lobes, whose light the race sees too
+ * rarely (through glass, off mirrors), the race cannot measure it and
+ * guided-nee (the photon rules' choice) stands. */
 #define IRIS_RACE_TAIL_MAX 0.5
 /* A method whose race image holds this many standard errors less light than
  * the other's loses, whatever its measured variance. */
@@ -57,7 +59,7 @@ typedef struct iris_race_outcome {
   uint64_t paths;      /* per method */
   double tail_share[2]; /* the share of each method's variance in the IRIS_RACE_TRIM pixels left out */
   double speedup;      /* guided-nee's efficiency over mis's (relvar x cost), before the light check */
-  bool unmeasurable;   /* tail_share above IRIS_RACE_TAIL_MAX: the rules' guided-nee stands */
+  bool unmeasurable;   /* tail_share above IRIS_RACE_TAIL_MAX with smooth lobes: the rules' guided-nee stands */
   bool guided;         /* the winner */
 } iris_race_outcome;
 
@@ -72,6 +74,9 @@ double iris_race_term(const double var[3], const double ref[3]);
  * largest values (sorts `terms`); *tail_share (may be NULL) gets the share of
  * the sum those held. */
 double iris_race_trimmed_mean(double *terms, size_t n, double *tail_share);
+/* Whether any material of the scene may have a delta lobe (roughness at or
+ * below IRIS_BSDF_MIN_ROUGHNESS, or a roughness texture that may reach it). */
+bool iris_race_scene_has_smooth_lobes(const iris_scene *scene);
 
 /* Races `mis` (an integrator with method mis) against `guided` (guided-nee,
  * its guide set) on camera `cam`. Without a time cap (time_cap <= 0)
