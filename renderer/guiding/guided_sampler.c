@@ -150,6 +150,9 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
     iris_vec3 wi;
     iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
     if (!iris_guide_vertex_lamp_sample(g, v, (us - v->sky) / v->lamp, u1, u2, &wi)) return false;
+    /* its throughput is small where the cone is dense: the integrator's
+     * roulette must not cut it on its way through the glass */
+    out->aimed = true;
     return guided_finish(g, sp, v, alpha, wi, out);
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
