@@ -11,7 +11,8 @@
  *    the walls learn that more than 10% of their light came straight through
  *    the glass from the bulb, none under --no-lamp-glass, none in door (a
  *    lamp without glass) or sky-room-glazed (the sky through glass is the
- *    sky's), and the shares are the same for 1 and 2 threads. Fails when
+ *    sky's), and the shares are the same for 1 and 2 threads and after a
+ *    guide file. Fails when
  *    photons.c does not flag lamp photons through glass. (A render's own
  *    variance cannot say what the feature gains: without it the bulb's light
  *    through the shade is found so rarely that most pixels' samples miss it,
@@ -20,10 +21,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "check.h"
 #include "chi2.h"
 #include "guide_fixture.h"
+#include "renderer/guiding/guide_file.h"
 #include "renderer/guiding/vertex.h"
 #include "scenes/builtin.h"
 
@@ -134,6 +137,28 @@ typedef struct shares {
   double sum;
 } shares;
 
+/* The guide file keeps the lamps and every cache's slots (version 4). */
+static void check_round_trip(const iris_guiding *g) {
+  char path[256];
+  const char *tmp = getenv("TMPDIR");
+  snprintf(path, sizeof path, "%s/iris_test_lamps_%ld.guide", tmp ? tmp : "/tmp", (long)getpid());
+  iris_error err;
+  iris_error_clear(&err);
+  iris_guiding *l = NULL;
+  if (CHECK(iris_guiding_save(g, path, 1, 2, &err) == IRIS_OK) &&
+      CHECK(iris_guiding_load(path, 1, 2, 1, &l, &err) == IRIS_OK)) {
+    CHECK_EQ_INT((int)l->lamp_count, (int)g->lamp_count);
+    CHECK(l->lamp_count == g->lamp_count && memcmp(l->lamps, g->lamps, sizeof *g->lamps * g->lamp_count) == 0);
+    int differ = l->cache_count != g->cache_count;
+    for (size_t i = 0; !differ && i < g->cache_count; ++i)
+      differ += memcmp(l->caches[i].lamp_share, g->caches[i].lamp_share, sizeof g->caches[i].lamp_share) != 0 ||
+                memcmp(l->caches[i].lamp, g->caches[i].lamp, sizeof g->caches[i].lamp) != 0;
+    iris_check_record(!differ, __FILE__, __LINE__, "lamp-shade's lamp shares differ after the guide file");
+  }
+  iris_guiding_destroy(l);
+  remove(path);
+}
+
 static shares lamp_shares(const char *scene, bool on, int threads, float **out) {
   shares s = {0, 0, 0, 0, 0.0};
   iris_scene *sc = NULL;
@@ -160,6 +185,7 @@ static shares lamp_shares(const char *scene, bool on, int threads, float **out) 
       s.wall += wall;
       s.wall_some += wall && share > 0.1f;
     }
+    if (on && threads == 1 && !strcmp(scene, "lamp-shade")) check_round_trip(g);
     printf("%s (lamp glass %s, %d threads): %d caches, %d with a lamp share (mean %.3f), %d of %d wall caches more "
            "than 10%%\n",
            scene, on ? "on" : "off", threads, s.caches, s.any, s.caches ? s.sum / s.caches : 0.0, s.wall_some, s.wall);
