@@ -12,7 +12,7 @@
  *    the glass from the bulb, none under --no-lamp-glass, none in door (a
  *    lamp without glass) or sky-room-glazed (the sky through glass is the
  *    sky's), and the shares are the same for 1 and 2 threads and after a
- *    guide file. Fails when
+ *    guide file; a guided-nee render of it is the same for 1 and 2 threads. Fails when
  *    photons.c does not flag lamp photons through glass. (A render's own
  *    variance cannot say what the feature gains: without it the bulb's light
  *    through the shade is found so rarely that most pixels' samples miss it,
@@ -26,6 +26,7 @@
 #include "check.h"
 #include "chi2.h"
 #include "guide_fixture.h"
+#include "render_run.h"
 #include "renderer/guiding/guide_file.h"
 #include "renderer/guiding/vertex.h"
 #include "scenes/builtin.h"
@@ -219,9 +220,31 @@ static void test_built(void) {
                     glazed.any);
 }
 
+/* A lamp-shade render with the cones is the same for 1 and 2 threads. */
+static void test_threads(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("lamp-shade", &s, &err) == IRIS_OK)) return;
+  iris_guiding_params gp = iris_guiding_params_default();
+  iris_vec3 *px[2] = {malloc(sizeof(iris_vec3) * 32 * 24), malloc(sizeof(iris_vec3) * 32 * 24)};
+  bool ok = px[0] && px[1];
+  for (int t = 0; ok && t < 2; t++) {
+    iris_render_params p = iris_test_params(32, 24, 8, IRIS_METHOD_GUIDED_NEE, 4);
+    p.threads = t + 1;
+    iris_test_attach_guide(&p, &gp);
+    ok = CHECK(iris_test_render_pixels(s, &p, px[t]));
+  }
+  if (ok) iris_check_record(memcmp(px[0], px[1], sizeof(iris_vec3) * 32 * 24) == 0, __FILE__, __LINE__,
+                            "lamp-shade: guided-nee differs between 1 and 2 threads");
+  free(px[0]);
+  free(px[1]);
+  iris_scene_destroy(s);
+}
+
 int main(void) {
   test_cones();
   test_mixture();
   test_built();
+  test_threads();
   return iris_check_summary("guiding.lamps");
 }
