@@ -431,6 +431,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   const bool adjoint_rr = iris_method_uses_guiding(it->method) && it->guide.radiance_estimate;
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
   bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
+  bool aimed = false;     /* the last non-delta vertex aimed at a lamp (iris_direction_sample) */
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o, prev_n = iris_v3(0, 0, 0);
   stats->paths++;
@@ -490,8 +491,10 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, stats)));
 
     iris_direction_sample ds;
+    memset(&ds, 0, sizeof ds);
     if (!iris_integrator_sample_direction(it, &sp, rng, &ds)) break;
     if (!direction_allowed(&sp, ds.wi)) break;
+    if (!sp.delta) aimed = ds.aimed; /* kept through the glass to the next non-delta vertex */
     float cos_i = fabsf(iris_dot(ds.wi, sp.si.ns));
     const iris_vec3 beta_before = beta;
     beta = iris_mul(beta, iris_scale(ds.f, cos_i / ds.pdf));
@@ -532,7 +535,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     float est = adjoint_rr ? it->guide.radiance_estimate(it->guide.ctx, &sp) : -1.0f;
     if (est >= 0.0f && !(pixel_estimate > 0.0f))
       pixel_estimate = iris_avg3(L) + iris_avg3(beta_before) * est;
-    if (bounce + 1 >= it->rr_depth) {
+    if (bounce + 1 >= it->rr_depth && !aimed) {
       float q = fminf(1.0f, sqrtf(iris_max3(beta)));
       if (est >= 0.0f && pixel_estimate > 0.0f)
         q = iris_clampf(RR_WINDOW * iris_max3(beta_before) * est / pixel_estimate, 0.1f * q, 1.0f);

@@ -106,6 +106,10 @@ typedef struct iris_direction_sample {
                          discrete probability */
   uint32_t lobe;      /* IRIS_LOBE_* of the sample */
   bool delta;
+  bool aimed;         /* drawn toward a lamp light sampling cannot reach (guiding's lamps
+                         behind glass): its throughput is small because its density is
+                         high, so Russian roulette waits for the next non-delta vertex
+                         (docs/guiding.md, "Lamps behind glass"); false unless set */
 } iris_direction_sample;
 
 /* Pluggable direction sampler (the guiding module provides one). `sample`

@@ -194,6 +194,8 @@ static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
     memcpy(&bits, &v[i], sizeof bits);
     h = iris_mix64(h ^ (bits + 0x9e3779b97f4a7c15ULL));
   }
+  /* lamps behind glass off: renders with it on keep the hash they had before it */
+  if (!gp->lamp_glass) h = iris_mix64(h ^ 0x1a3b91a55ULL);
   return h;
 }
 

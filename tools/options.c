@@ -132,6 +132,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("no-learn-alpha", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, learn_alpha,
         "keep alpha = min(roughness, --alpha-max) instead of learning\n"
         "each cache's selection probability in training"),
+    OPT("no-lamp-glass", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, lamp_glass,
+        "do not aim guided directions at lamps whose light reaches\n"
+        "a surface straight through glass (lamps behind glass)"),
     OPT("force-guiding", 0, IRIS_OPT_FLAG, NULL, 0, 0, iris_guiding_params, force,
         "build caches even where guiding would be skipped"),
     OPT("guide-out", 0, IRIS_OPT_STRING, "FILE", 0, 0, iris_guiding_params, guide_out,

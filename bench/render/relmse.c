@@ -2,8 +2,18 @@
  * of pixel errors dropped) of one EXR against a reference EXR, channels taken
  * by name (R, G, B). Usage: relmse IMAGE.exr REFERENCE.exr
  *                           relmse --own IMAGE.exr   (from its var.R/G/B)
+ *                           relmse --expected IMAGE.exr REFERENCE.exr
+ *   (the expected relMSE of IMAGE against the true image: the mean over
+ *   pixels and channels of its var.R/G/B / (REF^2 + eps), nothing dropped;
+ *   for scenes whose references are too noisy to measure against,
+ *   docs/guiding.md "Sky behind glass")
+ *                           relmse --raw IMAGE.exr OUT.f32
+ *   (writes width, height as two int32 and then per pixel R, G, B, var.R,
+ *   var.G, var.B as float32, the variances 0 when absent: for numpy)
  * Prints the relMSE; exit 2 on unreadable or mismatched images. Used by
  * bench/render/equal_spp.sh to compare iris and Cycles at equal spp. */
+#include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -54,6 +64,62 @@ int main(int argc, char **argv) {
       return 2;
     }
     printf("%.6g\n", own);
+    return 0;
+  }
+  if (argc == 4 && strcmp(argv[1], "--raw") == 0) {
+    iris_image img;
+    iris_error err;
+    iris_error_clear(&err);
+    if (iris_exr_read(argv[2], &img, NULL, NULL, &err) != IRIS_OK) {
+      fprintf(stderr, "relmse: %s: %s\n", argv[2], err.message);
+      return 2;
+    }
+    static const char *const names[6] = {"R", "G", "B", "var.R", "var.G", "var.B"};
+    int ch[6];
+    for (int c = 0; c < 6; c++) ch[c] = iris_image_channel(&img, names[c]);
+    FILE *f = fopen(argv[3], "wb");
+    if (!f || ch[0] < 0 || ch[1] < 0 || ch[2] < 0) {
+      fprintf(stderr, "relmse: cannot write %s or %s has no R, G, B\n", argv[3], argv[2]);
+      if (f) fclose(f);
+      iris_image_destroy(&img);
+      return 2;
+    }
+    int32_t wh[2] = {img.width, img.height};
+    fwrite(wh, sizeof wh, 1, f);
+    for (size_t i = 0; i < (size_t)img.width * (size_t)img.height; i++)
+      for (int c = 0; c < 6; c++) {
+        float v = ch[c] < 0 ? 0.0f : img.data[i * (size_t)img.channel_count + (size_t)ch[c]];
+        fwrite(&v, sizeof v, 1, f);
+      }
+    iris_image_destroy(&img);
+    return fclose(f) == 0 ? 0 : 2;
+  }
+  if (argc == 4 && strcmp(argv[1], "--expected") == 0) {
+    iris_image img, r;
+    iris_error err;
+    iris_error_clear(&err);
+    if (iris_exr_read(argv[2], &img, NULL, NULL, &err) != IRIS_OK) {
+      fprintf(stderr, "relmse: %s: %s\n", argv[2], err.message);
+      return 2;
+    }
+    if (!load_rgb(argv[3], &r)) return 2;
+    static const char *const vnames[3] = {"var.R", "var.G", "var.B"};
+    int v0[3];
+    for (int c = 0; c < 3; c++) v0[c] = iris_image_channel(&img, vnames[c]);
+    if (v0[0] < 0 || v0[1] < 0 || v0[2] < 0 || img.width != r.width || img.height != r.height) {
+      fprintf(stderr, "relmse: %s has no var.R/G/B channels or another size than %s\n", argv[2], argv[3]);
+      return 2;
+    }
+    size_t n = (size_t)img.width * (size_t)img.height;
+    double sum = 0.0;
+    for (size_t i = 0; i < n; i++)
+      for (int c = 0; c < 3; c++) {
+        double ref = r.data[3 * i + (size_t)c], v = img.data[i * (size_t)img.channel_count + (size_t)v0[c]];
+        if (isfinite(v) && v > 0.0) sum += v / (ref * ref + IRIS_METRIC_EPS) / 3.0;
+      }
+    printf("%.6g\n", n ? sum / (double)n : -1.0);
+    iris_image_destroy(&img);
+    iris_image_destroy(&r);
     return 0;
   }
   if (argc != 3) {

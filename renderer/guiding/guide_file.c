@@ -15,7 +15,7 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES 70u      /* one cache record */
+#define CACHE_BYTES (70u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
@@ -181,6 +181,11 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
   put_f32(&w, grid ? 2.0f * g->grid.cell : 0.0f);
   for (int a = 0; a < 3; ++a) put_i32(&w, grid ? g->grid.n[a] : 0);
   for (int a = 0; a < 3; ++a) put_f32(&w, grid ? g->grid.lo[a] : 0.0f);
+  put_u32(&w, (uint32_t)g->lamp_count); /* the spheres the caches' lamp shares name */
+  for (size_t i = 0; i < g->lamp_count; ++i) {
+    put_vec3(&w, g->lamps[i].center);
+    put_f32(&w, g->lamps[i].radius);
+  }
   put_u64(&w, (uint64_t)count);
   put_u64(&w, texels);
   /* Caches, with table offsets into the compacted tables (the in-memory
@@ -199,6 +204,10 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     put_u8(&w, c->sphere);
     put_u8(&w, c->from_camera);
     put_f32(&w, c->sky_through);
+    for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) {
+      put_f32(&w, c->lamp_share[k]);
+      put_u8(&w, c->lamp[k]);
+    }
     at += texels_of(g, c);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -390,6 +399,20 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
   *spacing = get_f32(r);
   for (int a = 0; a < 3; ++a) grid_n[a] = get_i32(r);
   for (int a = 0; a < 3; ++a) grid_lo[a] = get_f32(r);
+  uint32_t lamps = get_u32(r);
+  if (r->short_read) return refuse(err, path, "guide file is truncated");
+  if (lamps > IRIS_GUIDING_LAMP_GROUPS) return refuse(err, path, "guide file has too many lamps (corrupted)");
+  if (lamps) {
+    g->lamps = calloc(lamps, sizeof *g->lamps);
+    if (!g->lamps) return iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory for lamps");
+    g->lamp_count = lamps;
+  }
+  for (uint32_t i = 0; i < lamps; ++i) {
+    g->lamps[i].center = get_vec3(r);
+    g->lamps[i].radius = get_f32(r);
+    if (!finite3(g->lamps[i].center) || !(g->lamps[i].radius >= 0.0f && isfinite(g->lamps[i].radius)))
+      return refuse(err, path, "guide file has an invalid lamp (corrupted)");
+  }
   uint64_t count = get_u64(r), texels = get_u64(r);
   if (r->short_read) return refuse(err, path, "guide file is truncated");
   if (res != (uint32_t)g->params.cache_res)
@@ -441,11 +464,25 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     c->sphere = sph;
     c->from_camera = cam;
     c->sky_through = get_f32(r);
+    float through = c->sky_through;
+    bool lamps_ok = true;
+    for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) {
+      c->lamp_share[k] = get_f32(r);
+      c->lamp[k] = get_u8(r);
+      /* a share names a lamp with a sphere; slots after an empty one are empty */
+      if (!(c->lamp_share[k] >= 0.0f && c->lamp_share[k] <= 1.0f) ||
+          (c->lamp_share[k] > 0.0f && (c->lamp[k] >= lamps || !(g->lamps[c->lamp[k]].radius > 0.0f) ||
+                                       (k > 0 && !(c->lamp_share[k - 1] > 0.0f)))))
+        lamps_ok = false;
+      through += c->lamp_share[k];
+    }
     if (!finite3(c->p) || !finite3(c->frame.s) || !finite3(c->frame.t) || !finite3(c->frame.n))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: position or frame is not finite (corrupted)", i);
     if (sph > 1 || cam > 1 || c->photons == 0 || !isfinite(c->radiance) || c->radiance < 0.0f ||
         !isfinite(c->alpha) || c->alpha > 1.0f || !(c->sky_through >= 0.0f && c->sky_through <= 1.0f))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid values (corrupted)", i);
+    if (!lamps_ok || !(through <= 1.001f)) /* the shares are of the same photons' energy */
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid lamp shares (corrupted)", i);
     /* Tables are stored back to back in cache order: exactly one offset is right. */
     uint32_t n = sph ? sphere : hemi;
     if ((uint64_t)c->table != at || at + n > texels)
@@ -656,5 +693,7 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_u64(h, (uint64_t)(int64_t)p->sky_probes);
   h = mix_f32(h, p->sky_beta);
   h = mix_u64(h, (uint64_t)(int64_t)p->refine);
+  /* lamps behind glass: keeps the hash of guides without lamp light through glass */
+  if (!p->lamp_glass) h = mix_u64(h, 0x1a3b91a55ULL);
   return h;
 }

@@ -57,15 +57,18 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   if (v->m == 0) v->alpha = 0.0f;
   v->radiance = -1.0f;
   v->sky = 0.0f;
+  v->lamp = 0.0f;
+  v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
      * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
-    float r = 0.0f, a = 0.0f, sky = 0.0f;
+    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f;
     int learned = 0;
     for (int i = 0; i < v->m; ++i) {
       const iris_cache *c = &g->caches[v->ids[i]];
       r += c->radiance;
       sky += c->sky_through;
+      for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) lamp += c->lamp_share[k];
       if (c->alpha >= 0.0f) a += c->alpha, learned++;
     }
     v->radiance = r / (float)v->m;
@@ -73,6 +76,10 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
      * straight through glass from the map, which the map's own density finds
      * (the sun within its texels) and light sampling cannot reach. */
     v->sky = g->env ? sky / (float)v->m : 0.0f;
+    /* Lamps behind glass: the same for light that came straight through
+     * glass from a lamp, which the lamp's cone finds; one mixture with the
+     * sky's (the shares are of the same photons: they sum to at most 1). */
+    v->lamp = fminf(lamp / (float)v->m, 1.0f - v->sky);
     if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
   }
   /* The pdf tables of the tied caches are needed after this vertex's shadow
@@ -136,6 +143,16 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
     iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
     iris_vec3 wi;
     if (!iris_envmap_sample(g->env, u1, u2, &wi, &pdf_map, NULL)) return false;
+    return guided_finish(g, sp, v, alpha, wi, out);
+  }
+  if (us < v->sky + v->lamp) { /* lamps behind glass: a lamp's cone */
+    float u1, u2;
+    iris_vec3 wi;
+    iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
+    if (!iris_guide_vertex_lamp_sample(g, v, (us - v->sky) / v->lamp, u1, u2, &wi)) return false;
+    /* its throughput is small where the cone is dense: the integrator's
+     * roulette must not cut it on its way through the glass */
+    out->aimed = true;
     return guided_finish(g, sp, v, alpha, wi, out);
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */

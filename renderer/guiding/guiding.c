@@ -41,6 +41,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.sky_probes = -1;
   p.sky_beta = -1.0f;
   p.refine = -1;
+  p.lamp_glass = true;
   return p;
 }
 
@@ -234,6 +235,7 @@ static uint32_t select_groups(const normal_cone *cones, iris_vec3 n, uint32_t *o
 
 typedef struct fill_ctx {
   iris_guiding *g;
+  const iris_lights *lights;
   const iris_photon_map *photons;
   const iris_kdtree *photon_tree;
   const normal_cone *cones; /* NORMAL_GROUPS */
@@ -269,6 +271,44 @@ static bool photon_usable(void *ctx, const void *payload) {
   return f->sphere || iris_dot(ph.wi, f->n) > 0.0f;
 }
 
+/* A cache's photon energy that came straight through glass from each lamp
+ * (emitter group; "Lamps behind glass"), in the order the groups were met. */
+typedef struct lamp_sums {
+  bool on;
+  uint32_t n;
+  uint32_t group[IRIS_GUIDING_LAMP_GROUPS];
+  double energy[IRIS_GUIDING_LAMP_GROUPS];
+} lamp_sums;
+
+static void lamp_add(lamp_sums *l, const iris_guiding *g, uint32_t group, float energy) {
+  if (group >= g->lamp_count || !(g->lamps[group].radius > 0.0f)) return; /* no sphere to aim at */
+  uint32_t i = 0;
+  while (i < l->n && l->group[i] != group) ++i;
+  if (i == l->n) l->group[l->n++] = group, l->energy[i] = 0.0;
+  l->energy[i] += energy;
+}
+
+/* The brightest IRIS_CACHE_LAMPS groups' shares of the cache's photon
+ * energy (ties to the lower group: the same for any photon order). */
+static void lamp_shares(const lamp_sums *l, double power, iris_cache *cache) {
+  bool taken[IRIS_GUIDING_LAMP_GROUPS] = {false};
+  for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) {
+    cache->lamp_share[k] = 0.0f;
+    cache->lamp[k] = 0;
+    int best = -1;
+    for (uint32_t i = 0; i < l->n; ++i) {
+      if (taken[i]) continue;
+      if (best < 0 || l->energy[i] > l->energy[best] ||
+          (l->energy[i] == l->energy[best] && l->group[i] < l->group[best]))
+        best = (int)i;
+    }
+    if (best < 0 || !(power > 0.0)) continue;
+    taken[best] = true;
+    cache->lamp_share[k] = (float)(l->energy[best] / power);
+    cache->lamp[k] = (uint8_t)l->group[best];
+  }
+}
+
 static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   fill_ctx *c = ctx;
   iris_guiding *g = c->g;
@@ -284,6 +324,9 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     float *sq = fine ? fine + IRIS_REFINE_SUB * g->sphere.texel_count : NULL;
     if (fine) memset(fine, 0, sizeof(float) * (IRIS_REFINE_SUB + 1) * g->sphere.texel_count);
     photon_filter f = {cache->frame.n, cache->sphere != 0};
+    lamp_sums lamps;
+    lamps.on = g->params.lamp_glass && g->lamp_count > 0;
+    lamps.n = 0;
     uint32_t *slots = ids + c->k;
     uint32_t groups[NORMAL_GROUPS];
     uint32_t ng = select_groups(c->cones, cache->frame.n, groups);
@@ -301,9 +344,12 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       used += u;
       if (u) power += ph.energy;
       if (u && c->photons->photons[ids[j]].sky_through) through += ph.energy;
+      if (u && lamps.on && c->photons->photons[ids[j]].lamp_through)
+        lamp_add(&lamps, g, c->lights->entries[c->photons->photons[ids[j]].light].group, ph.energy);
     }
     cache->photons = used;
     cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
+    lamp_shares(&lamps, power, cache);
     /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
      * sum of powers / (paths * pi r_k^2); radiance of a white diffuse surface =
      * irradiance / pi. The photons cover the disc to the k-th nearest. */
@@ -674,7 +720,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
                                  err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
-  fill_ctx fc = {g, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL, NULL};
+  fill_ctx fc = {g, s->lights, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL, NULL};
   if (st == IRIS_OK) {
     fc.hist = calloc((size_t)threads, sizeof(float *));
     fc.ids = calloc((size_t)threads, sizeof(uint32_t *));
@@ -750,8 +796,23 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   return st;
 }
 
+/* The emitter groups' bounding spheres, which the caches' lamp shares name
+ * ("Lamps behind glass"): triangle groups only (a point light cannot be hit). */
+static iris_status copy_lamps(iris_guiding *g, const iris_lights *L, iris_error *err) {
+  size_t n = L->group_count < IRIS_GUIDING_LAMP_GROUPS ? L->group_count : IRIS_GUIDING_LAMP_GROUPS;
+  if (n == 0 || !g->params.lamp_glass) return IRIS_OK;
+  g->lamps = calloc(n, sizeof *g->lamps);
+  if (!g->lamps) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for lamps");
+  g->lamp_count = n;
+  for (size_t i = 0; i < n; ++i)
+    if (L->groups[i].kind == IRIS_LIGHT_KIND_TRIANGLE && L->groups[i].radius > 0.0f)
+      g->lamps[i] = (iris_guide_lamp){L->groups[i].center, L->groups[i].radius};
+  return IRIS_OK;
+}
+
 iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding_params *params,
                                iris_guiding **out, iris_error *err) {
+  iris_status st0;
   *out = NULL;
   double t0 = iris_time_now();
   iris_guiding *g = calloc(1, sizeof *g);
@@ -772,6 +833,11 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   g->stats.pdf_floor = g->params.pdf_floor;
   g->stats.pilot_share = g->stats.indirect_share = g->stats.seen_indirect_energy = -1.0;
   g->env = setup->lights->envmap; /* training samples the sky behind glass */
+  st0 = copy_lamps(g, setup->lights, err);
+  if (st0 != IRIS_OK) {
+    iris_guiding_destroy(g);
+    return st0;
+  }
   iris_status st = iris_octmap_create(&g->hemi, g->params.cache_res, false, err);
   if (st == IRIS_OK) st = iris_octmap_create(&g->sphere, g->params.cache_res, true, err);
   if (st == IRIS_OK) {
@@ -817,5 +883,6 @@ void iris_guiding_destroy(iris_guiding *g) {
   free(g->photon_hist);
   free(g->refine_slot);
   free(g->refine_sub);
+  free(g->lamps);
   free(g);
 }

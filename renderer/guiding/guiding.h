@@ -14,6 +14,7 @@
 #include "core/error.h"
 #include "renderer/guiding/cache.h"
 #include "renderer/guiding/kdtree.h"
+#include "renderer/guiding/lamps.h"
 #include "renderer/guiding/light_select.h"
 #include "renderer/guiding/octmap.h"
 #include "renderer/guiding/refine.h"
@@ -30,6 +31,8 @@ extern "C" {
 #define IRIS_GUIDING_PICK_K 5 /* Algorithm 1: the 5 nearest caches */
 /* Photons whose normal has a smaller cosine with the cache's are not splatted. */
 #define IRIS_GUIDING_PHOTON_NORMAL_COS 0.5f
+/* Emitter groups the guide keeps a sphere of (iris_cache.lamp is a byte). */
+#define IRIS_GUIDING_LAMP_GROUPS 64
 
 /* Where caches lie on the film (`iris render --aov caches`). */
 typedef struct iris_guiding_marks {
@@ -74,6 +77,9 @@ typedef struct iris_guiding_params {
   float sky_beta;       /* probability of a cache's regions (--sky-beta; 0: off) */
   int refine;           /* most texels per cache refined into 4 x 4 sub-cells where the light is
                            concentrated (--refine; -1 auto: 0 (measured), 0 off; refine.h) */
+  bool lamp_glass;      /* lamps behind glass: caches learn which emitter groups' light reached
+                           them straight through glass, and the guide draws directions in
+                           those groups' cones (default on; --no-lamp-glass; lamps.h) */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):
@@ -113,6 +119,10 @@ typedef struct iris_cache {
   float sky_through; /* share of its photons' energy that came from the environment
                         straight through glass (photons.h): the probability with which
                         its guided samples follow the map instead ("Sky behind glass") */
+  float lamp_share[IRIS_CACHE_LAMPS]; /* the same for lamps: shares of its photons' energy that
+                        came straight through glass from emitter group lamp[i] (brightest
+                        first, 0: unused), drawn in that group's cone ("Lamps behind glass") */
+  uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
 } iris_cache;
@@ -157,6 +167,9 @@ typedef struct iris_guiding {
   const iris_envmap *env; /* the lights' map, sampled for caches with sky_through > 0: borrowed,
                              set by the build for training and by the provider for rendering
                              (NULL: none, and guided sampling ignores sky_through) */
+  iris_guide_lamp *lamps;  /* the lights' groups' bounding spheres, by group index (owned; copied
+                              at the build, stored in the guide file): what iris_cache.lamp names */
+  size_t lamp_count;
   iris_light_select lights; /* learned light selection (setup->learn_lights; light_select.h) */
   iris_guiding_stats stats;
 } iris_guiding;

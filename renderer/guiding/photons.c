@@ -84,6 +84,9 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
    * travels along its emission direction having passed only delta vertices
    * (SKY_THROUGH_COS: a flat slab's faces are parallel). */
   bool specular_only = s->lights->envmap && s->lights->environment >= 0 && e.light == (uint32_t)s->lights->environment;
+  /* The same for a lamp (an emissive triangle): from a wall behind a glass
+   * shade, the bulb is where it would be without the glass ("Lamps behind glass"). */
+  bool lamp_only = s->lights->entries[e.light].kind == IRIS_LIGHT_KIND_TRIANGLE;
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -104,9 +107,11 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.bounce = (uint8_t)(bounce > 255 ? 255 : bounce);
       ph.transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
       ph.light = e.light;
-      ph.sky_through = specular_only && bounce > 0 && iris_dot(wo, e.dir) < -SKY_THROUGH_COS;
+      const bool straight = bounce > 0 && iris_dot(wo, e.dir) < -SKY_THROUGH_COS;
+      ph.sky_through = specular_only && straight;
+      ph.lamp_through = lamp_only && straight;
       block_push(out, &ph);
-      specular_only = false;
+      specular_only = lamp_only = false;
     }
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;

@@ -34,6 +34,8 @@ typedef struct iris_photon {
                           arriving along its emission direction (through a flat glass slab):
                           light that sampling the map as a direction finds and light
                           sampling cannot (docs/guiding.md, "Sky behind glass") */
+  uint8_t lamp_through; /* the same for a photon of an emissive triangle (a lamp): the lamp's
+                           cone from the surface finds that light ("Lamps behind glass") */
   uint32_t light;   /* the light entry it left (iris_lights; learned light selection) */
 } iris_photon;
 

@@ -39,6 +39,19 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     snprintf(sky + l, sizeof sky - l, "; sky behind glass: %zu caches (mean share %.2f)", through,
              tsum / (double)through);
   }
+  /* caches that aim at lamps behind glass ("Lamps behind glass") */
+  double lsum = 0.0;
+  size_t lamps = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    float share = 0.0f;
+    for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) share += g->caches[i].lamp_share[k];
+    if (share > 0.0f) lsum += share, lamps++;
+  }
+  if (lamps) {
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; lamps behind glass: %zu caches (mean share %.2f)", lamps,
+             lsum / (double)lamps);
+  }
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "

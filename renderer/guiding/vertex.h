@@ -17,7 +17,9 @@ typedef struct iris_guide_vertex_state {
   float alpha;                          /* cache-sampling probability; 0: BSDF only */
   float radiance;                       /* tied caches' mean radiance estimate; < 0 none */
   float sky;                            /* of the guide's share alpha, the map's (sky behind glass) */
+  float lamp;                           /* ... and the lamps' cones' (lamps behind glass) */
   int32_t m;                            /* tied caches */
+  iris_vec3 p;                          /* the shading point (the lamps' cones are seen from it) */
   uint32_t ids[IRIS_GUIDING_PICK_K];
   uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
 } iris_guide_vertex_state;
@@ -53,13 +55,62 @@ static inline float iris_guide_vertex_cache_pdf(const iris_guiding *g, const iri
   return v->m > 0 ? sum / (float)v->m : 0.0f;
 }
 
+/* Density of the lamps' component ("Lamps behind glass"): every tied cache's
+ * lamp slots, chosen in proportion to their shares, each uniform in its
+ * sphere's cone from the vertex: sum_k w_k [wi in cone_k] / (2 pi (1 - cos_k)) / sum_k w_k. */
+static inline float iris_guide_vertex_lamp_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
+                                               iris_vec3 wi) {
+  float sum = 0.0f, total = 0.0f;
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *c = &g->caches[v->ids[i]];
+    for (int k = 0; k < IRIS_CACHE_LAMPS && c->lamp_share[k] > 0.0f; ++k) {
+      const iris_guide_lamp *l = &g->lamps[c->lamp[k]];
+      total += c->lamp_share[k];
+      if (!iris_lamp_contains(l, v->p, wi)) continue;
+      iris_lamp_cone cone = iris_lamp_cone_at(l, v->p);
+      sum += c->lamp_share[k] * iris_lamp_cone_pdf(&cone);
+    }
+  }
+  return total > 0.0f ? sum / total : 0.0f;
+}
+
+/* Samples iris_guide_vertex_lamp_pdf: a tied cache's lamp slot in
+ * proportion to its share (u in [0, 1)), then a direction uniformly in that
+ * lamp's cone (u1, u2). False when no tied cache has a lamp share. */
+static inline bool iris_guide_vertex_lamp_sample(const iris_guiding *g, const iris_guide_vertex_state *v, float u,
+                                                 float u1, float u2, iris_vec3 *wi) {
+  float total = 0.0f;
+  for (int i = 0; i < v->m; ++i) {
+    const iris_cache *c = &g->caches[v->ids[i]];
+    for (int k = 0; k < IRIS_CACHE_LAMPS && c->lamp_share[k] > 0.0f; ++k) total += c->lamp_share[k];
+  }
+  const iris_guide_lamp *chosen = NULL;
+  float target = u * total, acc = 0.0f;
+  for (int i = 0; i < v->m && !(chosen && acc > target); ++i) {
+    const iris_cache *c = &g->caches[v->ids[i]];
+    for (int k = 0; k < IRIS_CACHE_LAMPS && c->lamp_share[k] > 0.0f; ++k) {
+      chosen = &g->lamps[c->lamp[k]]; /* the last one with a share when rounding runs past the end */
+      acc += c->lamp_share[k];
+      if (acc > target) break;
+    }
+  }
+  if (!chosen) return false;
+  iris_lamp_cone cone = iris_lamp_cone_at(chosen, v->p);
+  *wi = iris_lamp_cone_sample(&cone, u1, u2);
+  return true;
+}
+
 /* Density of the guide's strategy: the tied caches', mixed with the map's
- * where sky light arrives through glass (docs/guiding.md, "Sky behind glass"). */
+ * where sky light arrives through glass (docs/guiding.md, "Sky behind glass")
+ * and with the lamps' cones where lamp light does ("Lamps behind glass"). */
 static inline float iris_guide_vertex_guide_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
                                                 iris_vec3 wi) {
   float pc = iris_guide_vertex_cache_pdf(g, v, wi);
-  if (!(v->sky > 0.0f)) return pc;
-  return (1.0f - v->sky) * pc + v->sky * iris_envmap_pdf(g->env, wi);
+  if (!(v->sky > 0.0f) && !(v->lamp > 0.0f)) return pc;
+  float d = (1.0f - v->sky - v->lamp) * pc;
+  if (v->sky > 0.0f) d += v->sky * iris_envmap_pdf(g->env, wi);
+  if (v->lamp > 0.0f) d += v->lamp * iris_guide_vertex_lamp_pdf(g, v, wi);
+  return d;
 }
 
 #endif

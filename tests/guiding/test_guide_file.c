@@ -27,6 +27,7 @@
 
 #define SCENE_HASH 0x1234567890abcdefULL
 #define SETTINGS_HASH 0xfedcba0987654321ULL
+#define CB (70 + 5 * IRIS_CACHE_LAMPS) /* bytes of one cache record */
 
 static iris_guiding *build(const char *name, iris_method method, int64_t photons, bool force) {
   iris_scene *s = NULL;
@@ -233,7 +234,7 @@ static void refusals(const char *dir, iris_guiding *g) {
   iris_check_record(bad == 0, __FILE__, __LINE__, "%d of %d files with a flipped byte loaded", bad, tries);
   memcpy(c, d, n);
   put32(c + 8, IRIS_GUIDE_FILE_VERSION + 1);
-  CHECK(refused(dir, c, n, IRIS_GUIDE_FILE_VERSION == 3 ? "version 4" : "version"));
+  CHECK(refused(dir, c, n, IRIS_GUIDE_FILE_VERSION == 4 ? "version 5" : "version"));
   memcpy(c, d, n);
   memset(c + n, 0, 16);
   reseal(c, n + 16);
@@ -244,7 +245,7 @@ static void refusals(const char *dir, iris_guiding *g) {
   /* refinement (refine.h) after the alias tables: a slot byte per texel, the sub-tables per cache */
   const size_t refine_bytes = g->refine_slot ? tex + 4 * IRIS_REFINE_MAX * IRIS_REFINE_SUB * g->cache_count : 0;
   const size_t end = n - refine_bytes, slot_at = end, sub_at = end + tex;
-  const size_t caches_at = end - 70 * g->cache_count - 12 * tex, pdf_at = end - 12 * tex, alias_at = end - 8 * tex;
+  const size_t caches_at = end - CB * g->cache_count - 12 * tex, pdf_at = end - 12 * tex, alias_at = end - 8 * tex;
   CHECK(g->refine_slot != NULL); /* the default guide is refined: the forgeries below reach its tables */
   const size_t count_at = caches_at - 16, texels_at = caches_at - 8;
   struct forge {
@@ -256,13 +257,15 @@ static void refusals(const char *dir, iris_guiding *g) {
       {count_at, 8, (uint64_t)1 << 40, "do not match its size"},       /* huge count */
       {texels_at, 8, UINT64_MAX / 4, "do not match its size"},         /* huge texel count */
       {count_at, 8, g->cache_count - 1, "do not match its size"},      /* one cache fewer */
-      {caches_at + 48 + 70, 4, 1, "table offset"},                     /* cache 1's table offset */
-      {caches_at + 48 + 70 * 5, 4, UINT32_MAX - 3, "table offset"},    /* far out of range */
+      {caches_at + 48 + CB, 4, 1, "table offset"},                     /* cache 1's table offset */
+      {caches_at + 48 + CB * 5, 4, UINT32_MAX - 3, "table offset"},    /* far out of range */
       {caches_at + 4, 4, 0x7fc00000u, "not finite"},                   /* NaN position */
-      {caches_at + 70 * 2 + 36, 4, 0x7f800000u, "not finite"},         /* inf normal */
-      {caches_at + 70 * 3 + 56, 4, 0x7fc00000u, "invalid values"},     /* NaN radiance */
-      {caches_at + 70 * 3 + 64, 1, 7, "invalid values"},               /* sphere flag 7 */
-      {caches_at + 70 * 4 + 66, 4, 0x3fc00000u, "invalid values"},     /* sky behind glass 1.5 */
+      {caches_at + CB * 2 + 36, 4, 0x7f800000u, "not finite"},         /* inf normal */
+      {caches_at + CB * 3 + 56, 4, 0x7fc00000u, "invalid values"},     /* NaN radiance */
+      {caches_at + CB * 3 + 64, 1, 7, "invalid values"},               /* sphere flag 7 */
+      {caches_at + CB * 4 + 66, 4, 0x3fc00000u, "invalid values"},     /* sky behind glass 1.5 */
+      {caches_at + CB * 5 + 70, 4, 0x3fc00000u, "lamp shares"},         /* a lamp's share 1.5 */
+      {caches_at + CB * 5 + 75, 4, 0x3e800000u, "lamp shares"},         /* 0.25 in slot 1, slot 0 empty */
       {pdf_at + 4 * 17, 4, 0x7fc00000u, "not finite"},                 /* NaN pdf */
       {pdf_at + 4 * 18, 4, 0xbf800000u, "negative"},                   /* pdf -1 */
       {pdf_at + 4 * 19, 4, 0x7f800000u, "not finite"},                 /* inf pdf */
