@@ -7,15 +7,18 @@
 # speed-up against each Cycles row (time(Cycles) / time(iris method)).
 # usage: bench/cycles_stand.sh BUILD OUT "TIMES" HEIGHT METHODS REF SCENE...
 #   TIMES e.g. "4,16"; METHODS e.g. mis,auto; REF: auto (a cached iris mis
-#   reference of 4096 spp) or a directory holding ref_SCENE.exr.
+#   reference of 4096 spp), auto:N (of N spp) or a directory holding ref_SCENE.exr.
 # Runs that already have results in OUT are kept (delete them to rerun).
 set -eu
 B=$1; O=$2; T=$3; H=$4; M=$5; R=$6
 shift 6
 mkdir -p "$O"
 for sc in "$@"; do
-  ref="--reference auto --reference-spp 4096"
-  [ "$R" != auto ] && ref="--reference $R/ref_$sc.exr"
+  case "$R" in
+    auto) ref="--reference auto --reference-spp 4096" ;;
+    auto:*) ref="--reference auto --reference-spp ${R#auto:}" ;;
+    *) ref="--reference $R/ref_$sc.exr" ;;
+  esac
   for mode in cycles-adaptive cycles; do
     d="$O/$sc-$mode"
     [ -f "$d/results.csv" ] && continue
