@@ -21,14 +21,18 @@
 #include "core/image.h"
 #include "validate/metrics.h"
 
-static int load_rgb(const char *path, iris_image *out) {
-  iris_image img;
+/* Reads an EXR, saying why not on stderr. */
+static int read_exr(const char *path, iris_image *img) {
   iris_error err;
   iris_error_clear(&err);
-  if (iris_exr_read(path, &img, NULL, NULL, &err) != IRIS_OK) {
-    fprintf(stderr, "relmse: %s: %s\n", path, err.message);
-    return 0;
-  }
+  if (iris_exr_read(path, img, NULL, NULL, &err) == IRIS_OK) return 1;
+  fprintf(stderr, "relmse: %s: %s\n", path, err.message);
+  return 0;
+}
+
+static int load_rgb(const char *path, iris_image *out) {
+  iris_image img;
+  if (!read_exr(path, &img)) return 0;
   static const char *const names[3] = {"R", "G", "B"};
   int ch[3];
   for (int c = 0; c < 3; c++)
@@ -37,7 +41,10 @@ static int load_rgb(const char *path, iris_image *out) {
       iris_image_destroy(&img);
       return 0;
     }
+  iris_error err;
+  iris_error_clear(&err);
   if (iris_image_create(out, img.width, img.height, 3, names, &err) != IRIS_OK) {
+    fprintf(stderr, "relmse: %s: %s\n", path, err.message);
     iris_image_destroy(&img);
     return 0;
   }
@@ -51,12 +58,7 @@ static int load_rgb(const char *path, iris_image *out) {
 int main(int argc, char **argv) {
   if (argc == 3 && strcmp(argv[1], "--own") == 0) {
     iris_image img;
-    iris_error err;
-    iris_error_clear(&err);
-    if (iris_exr_read(argv[2], &img, NULL, NULL, &err) != IRIS_OK) {
-      fprintf(stderr, "relmse: %s: %s\n", argv[2], err.message);
-      return 2;
-    }
+    if (!read_exr(argv[2], &img)) return 2;
     double own = iris_metric_own_relmse(&img);
     iris_image_destroy(&img);
     if (own < 0) {
@@ -68,12 +70,7 @@ int main(int argc, char **argv) {
   }
   if (argc == 4 && strcmp(argv[1], "--raw") == 0) {
     iris_image img;
-    iris_error err;
-    iris_error_clear(&err);
-    if (iris_exr_read(argv[2], &img, NULL, NULL, &err) != IRIS_OK) {
-      fprintf(stderr, "relmse: %s: %s\n", argv[2], err.message);
-      return 2;
-    }
+    if (!read_exr(argv[2], &img)) return 2;
     static const char *const names[6] = {"R", "G", "B", "var.R", "var.G", "var.B"};
     int ch[6];
     for (int c = 0; c < 6; c++) ch[c] = iris_image_channel(&img, names[c]);
@@ -96,18 +93,18 @@ int main(int argc, char **argv) {
   }
   if (argc == 4 && strcmp(argv[1], "--expected") == 0) {
     iris_image img, r;
-    iris_error err;
-    iris_error_clear(&err);
-    if (iris_exr_read(argv[2], &img, NULL, NULL, &err) != IRIS_OK) {
-      fprintf(stderr, "relmse: %s: %s\n", argv[2], err.message);
+    if (!read_exr(argv[2], &img)) return 2;
+    if (!load_rgb(argv[3], &r)) {
+      iris_image_destroy(&img);
       return 2;
     }
-    if (!load_rgb(argv[3], &r)) return 2;
     static const char *const vnames[3] = {"var.R", "var.G", "var.B"};
     int v0[3];
     for (int c = 0; c < 3; c++) v0[c] = iris_image_channel(&img, vnames[c]);
     if (v0[0] < 0 || v0[1] < 0 || v0[2] < 0 || img.width != r.width || img.height != r.height) {
       fprintf(stderr, "relmse: %s has no var.R/G/B channels or another size than %s\n", argv[2], argv[3]);
+      iris_image_destroy(&img);
+      iris_image_destroy(&r);
       return 2;
     }
     size_t n = (size_t)img.width * (size_t)img.height;
