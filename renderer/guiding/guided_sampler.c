@@ -143,6 +143,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
     iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
     iris_vec3 wi;
     if (!iris_envmap_sample(g->env, u1, u2, &wi, &pdf_map, NULL)) return false;
+    out->aimed = true; /* as a lamp's cone below: no roulette on its way through the glass */
     return guided_finish(g, sp, v, alpha, wi, out);
   }
   if (us < v->sky + v->lamp) { /* lamps behind glass: a lamp's cone */

@@ -74,6 +74,13 @@ int main(int argc, char **argv) {
        * BSDF and the guide must cover the rest (the sky-room; elsewhere as the defaults) */
       {IRIS_METHOD_GUIDED_NEE, 0.0f, IRIS_SPLAT_BILINEAR, "guided-nee, sky beta 1, 32 regions, 1 probe", false, 0,
        false, 0, true}};
+  /* Behind the glazing the sun's light through the slab reaches the walls
+   * only along rare paths for mis (BSDF sampling alone finds the sun through
+   * glass): at 256 spp its image misses them, with a sample variance that does
+   * not show it (a wall block: mis 0.061, every method at 2048-8192 spp
+   * 0.093-0.11), so there the yardstick mis gets 32x the samples (a density
+   * of the sky's component 0.7x too low then fails 13 checks). */
+  const int yard_spp = !strcmp(scene, "sky-room-glazed") ? 32 * spp : 2 * spp;
   int bx = w / 8, by = h / 8;
   int n_tests = (NV - 1) * 3 * (1 + bx * by); /* an upper bound where variants are skipped */
   double z_max = fmax(3.0, z_for_alpha(1e-3 / n_tests));
@@ -85,7 +92,7 @@ int main(int argc, char **argv) {
   bool ok[NV];
   for (int m = 0; m < NV; m++) {
     /* mis gets more samples: it is the yardstick, and cheaper per sample. */
-    ok[m] = CHECK(render(s, &variants[m], w, h, m == 0 ? 2 * spp : spp, 200 + (uint64_t)m, &r[m]));
+    ok[m] = CHECK(render(s, &variants[m], w, h, m == 0 ? yard_spp : spp, 200 + (uint64_t)m, &r[m]));
   }
   /* Under a sky seen through a window, pure guided (no light sampling) finds
    * the sun only by chance: its samples are heavy-tailed and their sample
