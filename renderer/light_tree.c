@@ -416,7 +416,7 @@ static double infinite_share(const iris_light_tree *t, iris_vec3 p, iris_vec3 n)
 /* node_importance for the four lanes of a wide node at once, the same
  * formula without branches: both the inside and the outside case are
  * computed and one is kept. SSE where the compiler has it (every x86-64),
- * else the same arithmetic lane by lane. */
+ * else node_importance lane by lane. */
 #if defined(__SSE2__)
 #include <emmintrin.h>
 static inline __m128 sel4(__m128 m, __m128 a, __m128 b) { return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b)); }
@@ -479,49 +479,16 @@ static void importance4(const iris_light_tree_wide *w, int o, iris_vec3 p, iris_
   imp = _mm_and_ps(_mm_and_ps(_mm_cmpgt_ps(phi, zero), _mm_cmpgt_ps(imp, zero)), _mm_min_ps(imp, _mm_set1_ps(FLT_MAX)));
   _mm_storeu_ps(out, imp);
 }
-static void wide_importance(const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n, float out[IRIS_LIGHT_WIDE]) {
+static void wide_importance(const iris_light_tree *t, const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n,
+                            float out[IRIS_LIGHT_WIDE]) {
+  (void)t;
   for (int o = 0; o < IRIS_LIGHT_WIDE; o += 4) importance4(w, o, p, n, out + o);
 }
 #else
-static void wide_importance(const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n, float out[IRIS_LIGHT_WIDE]) {
-  const bool has_n = n.x != 0.0f || n.y != 0.0f || n.z != 0.0f;
-  for (int k = 0; k < IRIS_LIGHT_WIDE; k++) {
-    float lx = w->lo[0][k], ly = w->lo[1][k], lz = w->lo[2][k];
-    float hx = w->hi[0][k], hy = w->hi[1][k], hz = w->hi[2][k];
-    float wx = w->w[0][k], wy = w->w[1][k], wz = w->w[2][k];
-    float phi = w->phi[k], r = w->radius[k], r2 = r * r;
-    float tx = p.x - 0.5f * (lx + hx), ty = p.y - 0.5f * (ly + hy), tz = p.z - 0.5f * (lz + hz);
-    float dist2 = tx * tx + ty * ty + tz * tz;
-    float front = wx * (p.x - (wx > 0.0f ? lx : hx)) + wy * (p.y - (wy > 0.0f ? ly : hy)) +
-                  wz * (p.z - (wz > 0.0f ? lz : hz));
-    float above = n.x * ((n.x > 0.0f ? hx : lx) - p.x) + n.y * ((n.y > 0.0f ? hy : ly) - p.y) +
-                  n.z * ((n.z > 0.0f ? hz : lz) - p.z);
-    bool in_dead = (w->one_normal[k] > 0.0f && front <= 0.0f) || (has_n && above <= 0.0f);
-    float in_imp = in_dead ? 0.0f : w->phi_r2[k];
-    float d2 = dist2 > FLT_MIN ? dist2 : FLT_MIN;
-    float inv_d = 1.0f / sqrtf(d2);
-    float ux = tx * inv_d, uy = ty * inv_d, uz = tz * inv_d;
-    float sin_b = r * inv_d, cos_b = iris_safe_sqrt(1.0f - sin_b * sin_b);
-    float cos_w = wx * ux + wy * uy + wz * uz;
-    if (w->two_sided[k] > 0.0f) cos_w = fabsf(cos_w);
-    float sin_w = iris_safe_sqrt(1.0f - cos_w * cos_w);
-    float cos_o = w->cos_o[k], sin_o = w->sin_o[k];
-    bool in_cone = cos_w > cos_o;
-    float cos_x = in_cone ? 1.0f : cos_w * cos_o + sin_w * sin_o;
-    float sin_x = in_cone ? 0.0f : sin_w * cos_o - cos_w * sin_o;
-    float cos_p = cos_x > cos_b ? 1.0f : cos_x * cos_b + sin_x * sin_b;
-    bool out_dead = cos_p <= w->cos_e[k];
-    float out_imp = phi * cos_p * (inv_d * inv_d);
-    if (has_n) {
-      float cos_i = -(ux * n.x + uy * n.y + uz * n.z), sin_i = iris_safe_sqrt(1.0f - cos_i * cos_i);
-      float cos_pi = cos_i > cos_b ? 1.0f : cos_i * cos_b + sin_i * sin_b;
-      out_dead = out_dead || cos_pi <= 0.0f;
-      out_imp *= cos_pi;
-    }
-    float imp = dist2 > r2 ? (out_dead ? 0.0f : out_imp) : in_imp;
-    imp = phi > 0.0f && imp > 0.0f ? imp : 0.0f; /* NaN too */
-    out[k] = imp < FLT_MAX ? imp : FLT_MAX;
-  }
+/* Without SSE: each lane's binary node through the scalar function. */
+static void wide_importance(const iris_light_tree *t, const iris_light_tree_wide *w, iris_vec3 p, iris_vec3 n,
+                            float out[IRIS_LIGHT_WIDE]) {
+  for (int k = 0; k < IRIS_LIGHT_WIDE; k++) out[k] = w->phi[k] > 0.0f ? node_importance(&t->nodes[w->node[k]], p, n) : 0.0f;
 }
 #endif
 
@@ -531,7 +498,7 @@ float iris_light_tree_node_importance(const iris_light_tree_node *node, iris_vec
 
 void iris_light_tree_wide_importance(const iris_light_tree *t, size_t wide, iris_vec3 p, iris_vec3 n,
                                      float out[IRIS_LIGHT_WIDE]) {
-  wide_importance(&t->wide[wide], p, n, out);
+  wide_importance(t, &t->wide[wide], p, n, out);
 }
 
 /* THE descent, for sampling (bits == NULL: follows *u, rescaled at each
@@ -549,7 +516,7 @@ static uint32_t descend(const iris_light_tree *t, iris_vec3 p, iris_vec3 n, doub
   for (int depth = 0;;) {
     const iris_light_tree_wide *w = &t->wide[i];
     float c[IRIS_LIGHT_WIDE];
-    wide_importance(w, p, n, c);
+    wide_importance(t, w, p, n, c);
     double sum = 0.0;
     for (int k = 0; k < IRIS_LIGHT_WIDE; k++) sum += c[k];
     if (!(sum > 0.0)) return UINT32_MAX;

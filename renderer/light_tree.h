@@ -64,7 +64,7 @@ typedef struct iris_light_tree_wide {
   float two_sided[IRIS_LIGHT_WIDE]; /* 1: |cos| to the normals, else 0 */
   float one_normal[IRIS_LIGHT_WIDE]; /* 1: one-sided emitters of one normal (the box's half-space test) */
   uint32_t child[IRIS_LIGHT_WIDE]; /* IRIS_LIGHT_WIDE_LEAF | a binary leaf's index, or a wide node's */
-  uint32_t node[IRIS_LIGHT_WIDE];  /* the lane's binary node (for tests and inspection) */
+  uint32_t node[IRIS_LIGHT_WIDE];  /* the lane's binary node (tests; the importance without SSE) */
   uint8_t path[IRIS_LIGHT_WIDE], len[IRIS_LIGHT_WIDE];
 } iris_light_tree_wide;
 #define IRIS_LIGHT_WIDE_LEAF 0x80000000u

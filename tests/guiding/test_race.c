@@ -67,11 +67,7 @@ static bool race_seed(const world *w, const iris_integrator *a, const iris_integ
 
 static bool race(const world *w, const iris_integrator *a, const iris_integrator *b, int threads,
                  iris_race_outcome *o, char *why, size_t size) {
-  iris_error err;
-  iris_error_clear(&err);
-  iris_status st = iris_method_race(a, b, &w->cam, 5, threads, 0.0, o, why, size, &err);
-  CHECK_OK(st, &err);
-  return st == IRIS_OK;
+  return race_seed(w, a, b, threads, 5, o, why, size);
 }
 
 /* The race's statistic from a long mis render of the same frame. */
