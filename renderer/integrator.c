@@ -382,7 +382,7 @@ static float power_heuristic(float pa, float pb) {
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, float u_region, const iris_sampler *rng, bool mis,
-                               iris_path_stats *stats) {
+                               float p_light, iris_path_stats *stats, int8_t *outcome) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -409,11 +409,16 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
     if (isfinite(ls.dist)) shadow.tmax = ls.dist * (1.0f - 1e-5f);
   }
   stats->shadow_rays++;
+  *outcome = 0;
   if (iris_accel_occluded(it->accel, &shadow)) return iris_v3(0, 0, 0);
   iris_lights_sample_radiance(it->lights, &ls); /* an environment map's lookup, only now */
+  if (iris_max3(ls.L) > 0.0f) *outcome = 1;
+  /* light sampling ran with probability p_light (1 unless the guide makes it
+   * optional here): its density is p_light ls.pdf, for the weight too */
+  const float pdf = p_light * ls.pdf;
   float w = 1.0f;
-  if (mis && !ls.delta) w = power_heuristic(ls.pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
-  return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / ls.pdf);
+  if (mis && !ls.delta) w = power_heuristic(pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
+  return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / pdf);
 }
 
 static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
@@ -432,6 +437,9 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   float pixel_estimate = 0.0f; /* adjoint-driven RR: L + est at the first estimated vertex */
   bool prev_delta = true; /* the camera "bounce" counts as delta: emitters seen directly count */
   bool aimed = false;     /* the last non-delta vertex aimed at a lamp (iris_direction_sample) */
+  /* light sampling made optional by the guide (iris_direction_sampler.light_probability) */
+  const bool light_optional = nee && iris_method_uses_guiding(it->method) && it->guide.light_probability;
+  float prev_light = 1.0f; /* the probability with which the vertex the ray left sampled a light */
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o, prev_n = iris_v3(0, 0, 0);
   stats->paths++;
@@ -453,6 +461,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
         if (env_guided && !prev_delta && mis && bounce > 0) /* the map's coordinates of ray.d: st */
           env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, st[0], st[1]);
+        env_pdf *= prev_light;
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w));
@@ -469,7 +478,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
       float w = 1.0f;
       if (!prev_delta && nee)
-        w = mis ? power_heuristic(prev_pdf, iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si)) : 0.0f;
+        w = mis ? power_heuristic(prev_pdf, prev_light * iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si))
+                : 0.0f;
       L = iris_add(L, iris_scale(iris_mul(beta, le), w));
       if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
     }
@@ -488,7 +498,14 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), u_choice, &choice);
     }
     iris_integrator_prepare_direction(it, &sp);
-    if (nee && !sp.delta) L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, stats)));
+    int8_t light_outcome = -1; /* for the recorded vertex: -1 no shadow ray, 0 blocked, 1 lit */
+    float p_light = 1.0f;
+    if (nee && !sp.delta) {
+      if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
+      if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
+        L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, p_light, stats,
+                                                     &light_outcome)));
+    }
 
     iris_direction_sample ds;
     memset(&ds, 0, sizeof ds);
@@ -514,9 +531,11 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->L = L;
       last->miss = iris_v3(0, 0, 0);
       last->beta = beta; /* replaced after Russian roulette; a killed path brings 0 */
+      last->light = light_outcome;
     }
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;
+    prev_light = p_light;
     prev_p = sp.si.p;
     prev_n = light_normal(&sp);
     if (env_guided) prev_guide = sp.guide;

@@ -58,6 +58,8 @@ enum {
   IRIS_SLOT_LIGHT_CHOICE = 0,  /* NEE: which light */
   IRIS_SLOT_ENV_REGION = 1,    /* NEE of an environment map guided by the caches: cache and region */
   IRIS_SLOT_LOBE = 2,          /* BSDF: which lobe */
+  IRIS_SLOT_LIGHT_SKIP = 3,    /* light sampling at a vertex where the guide makes it optional
+                                  (the lobe's pair: two independent 1D decisions) */
   IRIS_SLOT_LIGHT_POS = 4,     /* 2D: NEE point on the light */
   IRIS_SLOT_DIRECTION = 6,     /* 2D: BSDF direction, or the position in the guide's texel */
   IRIS_SLOT_RR = 8,            /* Russian roulette */
@@ -147,6 +149,12 @@ typedef struct iris_direction_sampler {
    * coordinates (s, t) over the map's own, at the vertex whose prepared state
    * is v (for the MIS weight of a ray that left that vertex and escaped). */
   float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t);
+  /* Optional: after prepare, the probability in (0, 1] with which the vertex
+   * samples a light at all (guiding: < 1 where training never saw a light
+   * sample arrive, docs/guiding.md "Light sampling where no light arrives").
+   * Light samples are divided by it and MIS counts light sampling's density
+   * times it, at the vertex and at the emitter the next ray hits. */
+  float (*light_probability)(void *ctx, const iris_shading_point *sp);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */
@@ -239,6 +247,8 @@ typedef struct iris_path_vertex {
   float pdf;               /* density of the whole direction sampler */
   float pdf_bsdf;          /* density of BSDF sampling alone */
   iris_vec3 beta, L, miss;
+  int8_t light;            /* this vertex's light sample: -1 none traced, 0 its shadow ray was
+                              blocked (or it brought nothing), 1 it brought light */
 } iris_path_vertex;
 
 #define IRIS_PATH_RECORD_MAX 16

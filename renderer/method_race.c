@@ -54,6 +54,10 @@ static float counted_scale(void *ctx, const struct iris_envmap *env, const iris_
   tl_calls++;
   return c->inner.environment_scale(c->inner.ctx, env, v, s, t);
 }
+static float counted_light(void *ctx, const iris_shading_point *sp) {
+  const counted_guide *c = ctx;
+  return c->inner.light_probability(c->inner.ctx, sp);
+}
 
 static iris_direction_sampler counting(counted_guide *c) {
   const iris_direction_sampler *g = &c->inner;
@@ -64,7 +68,8 @@ static iris_direction_sampler counting(counted_guide *c) {
                               g->radiance_estimate ? counted_radiance : NULL,
                               g->prefetch ? counted_prefetch : NULL,
                               g->sample_environment ? counted_environment : NULL,
-                              g->environment_scale ? counted_scale : NULL};
+                              g->environment_scale ? counted_scale : NULL,
+                              g->light_probability ? counted_light : NULL};
   return w;
 }
 

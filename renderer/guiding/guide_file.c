@@ -15,7 +15,7 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES (70u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
+#define CACHE_BYTES (74u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
@@ -125,6 +125,7 @@ static void put_params(writer *w, const iris_guiding_params *p) {
   put_u8(w, p->train_all_light);
   put_u32(w, (uint32_t)p->photon_lights);
   put_i32(w, p->refine);
+  put_f32(w, p->light_min);
 }
 
 static void put_stats(writer *w, const iris_guiding_stats *s) {
@@ -201,6 +202,7 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     put_u32(&w, c->photons);
     put_f32(&w, c->radiance);
     put_f32(&w, c->alpha);
+    put_f32(&w, c->light);
     put_u8(&w, c->sphere);
     put_u8(&w, c->from_camera);
     put_f32(&w, c->sky_through);
@@ -331,6 +333,7 @@ static bool get_params(reader *r, iris_guiding_params *p) {
   uint8_t all_light = get_u8(r);
   uint32_t lights = get_u32(r);
   p->refine = get_i32(r);
+  p->light_min = get_f32(r);
   p->train_all_light = all_light != 0;
   p->splat = (iris_splat_mode)splat;
   p->force = force != 0;
@@ -343,7 +346,8 @@ static bool get_params(reader *r, iris_guiding_params *p) {
          p->cache_res >= 1 && p->cache_res <= IRIS_OCTMAP_MAX_RES && p->cache_k >= 1 && isfinite(p->pdf_floor) &&
          p->pdf_floor >= 0.0f && p->pdf_floor <= 1.0f && isfinite(p->alpha_max) && p->alpha_max >= 0.0f &&
          p->alpha_max < 1.0f && isfinite(p->cos_min) && p->cos_min >= -1.0f && p->cos_min <= 1.0f &&
-         p->direct_photons >= -1 && p->direct_photons <= 1 && p->refine >= 0 && p->refine <= IRIS_REFINE_MAX;
+         p->direct_photons >= -1 && p->direct_photons <= 1 && p->refine >= 0 && p->refine <= IRIS_REFINE_MAX &&
+         p->light_min > 0.0f && p->light_min <= 1.0f;
 }
 
 static bool get_stats(reader *r, iris_guiding_stats *s) {
@@ -460,6 +464,7 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     c->photons = get_u32(r);
     c->radiance = get_f32(r);
     c->alpha = get_f32(r);
+    c->light = get_f32(r);
     uint8_t sph = get_u8(r), cam = get_u8(r);
     c->sphere = sph;
     c->from_camera = cam;
@@ -479,7 +484,8 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     if (!finite3(c->p) || !finite3(c->frame.s) || !finite3(c->frame.t) || !finite3(c->frame.n))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: position or frame is not finite (corrupted)", i);
     if (sph > 1 || cam > 1 || c->photons == 0 || !isfinite(c->radiance) || c->radiance < 0.0f ||
-        !isfinite(c->alpha) || c->alpha > 1.0f || !(c->sky_through >= 0.0f && c->sky_through <= 1.0f))
+        !isfinite(c->alpha) || c->alpha > 1.0f || !(c->sky_through >= 0.0f && c->sky_through <= 1.0f) ||
+        !(c->light > 0.0f && c->light <= 1.0f))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid values (corrupted)", i);
     if (!lamps_ok || !(through <= 1.001f)) /* the shares are of the same photons' energy */
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid lamp shares (corrupted)", i);
@@ -695,5 +701,6 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_u64(h, (uint64_t)(int64_t)p->refine);
   /* lamps behind glass: keeps the hash of guides without lamp light through glass */
   if (!p->lamp_glass) h = mix_u64(h, 0x1a3b91a55ULL);
+  h = mix_f32(h, p->light_min);
   return h;
 }

@@ -58,20 +58,23 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->radiance = -1.0f;
   v->sky = 0.0f;
   v->lamp = 0.0f;
+  v->light = 1.0f;
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
      * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
-    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f;
+    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f, light = 0.0f;
     int learned = 0;
     for (int i = 0; i < v->m; ++i) {
       const iris_cache *c = &g->caches[v->ids[i]];
       r += c->radiance;
+      light = fmaxf(light, c->light); /* any tied cache that saw light arrive keeps it sampled */
       sky += c->sky_through;
       for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) lamp += c->lamp_share[k];
       if (c->alpha >= 0.0f) a += c->alpha, learned++;
     }
     v->radiance = r / (float)v->m;
+    v->light = light;
     /* Sky behind glass: the share of the tied caches' photon energy that came
      * straight through glass from the map, which the map's own density finds
      * (the sun within its texels) and light sampling cannot reach. */
@@ -189,6 +192,12 @@ static float guided_radiance_estimate(void *ctx, const iris_shading_point *sp) {
   return v->radiance;
 }
 
+/* Light sampling's probability at a prepared vertex (1 without caches). */
+static float guided_light_probability(void *ctx, const iris_shading_point *sp) {
+  (void)ctx;
+  return ((const iris_guide_vertex_state *)sp->guide.bytes)->light;
+}
+
 static void guided_prefetch(void *ctx, iris_vec3 p) {
   const iris_guiding *g = ctx;
   if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
@@ -204,6 +213,12 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   s.prepare = guided_prepare;
   s.prefetch = guided_prefetch;
   if (g->params.adjoint_rr) s.radiance_estimate = guided_radiance_estimate;
+  /* only where some cache samples lights less often: elsewhere the paths pay nothing */
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].light < 1.0f) {
+      s.light_probability = guided_light_probability;
+      break;
+    }
   iris_guiding_sky_hooks(g, &s);
   return s;
 }

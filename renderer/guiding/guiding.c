@@ -42,6 +42,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.sky_beta = -1.0f;
   p.refine = -1;
   p.lamp_glass = true;
+  p.light_min = IRIS_GUIDING_LIGHT_MIN;
   return p;
 }
 
@@ -758,6 +759,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     size_t kept = 0;
     for (size_t i = 0; i < total; ++i) {
       g->caches[i].alpha = -1.0f; /* until training learns it */
+      g->caches[i].light = 1.0f;  /* ... and where light sampling brings nothing */
       if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
       else g->stats.empty_caches++;
     }

@@ -31,6 +31,10 @@ extern "C" {
 #define IRIS_GUIDING_PICK_K 5 /* Algorithm 1: the 5 nearest caches */
 /* Photons whose normal has a smaller cosine with the cache's are not splatted. */
 #define IRIS_GUIDING_PHOTON_NORMAL_COS 0.5f
+/* Light sampling's default probability where training found that it brings
+ * nothing (params.light_min; docs/guiding.md, "Light sampling where no light
+ * arrives"). */
+#define IRIS_GUIDING_LIGHT_MIN 0.1f
 /* Emitter groups the guide keeps a sphere of (iris_cache.lamp is a byte). */
 #define IRIS_GUIDING_LAMP_GROUPS 64
 
@@ -80,6 +84,9 @@ typedef struct iris_guiding_params {
   bool lamp_glass;      /* lamps behind glass: caches learn which emitter groups' light reached
                            them straight through glass, and the guide draws directions in
                            those groups' cones (default on; --no-lamp-glass; lamps.h) */
+  float light_min;      /* light sampling's probability at vertices whose caches' training traced
+                           >= 32 light samples and none brought light (--light-min; 1: always
+                           sample lights; docs/guiding.md, "Light sampling where no light arrives") */
   iris_emission_selection photon_lights; /* photons leave lights by power (default) or by
                                             area (thesis; --photon-lights) */
   /* The guide as a file (docs/guiding.md, "The guide as a file"; NULL = off):
@@ -116,6 +123,8 @@ typedef struct iris_cache {
                         radiance a diffuse white surface here reflects (Russian roulette);
                         refined by training */
   float alpha;       /* learned cache-sampling probability (< 0: not learned, alpha_max) */
+  float light;       /* probability of light sampling at the vertices it serves: 1, or
+                        params.light_min where training's light samples all came back empty */
   float sky_through; /* share of its photons' energy that came from the environment
                         straight through glass (photons.h): the probability with which
                         its guided samples follow the map instead ("Sky behind glass") */

@@ -52,6 +52,14 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     snprintf(sky + l, sizeof sky - l, "; lamps behind glass: %zu caches (mean share %.2f)", lamps,
              lsum / (double)lamps);
   }
+  /* caches where light sampling became optional ("Light sampling where no light arrives") */
+  size_t dark = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) dark += g->caches[i].light < 1.0f;
+  if (dark) {
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; light sampling at p %g in %zu caches where it brought nothing",
+             (double)g->params.light_min, dark);
+  }
   snprintf(buf, size,
            "guiding: %llu photon paths -> %llu photons (%.0f%% indirect); %llu caches (%llu from "
            "camera rays every %d px, %llu empty dropped), %dx%d maps (%llu texels refined 4x4 in %llu caches), k=%d, "

@@ -18,6 +18,9 @@
 #define TRAIN_BATCH_SPP 4     /* ... and samples per pixel of each batch */
 /* Samples a cache needs before its learned selection probability is used. */
 #define ALPHA_MIN_SAMPLES 64
+/* Light samples a cache's vertices must have traced, none of them bringing
+ * light, before light sampling there becomes optional (params.light_min). */
+#define LIGHT_MIN_TRIES 32
 /* Share of the render's samples spent on training when train_spp is automatic. */
 #define TRAIN_SHARE 0.05
 
@@ -68,6 +71,7 @@ typedef struct train_sample {
   float q;   /* density the direction was sampled with */
   float pb;  /* BSDF density */
   float pc;  /* the tied caches' density (tables of this pass) */
+  int8_t light; /* the vertex's light sample (iris_path_vertex.light) */
 } train_sample;
 
 typedef struct sample_buffer {
@@ -129,6 +133,7 @@ static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_en
     t.q = pv->pdf;
     t.pb = pv->pdf_bsdf;
     t.pc = iris_guide_vertex_guide_pdf(c->g, v, pv->wi);
+    t.light = pv->light;
     if (!isfinite(t.li) || !isfinite(t.h) || !(t.q > 0.0f)) continue;
     if (!buffer_push(out, &t)) return false;
   }
@@ -176,6 +181,8 @@ typedef struct train_state {
   iris_alpha_learner *learner; /* per cache, this pass's samples */
   float *fine_acc, *photon_sub; /* refinement (refine.h), iris_guiding_sub layout: samples, photons' tables */
   uint32_t *fine_n;             /* per sub-table: samples */
+  uint32_t *light_tries, *light_lit; /* per cache, over all passes: light samples traced at the
+                                        vertices it served, and those that brought light */
 } train_state;
 
 /* Adds a tile's samples to the caches whose id is `lane` modulo `lanes`:
@@ -191,6 +198,7 @@ static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer 
       iris_vec3 wl = iris_frame_to_local(&c->frame, t->wi);
       float cosc = fabsf(wl.z);
       ts->n[id]++;
+      if (t->light >= 0) ts->light_tries[id]++, ts->light_lit[id] += (uint32_t)t->light;
       iris_alpha_learner_add(&ts->learner[id], t->h, t->q, t->pb, t->pc);
       if (!(t->li > 0.0f)) continue;
       /* Li cos / q estimates the integral of Li cos over the sphere; splatted
@@ -275,7 +283,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   }
   train_state ts = {malloc(caches * sizeof(float)), calloc(floats ? floats : 1, sizeof(float)),
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
-                    calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL};
+                    calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL,
+                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t))};
   if (ts.radiance_photons)
     for (size_t i = 0; i < caches; ++i) ts.radiance_photons[i] = g->caches[i].radiance;
   const size_t subs = g->refine_slot ? (floats / g->hemi.texel_count + 1) * IRIS_REFINE_MAX : 0;
@@ -288,7 +297,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   float *hist = malloc(sizeof(float) * g->sphere.texel_count);
   sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
   iris_status st = IRIS_OK;
-  if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf ||
+  if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf || !ts.light_tries ||
+      !ts.light_lit ||
       (subs && (!ts.fine_acc || !ts.fine_n || !ts.photon_sub)))
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
 
@@ -363,6 +373,11 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
       if (total < done) total = done;
     }
   }
+  /* Light sampling where it brought nothing: after all passes, so that every
+   * pass traced its light samples and the counts cover them all. */
+  if (st == IRIS_OK && p->light_min < 1.0f)
+    for (size_t i = 0; i < caches; ++i)
+      if (ts.light_tries[i] >= LIGHT_MIN_TRIES && ts.light_lit[i] == 0) g->caches[i].light = p->light_min;
   for (int t = 0; t < TRAIN_BATCH_TILES && buf; ++t) free(buf[t].s);
   free(buf);
   free(hist);
@@ -374,6 +389,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   free(ts.fine_acc);
   free(ts.fine_n);
   free(ts.photon_sub);
+  free(ts.light_tries);
+  free(ts.light_lit);
   free(g->photon_hist);
   g->photon_hist = NULL;
   g->stats.train_spp = done;

@@ -18,6 +18,7 @@ typedef struct iris_guide_vertex_state {
   float radiance;                       /* tied caches' mean radiance estimate; < 0 none */
   float sky;                            /* of the guide's share alpha, the map's (sky behind glass) */
   float lamp;                           /* ... and the lamps' cones' (lamps behind glass) */
+  float light;                          /* probability of light sampling here (the tied caches' largest) */
   int32_t m;                            /* tied caches */
   iris_vec3 p;                          /* the shading point (the lamps' cones are seen from it) */
   uint32_t ids[IRIS_GUIDING_PICK_K];

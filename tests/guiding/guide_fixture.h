@@ -14,30 +14,57 @@
 #include "renderer/render.h"
 #include "renderer/texture.h"
 
-static inline iris_guiding *test_guide_build(const iris_scene *s, iris_method method, iris_guiding_params gp,
-                                             uint64_t seed, int threads, int spp) {
-  iris_error err;
-  iris_error_clear(&err);
+/* A scene set up for rendering by hand (a 48x36 camera): what
+ * test_guide_build uses and frees, kept for tests that trace paths with the
+ * guide themselves. False (and a message) when anything fails. */
+typedef struct test_guide_scene {
   iris_pinhole cam;
-  iris_accel *acc = NULL;
+  iris_accel *acc;
   iris_textures tx;
   iris_lights lights;
-  memset(&tx, 0, sizeof tx);
-  memset(&lights, 0, sizeof lights);
-  iris_guiding *g = NULL;
-  if (iris_pinhole_setup(s, NULL, 48, 36, &cam, &err) == IRIS_OK && iris_accel_build(s, &acc, &err) == IRIS_OK &&
-      iris_textures_load(s, &tx, &err) == IRIS_OK && iris_lights_build(s, acc, &tx, &lights, &err) == IRIS_OK) {
-    iris_integrator it = iris_integrator_default(s, acc, &lights, &tx);
-    it.method = method;
-    gp.use_nee = iris_method_uses_nee(method);
-    iris_guide_setup gs = {s, acc, &lights, &tx, &cam, &it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
-    if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
-  } else {
-    fprintf(stderr, "scene set-up failed: %s\n", err.message);
+  iris_integrator it;
+} test_guide_scene;
+
+static inline void test_guide_scene_close(test_guide_scene *t) {
+  iris_lights_destroy(&t->lights);
+  iris_textures_destroy(&t->tx);
+  iris_accel_destroy(t->acc);
+  t->acc = NULL;
+}
+
+static inline bool test_guide_scene_open(const iris_scene *s, iris_method method, test_guide_scene *t) {
+  iris_error err;
+  iris_error_clear(&err);
+  memset(t, 0, sizeof *t);
+  if (iris_pinhole_setup(s, NULL, 48, 36, &t->cam, &err) == IRIS_OK && iris_accel_build(s, &t->acc, &err) == IRIS_OK &&
+      iris_textures_load(s, &t->tx, &err) == IRIS_OK && iris_lights_build(s, t->acc, &t->tx, &t->lights, &err) == IRIS_OK) {
+    t->it = iris_integrator_default(s, t->acc, &t->lights, &t->tx);
+    t->it.method = method;
+    return true;
   }
-  iris_lights_destroy(&lights);
-  iris_textures_destroy(&tx);
-  iris_accel_destroy(acc);
+  fprintf(stderr, "scene set-up failed: %s\n", err.message);
+  test_guide_scene_close(t);
+  return false;
+}
+
+/* The guide of a render of `spp` samples (sobol) for an open scene. */
+static inline iris_guiding *test_guide_build_in(const iris_scene *s, test_guide_scene *t, iris_guiding_params gp,
+                                                uint64_t seed, int threads, int spp) {
+  iris_error err;
+  iris_error_clear(&err);
+  iris_guiding *g = NULL;
+  gp.use_nee = iris_method_uses_nee(t->it.method);
+  iris_guide_setup gs = {s, t->acc, &t->lights, &t->tx, &t->cam, &t->it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
+  if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
+  return g;
+}
+
+static inline iris_guiding *test_guide_build(const iris_scene *s, iris_method method, iris_guiding_params gp,
+                                             uint64_t seed, int threads, int spp) {
+  test_guide_scene t;
+  if (!test_guide_scene_open(s, method, &t)) return NULL;
+  iris_guiding *g = test_guide_build_in(s, &t, gp, seed, threads, spp);
+  test_guide_scene_close(&t);
   return g;
 }
 

@@ -163,9 +163,9 @@ int main(int argc, char **argv) {
       snprintf(why, sizeof why, "byte %zu flipped", flips[i]);
       refused(dir, bin, "--guide-in F", "F", why);
     }
-    d[8] = 5; /* version (this iris reads 4) */
+    d[8] = 6; /* version (this iris reads 5) */
     CHECK(write_bytes(dir, "V", d, n));
-    refused(dir, bin, "--guide-in V", "V", "version 5");
+    refused(dir, bin, "--guide-in V", "V", "version 6");
     free(data);
   }
   /* usage errors, nothing written */
