@@ -17,8 +17,8 @@
 #define BYTES_PER_PLACEMENT 240.0       /* Embree instance + iris placement table + box */
 #define BYTES_PER_EMISSIVE_TRIANGLE 280.0 /* tables and tree; +100 for the descent's wide nodes (384 B, ~1 per 2 leaves) */
 #define BASE_BYTES 14e6                 /* iris + libraries + Embree's threads */
-#define PATH_BYTES 240.0                /* one photon path: ~4 stored photons and their kd-tree */
-#define CACHE_BYTES 1400.0              /* one 8x8 cache with its tables */
+#define PATH_BYTES 304.0                /* one photon path: ~4 stored photons (64 B) and their kd-tree */
+#define CACHE_BYTES 1424.0              /* one 8x8 cache with its tables */
 #define LIGHT_SELECT_BYTES 129.0        /* one cache's learned light table (guiding/light_select.h) */
 #define FILM_BYTES_PER_PIXEL 62.0       /* sums, counts and the EXR image */
 #define ENV_BYTES_PER_TEXEL 24.0        /* RGB float + sampling tables */

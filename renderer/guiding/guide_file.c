@@ -15,7 +15,7 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES (74u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
+#define CACHE_BYTES (94u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
@@ -210,6 +210,8 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
       put_f32(&w, c->lamp_share[k]);
       put_u8(&w, c->lamp[k]);
     }
+    put_f32(&w, c->pane_share);
+    for (int k = 0; k < 4; ++k) put_f32(&w, c->pane[k]);
     at += texels_of(g, c);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -481,12 +483,22 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
         lamps_ok = false;
       through += c->lamp_share[k];
     }
+    c->pane_share = get_f32(r);
+    for (int k = 0; k < 4; ++k) c->pane[k] = get_f32(r);
+    through += c->pane_share;
+    const float pn2 = c->pane[0] * c->pane[0] + c->pane[1] * c->pane[1] + c->pane[2] * c->pane[2];
+    /* a share names a plane: a unit normal and an index ratio a build makes (1/4 to 4) */
+    const bool pane_ok = c->pane_share == 0.0f ||
+                         (c->pane_share > 0.0f && c->pane_share <= 1.0f && fabsf(pn2 - 1.0f) < 1e-3f &&
+                          c->pane[3] >= 0.25f && c->pane[3] <= 4.0f);
     if (!finite3(c->p) || !finite3(c->frame.s) || !finite3(c->frame.t) || !finite3(c->frame.n))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: position or frame is not finite (corrupted)", i);
     if (sph > 1 || cam > 1 || c->photons == 0 || !isfinite(c->radiance) || c->radiance < 0.0f ||
         !isfinite(c->alpha) || c->alpha > 1.0f || !(c->sky_through >= 0.0f && c->sky_through <= 1.0f) ||
         !(c->light > 0.0f && c->light <= 1.0f))
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid values (corrupted)", i);
+    if (!pane_ok)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid pane (corrupted)", i);
     if (!lamps_ok || !(through <= 1.001f)) /* the shares are of the same photons' energy */
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid lamp shares (corrupted)", i);
     /* Tables are stored back to back in cache order: exactly one offset is right. */

@@ -59,15 +59,19 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->sky = 0.0f;
   v->lamp = 0.0f;
   v->light = 1.0f;
+  v->pane = 0xff;
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
      * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
-    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f, light = 0.0f;
+    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f, light = 0.0f, pane = 0.0f;
     int learned = 0;
     for (int i = 0; i < v->m; ++i) {
       const iris_cache *c = &g->caches[v->ids[i]];
       r += c->radiance;
+      /* the sky through a pane: the plane of the tied cache with the largest share */
+      if (c->pane_share > pane) pane = c->pane_share, v->pane = (uint8_t)i;
+      sky += c->pane_share;
       light = fmaxf(light, c->light); /* any tied cache that saw light arrive keeps it sampled */
       sky += c->sky_through;
       for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) lamp += c->lamp_share[k];
@@ -142,10 +146,10 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   /* Sky behind glass: the guide's share alpha split between the map (sky) and the caches. */
   const float us = u / alpha;
   if (us < v->sky) {
-    float u1, u2, pdf_map;
+    float u1, u2;
     iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
     iris_vec3 wi;
-    if (!iris_envmap_sample(g->env, u1, u2, &wi, &pdf_map, NULL)) return false;
+    if (!iris_guide_vertex_sky_sample(g, v, u1, u2, &wi)) return false;
     out->aimed = true; /* as a lamp's cone below: no roulette on its way through the glass */
     return guided_finish(g, sp, v, alpha, wi, out);
   }

@@ -334,7 +334,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
                                                    photon_usable, &f, ids, d2, slots);
     uint32_t used = 0;
-    double power = 0.0, through = 0.0;
+    double power = 0.0, through = 0.0, paned = 0.0, pane[4] = {0, 0, 0, 0};
     for (uint32_t j = 0; j < n; ++j) {
       photon_dirs ph;
       memcpy(&ph, c->photon_tree->payload + (size_t)slots[j] * sizeof ph, sizeof ph);
@@ -345,11 +345,23 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
       used += u;
       if (u) power += ph.energy;
       if (u && c->photons->photons[ids[j]].sky_through) through += ph.energy;
+      if (u && c->photons->photons[ids[j]].pane[3] > 0.0f) {
+        paned += ph.energy;
+        for (int k = 0; k < 4; ++k) pane[k] += ph.energy * c->photons->photons[ids[j]].pane[k];
+      }
       if (u && lamps.on && c->photons->photons[ids[j]].lamp_through)
         lamp_add(&lamps, g, c->lights->entries[c->photons->photons[ids[j]].light].group, ph.energy);
     }
     cache->photons = used;
     cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
+    cache->pane_share = 0.0f;
+    memset(cache->pane, 0, sizeof cache->pane);
+    const double pn = sqrt(pane[0] * pane[0] + pane[1] * pane[1] + pane[2] * pane[2]);
+    if (g->env && power > 0.0 && paned > 0.0 && pn > 0.5 * paned) { /* one plane's photons, not opposed ones */
+      cache->pane_share = (float)(paned / power);
+      for (int k = 0; k < 3; ++k) cache->pane[k] = (float)(pane[k] / pn);
+      cache->pane[3] = (float)(pane[3] / paned);
+    }
     lamp_shares(&lamps, power, cache);
     /* Photon density estimate (thesis 4.2.1's energies, absolute): irradiance =
      * sum of powers / (paths * pi r_k^2); radiance of a white diffuse surface =

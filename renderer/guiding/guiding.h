@@ -131,6 +131,11 @@ typedef struct iris_cache {
   float lamp_share[IRIS_CACHE_LAMPS]; /* the same for lamps: shares of its photons' energy that
                         came straight through glass from emitter group lamp[i] (brightest
                         first, 0: unused), drawn in that group's cone ("Lamps behind glass") */
+  float pane_share;  /* share of its photons' energy that came from the environment through
+                        one refracting plane (a single glass quad), drawn from the map carried
+                        through pane[] ("Sky through a pane"); sky_through + pane_share +
+                        the lamp shares <= 1 */
+  float pane[4];     /* that plane: energy-weighted normal on the sky's side, eta = n_room / n_sky */
   uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;

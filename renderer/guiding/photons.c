@@ -87,6 +87,10 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
   /* The same for a lamp (an emissive triangle): from a wall behind a glass
    * shade, the bulb is where it would be without the glass ("Lamps behind glass"). */
   bool lamp_only = s->lights->entries[e.light].kind == IRIS_LIGHT_KIND_TRIANGLE;
+  /* ... and for a map photon, the one refracting plane it passed, if it passed
+   * exactly one delta vertex and that bent it (a single glass quad) */
+  int deltas = 0;
+  float pane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -110,11 +114,22 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       const bool straight = bounce > 0 && iris_dot(wo, e.dir) < -SKY_THROUGH_COS;
       ph.sky_through = specular_only && straight;
       ph.lamp_through = lamp_only && straight;
+      const bool paned = specular_only && deltas == 1 && !straight && pane[3] > 0.0f;
+      for (int k = 0; k < 4; ++k) ph.pane[k] = paned ? pane[k] : 0.0f;
       block_push(out, &ph);
       specular_only = lamp_only = false;
     }
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    if (sp.delta && specular_only && ++deltas == 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION) && sp.bsdf.ior > 0.0f &&
+        sp.bsdf.ior != 1.0f) {
+      /* n on the side the photon came from (the sky's); entering the
+       * surface's front it enters a medium of index ior, else it leaves one */
+      iris_vec3 n = iris_dot(si.ng, ray.d) < 0.0f ? si.ng : iris_neg(si.ng);
+      n = iris_normalize(n);
+      pane[0] = n.x, pane[1] = n.y, pane[2] = n.z;
+      pane[3] = si.front ? sp.bsdf.ior : 1.0f / sp.bsdf.ior;
+    }
     /* f |cos| / pdf for every lobe: a delta lobe's f carries 1/|cos wi|
      * (bsdf.c), so its weight is the lobe's colour, as on camera paths;
      * weighting it by f alone gained 1/|cos| at every glass interface. */

@@ -20,7 +20,7 @@ extern "C" {
 
 #define IRIS_PHOTON_MAX_BOUNCES 32
 
-/* One stored photon (48 bytes). Energy is a single float, the mean
+/* One stored photon (64 bytes). Energy is a single float, the mean
  * of the RGB power (the thesis's choice): the caches only need the relative
  * distribution of incident power over directions, not its colour. */
 typedef struct iris_photon {
@@ -37,6 +37,9 @@ typedef struct iris_photon {
   uint8_t lamp_through; /* the same for a photon of an emissive triangle (a lamp): the lamp's
                            cone from the surface finds that light ("Lamps behind glass") */
   uint32_t light;   /* the light entry it left (iris_lights; learned light selection) */
+  float pane[4];    /* from the environment map through exactly one refracting plane (a window
+                       modelled as one glass quad): the plane's normal on the sky's side and
+                       eta = n_room / n_sky; pane[3] = 0 for every other photon (pane.h) */
 } iris_photon;
 
 typedef struct iris_photon_map {

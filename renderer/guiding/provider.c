@@ -27,7 +27,7 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
              asum / (double)learned, (double)g->params.alpha_max);
   else
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
-  char sky[256];
+  char sky[384];
   iris_skyvis_describe(&g->sky, sky, sizeof sky);
   /* caches that sample the map for sky light behind glass ("Sky behind glass") */
   double tsum = 0.0;
@@ -38,6 +38,16 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     size_t l = strlen(sky);
     snprintf(sky + l, sizeof sky - l, "; sky behind glass: %zu caches (mean share %.2f)", through,
              tsum / (double)through);
+  }
+  /* ... and through one refracting plane ("Sky through a pane") */
+  double psum = 0.0;
+  size_t paned = 0;
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].pane_share > 0.0f) psum += g->caches[i].pane_share, paned++;
+  if (paned) {
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; sky through a pane: %zu caches (mean share %.2f)", paned,
+             psum / (double)paned);
   }
   /* caches that aim at lamps behind glass ("Lamps behind glass") */
   double lsum = 0.0;

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "renderer/guiding/guiding.h"
+#include "renderer/guiding/pane.h"
 
 /* Alpha and the tied caches of Algorithm 1. Caches with the same frame and
  * map layout (coplanar caches: the usual tie) map a direction to the same
@@ -23,6 +24,8 @@ typedef struct iris_guide_vertex_state {
   iris_vec3 p;                          /* the shading point (the lamps' cones are seen from it) */
   uint32_t ids[IRIS_GUIDING_PICK_K];
   uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
+  uint8_t pane;                         /* the tied cache (index into ids) whose refracting plane the
+                                           map's directions pass ("Sky through a pane"); 0xff: none */
 } iris_guide_vertex_state;
 _Static_assert(sizeof(iris_guide_vertex_state) <= IRIS_GUIDE_VERTEX_BYTES, "guide vertex state too large");
 
@@ -101,6 +104,32 @@ static inline bool iris_guide_vertex_lamp_sample(const iris_guiding *g, const ir
   return true;
 }
 
+/* Density of the map's component at the vertex: the map's own, or carried
+ * through the plane of the tied cache v->pane ("Sky through a pane"). */
+static inline float iris_guide_vertex_sky_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
+                                              iris_vec3 wi) {
+  if (v->pane == 0xff) return iris_envmap_pdf(g->env, wi);
+  const float *pl = g->caches[v->ids[v->pane]].pane;
+  iris_vec3 ws;
+  float jac;
+  if (!iris_pane_to_sky(iris_v3(pl[0], pl[1], pl[2]), pl[3], wi, &ws, &jac)) return 0.0f;
+  return iris_envmap_pdf(g->env, ws) * jac;
+}
+
+/* Samples iris_guide_vertex_sky_pdf from (u1, u2); false where nothing is drawn. */
+static inline bool iris_guide_vertex_sky_sample(const iris_guiding *g, const iris_guide_vertex_state *v, float u1,
+                                                float u2, iris_vec3 *wi) {
+  float pdf;
+  iris_vec3 ws;
+  if (!iris_envmap_sample(g->env, u1, u2, &ws, &pdf, NULL)) return false;
+  if (v->pane == 0xff) {
+    *wi = ws;
+    return true;
+  }
+  const float *pl = g->caches[v->ids[v->pane]].pane;
+  return iris_pane_to_room(iris_v3(pl[0], pl[1], pl[2]), pl[3], ws, wi);
+}
+
 /* Density of the guide's strategy: the tied caches', mixed with the map's
  * where sky light arrives through glass (docs/guiding.md, "Sky behind glass")
  * and with the lamps' cones where lamp light does ("Lamps behind glass"). */
@@ -109,7 +138,7 @@ static inline float iris_guide_vertex_guide_pdf(const iris_guiding *g, const iri
   float pc = iris_guide_vertex_cache_pdf(g, v, wi);
   if (!(v->sky > 0.0f) && !(v->lamp > 0.0f)) return pc;
   float d = (1.0f - v->sky - v->lamp) * pc;
-  if (v->sky > 0.0f) d += v->sky * iris_envmap_pdf(g->env, wi);
+  if (v->sky > 0.0f) d += v->sky * iris_guide_vertex_sky_pdf(g, v, wi);
   if (v->lamp > 0.0f) d += v->lamp * iris_guide_vertex_lamp_pdf(g, v, wi);
   return d;
 }
