@@ -488,7 +488,7 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     through += c->pane_share;
     const float pn2 = c->pane[0] * c->pane[0] + c->pane[1] * c->pane[1] + c->pane[2] * c->pane[2];
     /* a share names a plane: a unit normal and an index ratio a build makes (1/4 to 4) */
-    const bool pane_ok = c->pane_share == 0.0f ||
+    const bool pane_ok = (c->pane_share == 0.0f && pn2 == 0.0f && c->pane[3] == 0.0f) || /* none: all zero */
                          (c->pane_share > 0.0f && c->pane_share <= 1.0f && fabsf(pn2 - 1.0f) < 1e-3f &&
                           c->pane[3] >= 0.25f && c->pane[3] <= 4.0f);
     if (!finite3(c->p) || !finite3(c->frame.s) || !finite3(c->frame.t) || !finite3(c->frame.n))
