@@ -10,6 +10,30 @@
 #include "renderer/guiding/guide_file.h"
 #include "renderer/merge.h"
 
+/* A cache's share of the light that its guided samples draw from the map
+ * (straight or through a pane) or from lamps' cones. */
+static float share_sky(const iris_cache *c) { return c->sky_through; }
+static float share_pane(const iris_cache *c) { return c->pane_share; }
+static float share_lamps(const iris_cache *c) {
+  float s = 0.0f;
+  for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) s += c->lamp_share[k];
+  return s;
+}
+
+/* Appends "; WHAT: N caches (mean share M)" over the caches with a share > 0. */
+static void append_shares(char *buf, size_t size, const iris_guiding *g, const char *what,
+                          float (*share)(const iris_cache *)) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    float v = share(&g->caches[i]);
+    if (v > 0.0f) sum += v, n++;
+  }
+  if (!n) return;
+  size_t l = strlen(buf);
+  snprintf(buf + l, size - l, "; %s: %zu caches (mean share %.2f)", what, n, sum / (double)n);
+}
+
 void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
   const iris_guiding_stats *s = &g->stats;
   if (s->skipped) {
@@ -29,39 +53,9 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     snprintf(alpha, sizeof alpha, "alpha <= %g", (double)g->params.alpha_max);
   char sky[384];
   iris_skyvis_describe(&g->sky, sky, sizeof sky);
-  /* caches that sample the map for sky light behind glass ("Sky behind glass") */
-  double tsum = 0.0;
-  size_t through = 0;
-  for (size_t i = 0; i < g->cache_count; ++i)
-    if (g->caches[i].sky_through > 0.0f) tsum += g->caches[i].sky_through, through++;
-  if (through) {
-    size_t l = strlen(sky);
-    snprintf(sky + l, sizeof sky - l, "; sky behind glass: %zu caches (mean share %.2f)", through,
-             tsum / (double)through);
-  }
-  /* ... and through one refracting plane ("Sky through a pane") */
-  double psum = 0.0;
-  size_t paned = 0;
-  for (size_t i = 0; i < g->cache_count; ++i)
-    if (g->caches[i].pane_share > 0.0f) psum += g->caches[i].pane_share, paned++;
-  if (paned) {
-    size_t l = strlen(sky);
-    snprintf(sky + l, sizeof sky - l, "; sky through a pane: %zu caches (mean share %.2f)", paned,
-             psum / (double)paned);
-  }
-  /* caches that aim at lamps behind glass ("Lamps behind glass") */
-  double lsum = 0.0;
-  size_t lamps = 0;
-  for (size_t i = 0; i < g->cache_count; ++i) {
-    float share = 0.0f;
-    for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) share += g->caches[i].lamp_share[k];
-    if (share > 0.0f) lsum += share, lamps++;
-  }
-  if (lamps) {
-    size_t l = strlen(sky);
-    snprintf(sky + l, sizeof sky - l, "; lamps behind glass: %zu caches (mean share %.2f)", lamps,
-             lsum / (double)lamps);
-  }
+  append_shares(sky, sizeof sky, g, "sky behind glass", share_sky);  /* "Sky behind glass" */
+  append_shares(sky, sizeof sky, g, "sky through a pane", share_pane); /* "Sky through a pane" */
+  append_shares(sky, sizeof sky, g, "lamps behind glass", share_lamps); /* "Lamps behind glass" */
   /* caches where light sampling became optional ("Light sampling where no light arrives") */
   size_t dark = 0;
   for (size_t i = 0; i < g->cache_count; ++i) dark += g->caches[i].light < 1.0f;
