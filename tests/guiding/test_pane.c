@@ -9,7 +9,7 @@
  *    directions' maps invert each other;
  *  - built on sky-room-pane (a window of one glass quad in the wall x = 2):
  *    most caches have a pane share, every plane is the window's (normal +x,
- *    eta 1.5 or 1/1.5), none in sky-room-glazed (its slab passes light
+ *    eta 1.5: the light enters the quad's front), none in sky-room-glazed (its slab passes light
  *    straight: the share is sky_through's) or sky-room (no glass), and the
  *    same for 1 and 2 threads. Fails when photons through one refraction are
  *    not flagged, or flagged with the wrong side's normal or index. */
@@ -117,7 +117,8 @@ static panes built(const char *scene, int threads) {
       p.slabbed += c->sky_through > 0.0f;
       if (!(c->pane_share > 0.0f)) continue;
       p.shared++;
-      const bool window = c->pane[0] > 0.999f && (fabsf(c->pane[3] - 1.5f) < 1e-4f || fabsf(c->pane[3] - 1.0f / 1.5f) < 1e-4f);
+      /* the quad's front faces the sky (+x): the light enters glass of index 1.5 */
+      const bool window = c->pane[0] > 0.999f && fabsf(c->pane[3] - 1.5f) < 1e-4f;
       p.window += window;
       p.other_plane += !window;
     }
