@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "renderer/accel.h"
+#include "renderer/envmap.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/lights.h"
 #include "renderer/render.h"
@@ -66,6 +67,17 @@ static inline iris_guiding *test_guide_build(const iris_scene *s, iris_method me
   iris_guiding *g = test_guide_build_in(s, &t, gp, seed, threads, spp);
   test_guide_scene_close(&t);
   return g;
+}
+
+/* Loads the environment map at `path` (strength 1, rotated by `rotation`
+ * degrees) into *env; false (and the message) when it cannot. */
+static inline bool test_envmap_open(const char *path, float rotation, iris_envmap *env) {
+  iris_environment_map m = {(char *)path, 1.0f, rotation};
+  iris_error err;
+  iris_error_clear(&err);
+  if (iris_envmap_load(&m, env, &err) == IRIS_OK) return true;
+  fprintf(stderr, "environment map %s: %s\n", path, err.message);
+  return false;
 }
 
 #endif

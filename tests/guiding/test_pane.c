@@ -52,13 +52,8 @@ static double pane_pdf(void *vc, const double dir[3]) {
 }
 
 static void test_density(const char *path) {
-  iris_environment_map m = {(char *)path, 1.0f, 40.0f};
   iris_envmap env;
-  iris_error err;
-  iris_error_clear(&err);
-  iris_status st = iris_envmap_load(&m, &env, &err);
-  CHECK_OK(st, &err);
-  if (st != IRIS_OK) return;
+  if (!CHECK(test_envmap_open(path, 40.0f, &env))) return;
   const float etas[2] = {1.5f, 1.0f / 1.5f};
   chi2_domain dom = {CHI2_SPHERE, 32, 64, 29};
   for (int k = 0; k < 2; ++k) {

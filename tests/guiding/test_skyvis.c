@@ -87,13 +87,11 @@ static double mix_pdf(void *vc, const double dir[3]) {
 #define N_TESTS 5
 
 static void test_regions_and_mixture(const char *path) {
-  iris_environment_map m = {(char *)path, 1.0f, 23.0f};
   iris_envmap env;
+  if (!CHECK(test_envmap_open(path, 23.0f, &env))) return;
   iris_error err;
   iris_error_clear(&err);
-  iris_status st = iris_envmap_load(&m, &env, &err);
-  CHECK_OK(st, &err);
-  if (st != IRIS_OK) return;
+  iris_status st;
   iris_envmap_regions R;
   st = iris_envmap_regions_build(&env, 7, 3, &R, &err);
   CHECK_OK(st, &err);
