@@ -77,7 +77,7 @@ static inline void iris_sampler_set_bounce(iris_sampler *rng, int bounce) {
  * by iris_direction_sampler.prepare, read by its sample and pdf at that
  * vertex (guiding keeps the caches it picked for the point here, so the
  * cache search runs once per bounce, not once per sample/pdf call). */
-#define IRIS_GUIDE_VERTEX_BYTES 64
+#define IRIS_GUIDE_VERTEX_BYTES 96
 typedef struct iris_guide_vertex {
   _Alignas(16) unsigned char bytes[IRIS_GUIDE_VERTEX_BYTES];
 } iris_guide_vertex;

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "core/image.h"
+#include "renderer/guiding/photons.h"
 
 /* Measured costs (docs/performance.md, "Memory estimate"; Embree 3.13 with
  * ROBUST and HIGH quality, from its memory monitor and peak RSS). */
@@ -18,7 +19,8 @@
 #define BYTES_PER_EMISSIVE_TRIANGLE 280.0 /* tables and tree; +100 for the descent's wide nodes (384 B, ~1 per 2 leaves) */
 #define BASE_BYTES 14e6                 /* iris + libraries + Embree's threads */
 #define PATH_BYTES 304.0                /* one photon path: ~4 stored photons (64 B) and their kd-tree */
-#define CACHE_BYTES 1424.0              /* one 8x8 cache with its tables */
+#define CACHE_BYTES 1428.0              /* one 8x8 cache with its tables */
+#define GLINT_BYTES 3.8e6               /* glint photons and their tree (guiding/glints.h), with a smooth material */
 #define LIGHT_SELECT_BYTES 129.0        /* one cache's learned light table (guiding/light_select.h) */
 #define FILM_BYTES_PER_PIXEL 62.0       /* sums, counts and the EXR image */
 #define ENV_BYTES_PER_TEXEL 24.0        /* RGB float + sampling tables */
@@ -38,6 +40,12 @@ static bool affine(const iris_mat4 *m) {
 static uint64_t file_size(const char *path) {
   struct stat st;
   return path && stat(path, &st) == 0 && st.st_size > 0 ? (uint64_t)st.st_size : 0;
+}
+
+/* A material that may reflect glints (renderer/guiding/glints.h): not diffuse,
+ * and smooth enough, or textured so that it may be. */
+static bool may_be_smooth(const iris_material *m) {
+  return m->type != IRIS_MATERIAL_DIFFUSE && (m->roughness <= IRIS_GLINT_ROUGHNESS || m->metallic_roughness_texture >= 0);
 }
 
 void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool guided,
@@ -123,6 +131,11 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
     /* learned light selection: with more than one light to choose from */
     if (emissive_tris + s->light_count > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
     out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;
+    for (size_t m = 0; m < s->material_count; m++)
+      if (may_be_smooth(&s->materials[m])) { /* glints: at most one set of 65536 paths */
+        out->guide += (uint64_t)GLINT_BYTES;
+        break;
+      }
   }
   out->film = (uint64_t)(FILM_BYTES_PER_PIXEL * (double)width * height);
   out->base = (uint64_t)BASE_BYTES;

@@ -196,6 +196,7 @@ static uint64_t guiding_params_hash(const iris_guiding_params *gp) {
   }
   /* lamps behind glass off: renders with it on keep the hash they had before it */
   if (!gp->lamp_glass) h = iris_mix64(h ^ 0x1a3b91a55ULL);
+  if (!gp->glints) h = iris_mix64(h ^ 0x611e75ULL); /* glints off: likewise */
   /* light sampling made optional where it brought nothing: likewise */
   if (gp->light_min != IRIS_GUIDING_LIGHT_MIN) {
     uint64_t bits;

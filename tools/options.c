@@ -135,6 +135,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("no-lamp-glass", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, lamp_glass,
         "do not aim guided directions at lamps whose light reaches\n"
         "a surface straight through glass (lamps behind glass)"),
+    OPT("no-glints", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, glints,
+        "do not aim guided directions at the spots where a mirror,\n"
+        "glass or near-mirror metal reflects a light (glints)"),
     OPT("light-min", 0, IRIS_OPT_FLOAT, "P", 0.001, 1, iris_guiding_params, light_min,
         "probability of light sampling where the caches' training\n"
         "found it brings no light (default 0.1; 1: always)"),

@@ -15,7 +15,8 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES (94u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
+#define CACHE_BYTES (98u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
+#define GLINT_BYTES 40u      /* one glint photon: p, n, y (9 f32), energy f32 */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
 #define GUIDE_FLAG_LIGHTS 1u /* learned light tables follow the alias tables (light_select.h) */
@@ -187,6 +188,10 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     put_vec3(&w, g->lamps[i].center);
     put_f32(&w, g->lamps[i].radius);
   }
+  const uint32_t glints = skipped ? 0 : g->glints.count; /* glint photons ("Glints"), written last */
+  put_f32(&w, glints ? g->glints.radius2 : 0.0f);
+  put_u64(&w, glints ? g->glints.paths : 0);
+  put_u32(&w, glints);
   put_u64(&w, (uint64_t)count);
   put_u64(&w, texels);
   /* Caches, with table offsets into the compacted tables (the in-memory
@@ -212,6 +217,7 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     }
     put_f32(&w, c->pane_share);
     for (int k = 0; k < 4; ++k) put_f32(&w, c->pane[k]);
+    put_f32(&w, c->glint_share);
     at += texels_of(g, c);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -246,6 +252,13 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
         put_f32(&w, sl->cdf);
       }
     }
+  }
+  for (uint32_t i = 0; i < glints; ++i) {
+    const iris_glint_photon *gp = &g->glints.photons[i];
+    put_vec3(&w, gp->p);
+    put_vec3(&w, gp->n);
+    put_vec3(&w, gp->y);
+    put_f32(&w, gp->energy);
   }
   if (w.failed) {
     free(w.data);
@@ -419,8 +432,13 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     if (!finite3(g->lamps[i].center) || !(g->lamps[i].radius >= 0.0f && isfinite(g->lamps[i].radius)))
       return refuse(err, path, "guide file has an invalid lamp (corrupted)");
   }
+  const float glint_r2 = get_f32(r);
+  const uint64_t glint_paths = get_u64(r);
+  const uint32_t glints = get_u32(r);
   uint64_t count = get_u64(r), texels = get_u64(r);
   if (r->short_read) return refuse(err, path, "guide file is truncated");
+  if (!(glints == 0 ? glint_r2 == 0.0f && glint_paths == 0 : glint_r2 > 0.0f && isfinite(glint_r2) && glint_paths >= glints))
+    return refuse(err, path, "guide file has invalid glint photon counts (corrupted)");
   if (res != (uint32_t)g->params.cache_res)
     return refuse(err, path, "guide file's map size differs from its cache resolution (corrupted)");
   if (isnan(g->pick_radius2) || !(g->pick_radius2 > 0.0f || (g->stats.skipped && g->pick_radius2 == 0.0f)) ||
@@ -434,8 +452,9 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
   const bool refined = g->params.refine > 0;
   const uint64_t cache_bytes = CACHE_BYTES + (refined ? REFINE_CACHE_BYTES : 0);
   const uint64_t texel_bytes = TEXEL_BYTES + (refined ? 1u : 0u);
-  if (count > r->left / cache_bytes || texels > r->left / texel_bytes ||
-      count * cache_bytes + texels * texel_bytes + light_bytes != r->left)
+  const uint64_t glint_bytes = (uint64_t)glints * GLINT_BYTES;
+  if (count > r->left / cache_bytes || texels > r->left / texel_bytes || glint_bytes > r->left ||
+      count * cache_bytes + texels * texel_bytes + light_bytes + glint_bytes != r->left)
     return refuse(err, path, "guide file's cache and texel counts do not match its size (corrupted)");
   if (count > UINT32_MAX || texels > UINT32_MAX)
     return refuse(err, path, "guide file has too many caches or texels");
@@ -486,6 +505,10 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     c->pane_share = get_f32(r);
     for (int k = 0; k < 4; ++k) c->pane[k] = get_f32(r);
     through += c->pane_share;
+    c->glint_share = get_f32(r);
+    through += c->glint_share;
+    /* a share asks the vertex for a spot among glint photons: there must be some */
+    const bool glint_ok = c->glint_share == 0.0f || (c->glint_share > 0.0f && c->glint_share <= 1.0f && glints > 0);
     const float pn2 = c->pane[0] * c->pane[0] + c->pane[1] * c->pane[1] + c->pane[2] * c->pane[2];
     /* a share names a plane: a unit normal and an index ratio a build makes (1/4 to 4) */
     const bool pane_ok = (c->pane_share == 0.0f && pn2 == 0.0f && c->pane[3] == 0.0f) || /* none: all zero */
@@ -499,6 +522,8 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid values (corrupted)", i);
     if (!pane_ok)
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid pane (corrupted)", i);
+    if (!glint_ok)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid glint share (corrupted)", i);
     if (!lamps_ok || !(through <= 1.001f)) /* the shares are of the same photons' energy */
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid lamp shares (corrupted)", i);
     /* Tables are stored back to back in cache order: exactly one offset is right. */
@@ -557,6 +582,22 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
         sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + k].leaf = get_u32(r);
         sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + k].cdf = get_f32(r);
       }
+    }
+  }
+  if (glints) {
+    g->glints.photons = malloc((size_t)glints * sizeof *g->glints.photons);
+    if (!g->glints.photons) return iris_error_set(err, IRIS_ERR_NOMEM, path, 0, NULL, "out of memory for glint photons");
+    g->glints.count = glints;
+    g->glints.radius2 = glint_r2;
+    g->glints.paths = glint_paths;
+    for (uint32_t i = 0; i < glints; ++i) {
+      iris_glint_photon *gp = &g->glints.photons[i];
+      gp->p = get_vec3(r);
+      gp->n = get_vec3(r);
+      gp->y = get_vec3(r);
+      gp->energy = get_f32(r);
+      if (!finite3(gp->p) || !finite3(gp->n) || !finite3(gp->y) || !(gp->energy > 0.0f && isfinite(gp->energy)))
+        return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "glint photon %u: invalid values (corrupted)", i);
     }
   }
   if (r->short_read || r->left != 0) return refuse(err, path, "guide file is truncated");
@@ -630,6 +671,7 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
     st = iris_kdtree_build(&g->tree, &g->caches[0].p, sizeof(iris_cache), (uint32_t)g->cache_count, err);
   if (st == IRIS_OK && !g->stats.skipped)
     st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing, threads, err);
+  if (st == IRIS_OK) st = iris_glints_index(&g->glints, threads, err);
   if (st == IRIS_OK && (g->grid.n[0] != grid_n[0] || g->grid.n[1] != grid_n[1] || g->grid.n[2] != grid_n[2] ||
                         (grid_n[0] && memcmp(g->grid.lo, grid_lo, sizeof grid_lo) != 0)))
     st = refuse(err, path, "the cache grid rebuilt from the guide file differs from the one written (corrupted)");
@@ -643,7 +685,8 @@ iris_status iris_guiding_load(const char *path, uint64_t scene_hash, uint64_t se
   g->stats.memory_bytes = (sizeof(iris_cache) + sizeof(float) * 3 + sizeof(uint32_t) + 1) * g->cache_count +
                           (sizeof(float) + sizeof(iris_cache_alias)) * texels +
                           sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) + g->grid.memory_bytes +
-                          (g->refine_sub ? texels + (size_t)REFINE_CACHE_BYTES * (texels / g->hemi.texel_count + 1) : 0);
+                          (g->refine_sub ? texels + (size_t)REFINE_CACHE_BYTES * (texels / g->hemi.texel_count + 1) : 0) +
+                          iris_glints_bytes(g->glints.count);
   iris_guiding_count_refined(g);
   *out = g;
   return IRIS_OK;
@@ -713,6 +756,7 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   h = mix_u64(h, (uint64_t)(int64_t)p->refine);
   /* lamps behind glass: keeps the hash of guides without lamp light through glass */
   if (!p->lamp_glass) h = mix_u64(h, 0x1a3b91a55ULL);
+  if (!p->glints) h = mix_u64(h, 0x611e75ULL);
   h = mix_f32(h, p->light_min);
   return h;
 }

@@ -60,11 +60,12 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->lamp = 0.0f;
   v->light = 1.0f;
   v->pane = 0xff;
+  v->glint = 0.0f;
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
      * caches' mean replaces alpha_max; a glossy lobe's roughness still caps it. */
-    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f, light = 0.0f, pane = 0.0f;
+    float r = 0.0f, a = 0.0f, sky = 0.0f, lamp = 0.0f, light = 0.0f, pane = 0.0f, glint = 0.0f;
     int learned = 0;
     for (int i = 0; i < v->m; ++i) {
       const iris_cache *c = &g->caches[v->ids[i]];
@@ -75,6 +76,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
       light = fmaxf(light, c->light); /* any tied cache that saw light arrive keeps it sampled */
       sky += c->sky_through;
       for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) lamp += c->lamp_share[k];
+      glint += c->glint_share;
       if (c->alpha >= 0.0f) a += c->alpha, learned++;
     }
     v->radiance = r / (float)v->m;
@@ -87,6 +89,10 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
      * glass from a lamp, which the lamp's cone finds; one mixture with the
      * sky's (the shares are of the same photons: they sum to at most 1). */
     v->lamp = fminf(lamp / (float)v->m, 1.0f - v->sky);
+    /* Glints: where the tied caches lie among glint photons, the spot the
+     * vertex's nearest ones left (glints.h), if they agree on one. */
+    if (glint > 0.0f && iris_glints_spot(&g->glints, v->p, sp->frame.n, &v->spot))
+      v->glint = fmaxf(0.0f, fminf(glint / (float)v->m, 1.0f - v->sky - v->lamp));
     if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a / (float)v->m);
   }
   /* The pdf tables of the tied caches are needed after this vertex's shadow
@@ -162,6 +168,13 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
      * roulette must not cut it on its way through the glass */
     out->aimed = true;
     return guided_finish(g, sp, v, alpha, wi, out);
+  }
+  if (us < v->sky + v->lamp + v->glint) { /* a glint: the spot's cone */
+    float u1, u2;
+    iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
+    iris_lamp_cone cone = iris_lamp_cone_at(&v->spot, v->p);
+    out->aimed = true; /* its throughput is small where the cone is dense, as a lamp's */
+    return guided_finish(g, sp, v, alpha, iris_lamp_cone_sample(&cone, u1, u2), out);
   }
   /* Cache strategy: one of the tied caches, uniformly (Algorithm 1), then Algorithm 2. */
   float uc, u0, u1, u2;

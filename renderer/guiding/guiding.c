@@ -42,6 +42,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.sky_beta = -1.0f;
   p.refine = -1;
   p.lamp_glass = true;
+  p.glints = true;
   p.light_min = IRIS_GUIDING_LIGHT_MIN;
   return p;
 }
@@ -355,6 +356,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     cache->photons = used;
     cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
     cache->pane_share = 0.0f;
+    cache->glint_share = 0.0f; /* build_glints, once the caches' spacing is known */
     memset(cache->pane, 0, sizeof cache->pane);
     const double pn = sqrt(pane[0] * pane[0] + pane[1] * pane[1] + pane[2] * pane[2]);
     if (g->env && power > 0.0 && paned > 0.0 && pn > 0.5 * paned) { /* one plane's photons, not opposed ones */
@@ -389,6 +391,52 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
         g->photon_hist[cache->table + t] = (float)(hist[t] / sum);
     }
   }
+}
+
+/* ---- glints ---------------------------------------------------------------- */
+
+/* Glint photon paths traced when photons met smooth surfaces ("Glints"). */
+#define GLINT_PATHS 65536u
+#define GLINT_DENSITY_SAMPLES 4096u
+#define GLINT_REACH 2.0f
+
+static int by_float(const void *a, const void *b) {
+  const float x = *(const float *)a, y = *(const float *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* Traces the glint photons and gives every cache among them its share: a
+ * vertex looks for them within the caches' spacing. */
+static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons,
+                                float spacing, iris_error *err) {
+  iris_status st = iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err);
+  if (st != IRIS_OK || g->glints.count == 0) return st;
+  /* A vertex looks GLINT_REACH times as far as the median distance to the
+   * IRIS_GLINT_K-th nearest glint photon among themselves (a sample of them),
+   * at most the caches' spacing: wide where they are sparse, no wider. */
+  const uint32_t samples = g->glints.count < GLINT_DENSITY_SAMPLES ? g->glints.count : GLINT_DENSITY_SAMPLES;
+  float *dk = malloc(sizeof(float) * samples);
+  if (!dk) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for glint photons");
+  for (uint32_t j = 0; j < samples; ++j) {
+    uint32_t ids[IRIS_GLINT_K + 1];
+    float d2[IRIS_GLINT_K + 1];
+    const iris_vec3 q = g->glints.photons[(uint64_t)j * g->glints.count / samples].p;
+    const uint32_t n = iris_kdtree_knn(&g->glints.tree, q, IRIS_GLINT_K + 1, INFINITY, ids, d2);
+    dk[j] = n ? d2[n - 1] : 0.0f;
+  }
+  qsort(dk, samples, sizeof *dk, by_float);
+  const float median2 = dk[samples / 2];
+  free(dk);
+  g->glints.radius2 = fminf(GLINT_REACH * GLINT_REACH * median2, spacing * spacing);
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    iris_cache *c = &g->caches[i];
+    float taken = c->sky_through + c->pane_share;
+    for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) taken += c->lamp_share[k];
+    iris_guide_lamp spot;
+    if (iris_glints_spot(&g->glints, c->p, c->frame.n, &spot))
+      c->glint_share = fmaxf(0.0f, fminf(IRIS_GLINT_SHARE, 1.0f - taken));
+  }
+  return IRIS_OK;
 }
 
 /* ---- budget ---------------------------------------------------------------- */
@@ -788,13 +836,15 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (st == IRIS_OK)
         st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing,
                                   s->threads, err);
+      if (st == IRIS_OK && p->glints && photons.smooth_count > 0) st = build_glints(g, s, &photons, spacing, err);
       g->stats.memory_bytes = sizeof(iris_cache) * kept + (sizeof(float) + sizeof(iris_cache_alias)) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
                               sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +
                               g->grid.memory_bytes +
                               (g->refine_sub ? floats + sizeof(float) * IRIS_REFINE_MAX * IRIS_REFINE_SUB *
                                                             (floats / g->hemi.texel_count + 1)
-                                             : 0);
+                                             : 0) +
+                              iris_glints_bytes(g->glints.count);
     }
   }
   if (st == IRIS_OK && !g->stats.skipped && s->learn_lights && g->cache_count) {
@@ -887,6 +937,7 @@ void iris_guiding_destroy(iris_guiding *g) {
   if (!g) return;
   iris_skyvis_destroy(&g->sky);
   iris_light_select_destroy(&g->lights);
+  iris_glints_destroy(&g->glints);
   iris_octmap_destroy(&g->hemi);
   iris_octmap_destroy(&g->sphere);
   iris_kdtree_destroy(&g->tree);

@@ -13,6 +13,7 @@
 
 #include "core/error.h"
 #include "renderer/guiding/cache.h"
+#include "renderer/guiding/glints.h"
 #include "renderer/guiding/kdtree.h"
 #include "renderer/guiding/lamps.h"
 #include "renderer/guiding/light_select.h"
@@ -84,6 +85,10 @@ typedef struct iris_guiding_params {
   bool lamp_glass;      /* lamps behind glass: caches learn which emitter groups' light reached
                            them straight through glass, and the guide draws directions in
                            those groups' cones (default on; --no-lamp-glass; lamps.h) */
+  bool glints;          /* glints: photons aimed at smooth surfaces (mirrors, glass, near-mirror
+                           metal) mark where their reflections of the lights land, and the guide
+                           draws directions in the cone of the spot a vertex's nearest ones left
+                           (default on; --no-glints; glints.h, docs/guiding.md "Glints") */
   float light_min;      /* light sampling's probability at vertices whose caches' training traced
                            >= 32 light samples and none brought light (--light-min; 1: always
                            sample lights; docs/guiding.md, "Light sampling where no light arrives") */
@@ -136,6 +141,10 @@ typedef struct iris_cache {
                         through pane[] ("Sky through a pane"); sky_through + pane_share +
                         the lamp shares <= 1 */
   float pane[4];     /* that plane: energy-weighted normal on the sky's side, eta = n_room / n_sky */
+  float glint_share;  /* of the guide's share, the probability of drawing in the cone of the
+                        glint spot a vertex finds among the glint photons near it (glints.h):
+                        IRIS_GLINT_SHARE where enough of them lie within the caches' spacing,
+                        else 0 ("Glints"); with the shares above <= 1 */
   uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
@@ -185,6 +194,7 @@ typedef struct iris_guiding {
                               at the build, stored in the guide file): what iris_cache.lamp names */
   size_t lamp_count;
   iris_light_select lights; /* learned light selection (setup->learn_lights; light_select.h) */
+  iris_glints glints;       /* glint photons ("Glints"; glints.h): what iris_cache.glint_share asks for */
   iris_guiding_stats stats;
 } iris_guiding;
 

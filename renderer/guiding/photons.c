@@ -19,6 +19,8 @@ typedef struct photon_block {
   iris_photon *items;
   size_t count, cap;
   size_t at;       /* offset in the concatenated array */
+  iris_vec3 *smooth; /* smooth vertices met (iris_photon_map.smooth) */
+  size_t smooth_count, smooth_cap, smooth_at;
   uint64_t indirect;
   bool oom;
 } photon_block;
@@ -29,6 +31,7 @@ typedef struct trace_ctx {
   uint64_t first, paths;        /* path indices first .. paths - 1 */
   photon_block *blocks;
   iris_photon *all; /* concatenation target */
+  iris_vec3 *smooth; /* ... of the smooth vertices */
 } trace_ctx;
 
 static void block_push(photon_block *b, const iris_photon *ph) {
@@ -46,6 +49,27 @@ static void block_push(photon_block *b, const iris_photon *ph) {
     b->cap = cap;
   }
   b->items[b->count++] = *ph;
+}
+
+bool iris_photon_smooth(const iris_shading_point *sp) {
+  if (sp->delta) return true;
+  return (sp->lobes & IRIS_LOBE_GLOSSY) && !(sp->lobes & IRIS_LOBE_DIFFUSE) &&
+         iris_bsdf_guiding_roughness(&sp->bsdf) <= IRIS_GLINT_ROUGHNESS;
+}
+
+static void smooth_push(photon_block *b, iris_vec3 p) {
+  if (b->oom) return;
+  if (b->smooth_count == b->smooth_cap) {
+    size_t cap = b->smooth_cap ? 2 * b->smooth_cap : 256;
+    iris_vec3 *n = realloc(b->smooth, cap * sizeof *n);
+    if (!n) {
+      b->oom = true;
+      return;
+    }
+    b->smooth = n;
+    b->smooth_cap = cap;
+  }
+  b->smooth[b->smooth_count++] = p;
 }
 
 static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, uint64_t index,
@@ -119,6 +143,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       block_push(out, &ph);
       specular_only = lamp_only = false;
     }
+    if (iris_photon_smooth(&sp)) smooth_push(out, si.p);
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
     if (sp.delta && specular_only && ++deltas == 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION) && sp.bsdf.ior > 0.0f &&
@@ -167,8 +192,11 @@ static void copy_blocks(void *ctx, uint64_t begin, uint64_t end, int thread_inde
   for (uint64_t b = begin; b < end; ++b) {
     photon_block *blk = &c->blocks[b];
     if (blk->count) memcpy(c->all + blk->at, blk->items, blk->count * sizeof *c->all);
+    if (blk->smooth_count) memcpy(c->smooth + blk->smooth_at, blk->smooth, blk->smooth_count * sizeof *c->smooth);
     free(blk->items);
+    free(blk->smooth);
     blk->items = NULL;
+    blk->smooth = NULL;
   }
 }
 
@@ -196,34 +224,40 @@ iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for photons");
   }
   trace_ctx c = {setup, by == IRIS_EMIT_BY_AREA ? &area_select : &setup->lights->select, first, paths, blocks,
-                 NULL};
+                 NULL, NULL};
   iris_parallel_for(nblocks, 1, setup->threads, trace_blocks, &c);
   iris_distrib1d_destroy(&area_select);
   if (iris_cancel_requested()) {
-    for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items);
+    for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items), free(blocks[b].smooth);
     free(blocks);
     return iris_cancel_error(err);
   }
-  size_t total = out->count; /* the new photons go after the ones already traced */
+  size_t total = out->count, smooth = out->smooth_count; /* the new ones go after those already traced */
   uint64_t indirect = 0;
   bool oom = false;
   for (uint64_t b = 0; b < nblocks; ++b) {
     blocks[b].at = total;
     total += blocks[b].count;
+    blocks[b].smooth_at = smooth;
+    smooth += blocks[b].smooth_count;
     indirect += blocks[b].indirect;
     oom |= blocks[b].oom;
   }
   iris_photon *all = oom ? NULL : realloc(out->photons, (total ? total : 1) * sizeof *all);
-  if (all) {
-    out->photons = all;
+  if (all) out->photons = all;
+  iris_vec3 *sm = all ? realloc(out->smooth, (smooth ? smooth : 1) * sizeof *sm) : NULL;
+  if (sm) {
+    out->smooth = sm;
     c.all = all;
+    c.smooth = sm;
     iris_parallel_for(nblocks, 1, setup->threads, copy_blocks, &c);
   }
-  for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items);
+  for (uint64_t b = 0; b < nblocks; ++b) free(blocks[b].items), free(blocks[b].smooth);
   free(blocks);
-  if (!all)
+  if (!sm)
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %zu photons", total);
   out->count = total;
+  out->smooth_count = smooth;
   out->paths = paths;
   out->indirect += indirect;
   return IRIS_OK;
@@ -231,5 +265,6 @@ iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission
 
 void iris_photons_destroy(iris_photon_map *map) {
   free(map->photons);
+  free(map->smooth);
   memset(map, 0, sizeof *map);
 }

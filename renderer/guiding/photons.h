@@ -7,6 +7,7 @@
 #ifndef IRIS_RENDERER_GUIDING_PHOTONS_H
 #define IRIS_RENDERER_GUIDING_PHOTONS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -19,6 +20,9 @@ extern "C" {
 #endif
 
 #define IRIS_PHOTON_MAX_BOUNCES 32
+/* The largest roughness of a glossy lobe whose reflection of a light is a
+ * glint: a spot too small for a cache's texels (docs/guiding.md, "Glints"). */
+#define IRIS_GLINT_ROUGHNESS 0.1f
 
 /* One stored photon (64 bytes). Energy is a single float, the mean
  * of the RGB power (the thesis's choice): the caches only need the relative
@@ -45,6 +49,9 @@ typedef struct iris_photon {
 typedef struct iris_photon_map {
   iris_photon *photons;
   size_t count;
+  iris_vec3 *smooth;    /* where photon paths met smooth surfaces (iris_photon_smooth), in path
+                           order: the targets of the glint photons (glints.h) */
+  size_t smooth_count;
   uint64_t paths;     /* photon paths emitted */
   uint64_t indirect;  /* stored photons with bounce >= 1 */
 } iris_photon_map;
@@ -59,6 +66,9 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
 iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
                                     iris_photon_map *map, iris_error *err);
 void iris_photons_destroy(iris_photon_map *map);
+/* A smooth vertex: a delta BSDF, or glossy lobes of roughness <= IRIS_GLINT_ROUGHNESS
+ * without a diffuse one; what turns a light into a glint. */
+bool iris_photon_smooth(const iris_shading_point *sp);
 
 #ifdef __cplusplus
 }

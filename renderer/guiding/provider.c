@@ -11,7 +11,7 @@
 #include "renderer/merge.h"
 
 /* A cache's share of the light that its guided samples draw from the map
- * (straight or through a pane) or from lamps' cones. */
+ * (straight or through a pane), from lamps' cones or from glint spots' cones. */
 static float share_sky(const iris_cache *c) { return c->sky_through; }
 static float share_pane(const iris_cache *c) { return c->pane_share; }
 static float share_lamps(const iris_cache *c) {
@@ -19,6 +19,7 @@ static float share_lamps(const iris_cache *c) {
   for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) s += c->lamp_share[k];
   return s;
 }
+static float share_glints(const iris_cache *c) { return c->glint_share; }
 
 /* Appends "; WHAT: N caches (mean share M)" over the caches with a share > 0. */
 static void append_shares(char *buf, size_t size, const iris_guiding *g, const char *what,
@@ -56,6 +57,7 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
   append_shares(sky, sizeof sky, g, "sky behind glass", share_sky);  /* "Sky behind glass" */
   append_shares(sky, sizeof sky, g, "sky through a pane", share_pane); /* "Sky through a pane" */
   append_shares(sky, sizeof sky, g, "lamps behind glass", share_lamps); /* "Lamps behind glass" */
+  append_shares(sky, sizeof sky, g, "glints", share_glints);             /* "Glints" */
   /* caches where light sampling became optional ("Light sampling where no light arrives") */
   size_t dark = 0;
   for (size_t i = 0; i < g->cache_count; ++i) dark += g->caches[i].light < 1.0f;

@@ -26,6 +26,8 @@ typedef struct iris_guide_vertex_state {
   uint8_t same_as[IRIS_GUIDING_PICK_K]; /* first tied cache with this one's frame */
   uint8_t pane;                         /* the tied cache (index into ids) whose refracting plane the
                                            map's directions pass ("Sky through a pane"); 0xff: none */
+  float glint;                          /* ... and the glint spot's cone's ("Glints"); 0: no spot */
+  iris_guide_lamp spot;                 /* the glint spot seen from p (glints.h) */
 } iris_guide_vertex_state;
 _Static_assert(sizeof(iris_guide_vertex_state) <= IRIS_GUIDE_VERTEX_BYTES, "guide vertex state too large");
 
@@ -104,6 +106,13 @@ static inline bool iris_guide_vertex_lamp_sample(const iris_guiding *g, const ir
   return true;
 }
 
+/* Density of the glint spot's component ("Glints"): uniform in its cone from the vertex. */
+static inline float iris_guide_vertex_glint_pdf(const iris_guide_vertex_state *v, iris_vec3 wi) {
+  if (!iris_lamp_contains(&v->spot, v->p, wi)) return 0.0f;
+  iris_lamp_cone cone = iris_lamp_cone_at(&v->spot, v->p);
+  return iris_lamp_cone_pdf(&cone);
+}
+
 /* Density of the map's component at the vertex: the map's own, or carried
  * through the plane of the tied cache v->pane ("Sky through a pane"). */
 static inline float iris_guide_vertex_sky_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
@@ -136,10 +145,11 @@ static inline bool iris_guide_vertex_sky_sample(const iris_guiding *g, const iri
 static inline float iris_guide_vertex_guide_pdf(const iris_guiding *g, const iris_guide_vertex_state *v,
                                                 iris_vec3 wi) {
   float pc = iris_guide_vertex_cache_pdf(g, v, wi);
-  if (!(v->sky > 0.0f) && !(v->lamp > 0.0f)) return pc;
-  float d = (1.0f - v->sky - v->lamp) * pc;
+  if (!(v->sky > 0.0f) && !(v->lamp > 0.0f) && !(v->glint > 0.0f)) return pc;
+  float d = (1.0f - v->sky - v->lamp - v->glint) * pc;
   if (v->sky > 0.0f) d += v->sky * iris_guide_vertex_sky_pdf(g, v, wi);
   if (v->lamp > 0.0f) d += v->lamp * iris_guide_vertex_lamp_pdf(g, v, wi);
+  if (v->glint > 0.0f) d += v->glint * iris_guide_vertex_glint_pdf(v, wi);
   return d;
 }
 

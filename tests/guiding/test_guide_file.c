@@ -27,7 +27,7 @@
 
 #define SCENE_HASH 0x1234567890abcdefULL
 #define SETTINGS_HASH 0xfedcba0987654321ULL
-#define CB (94 + 5 * IRIS_CACHE_LAMPS) /* bytes of one cache record */
+#define CB (98 + 5 * IRIS_CACHE_LAMPS) /* bytes of one cache record */
 
 static iris_guiding *build(const char *name, iris_method method, int64_t photons, bool force) {
   iris_scene *s = NULL;
@@ -55,7 +55,8 @@ static bool same_caches(const iris_guiding *a, const iris_guiding *b) {
     if (memcmp(&x->p, &y->p, sizeof x->p) || memcmp(&x->frame, &y->frame, sizeof x->frame) ||
         x->photons != y->photons || memcmp(&x->radiance, &y->radiance, sizeof(float)) ||
         memcmp(&x->alpha, &y->alpha, sizeof(float)) || memcmp(&x->light, &y->light, sizeof(float)) ||
-        memcmp(&x->pane_share, &y->pane_share, sizeof(float)) || memcmp(x->pane, y->pane, sizeof x->pane) || x->sphere != y->sphere || x->from_camera != y->from_camera)
+        memcmp(&x->pane_share, &y->pane_share, sizeof(float)) || memcmp(x->pane, y->pane, sizeof x->pane) ||
+        memcmp(&x->glint_share, &y->glint_share, sizeof(float)) || x->sphere != y->sphere || x->from_camera != y->from_camera)
       return false;
     uint32_t n = texels(a, x);
     if (memcmp(a->pdf + x->table, b->pdf + y->table, n * sizeof(float)) ||
@@ -271,6 +272,8 @@ static void refusals(const char *dir, iris_guiding *g) {
       {caches_at + CB * 5 + 79, 4, 0x3e800000u, "lamp shares"},         /* 0.25 in slot 1, slot 0 empty */
       {caches_at + CB * 6 + 94, 4, 0x3e800000u, "invalid pane"},        /* a pane share 0.25 with no plane */
       {caches_at + CB * 6 + 94, 4, 0x3fc00000u, "invalid pane"},        /* a pane share 1.5 */
+      {caches_at + CB * 7 + 114, 4, 0x3e800000u, "invalid glint share"}, /* a glint share 0.25 with no glint photons */
+      {caches_at + CB * 7 + 114, 4, 0x7fc00000u, "invalid glint share"}, /* a NaN glint share */
       {pdf_at + 4 * 17, 4, 0x7fc00000u, "not finite"},                 /* NaN pdf */
       {pdf_at + 4 * 18, 4, 0xbf800000u, "negative"},                   /* pdf -1 */
       {pdf_at + 4 * 19, 4, 0x7f800000u, "not finite"},                 /* inf pdf */

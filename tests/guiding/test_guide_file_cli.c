@@ -163,9 +163,11 @@ int main(int argc, char **argv) {
       snprintf(why, sizeof why, "byte %zu flipped", flips[i]);
       refused(dir, bin, "--guide-in F", "F", why);
     }
-    d[8] = 6; /* version (this iris reads 5) */
+    d[8]++; /* the next version, which this iris does not read */
     CHECK(write_bytes(dir, "V", d, n));
-    refused(dir, bin, "--guide-in V", "V", "version 6");
+    char version[32];
+    snprintf(version, sizeof version, "version %u", (unsigned)d[8]);
+    refused(dir, bin, "--guide-in V", "V", version);
     free(data);
   }
   /* usage errors, nothing written */

@@ -1,0 +1,221 @@
+/* guiding.glints: glints (renderer/guiding/glints.h; docs/guiding.md, "Glints").
+ *  - built on env-spheres (the map's sun and a metal sphere of roughness
+ *    0.05): glint photons land on the ground, and at ground points around
+ *    that sphere the spot a vertex finds holds the sphere's true mirror
+ *    reflection of the sun's direction (the point whose reflection of the
+ *    direction to x is the sun's), found by iteration on the sphere; most
+ *    such points find a spot, and the spots are small (a tenth of the
+ *    sphere); nothing with params.glints off; the same glint photons and
+ *    shares for 1 and 2 threads and after a guide file;
+ *  - the whole guided sampler (BSDF, caches, the spot's cone) at a ground
+ *    point that has a spot, against its own pdf: chi-square over the sphere
+ *    and the pdf's integral. Fails when glint photons are not kept or keep
+ *    the wrong smooth point, and when the cone's density is left out of the
+ *    mixture. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "chi2.h"
+#include "guide_fixture.h"
+#include "renderer/guiding/guide_file.h"
+#include "renderer/guiding/vertex.h"
+#include "scenes/builtin.h"
+
+#define N_TESTS 1
+
+/* env-spheres' metal sphere of roughness 0.05 (scenes/sky.c) */
+static const iris_vec3 SPHERE_C = {-0.7f, 0.6f, 0.0f};
+#define SPHERE_R 0.6f
+
+/* The direction of the map's brightest texel: its sun. */
+static iris_vec3 sun_direction(const iris_envmap *env) {
+  size_t best = 0;
+  float lum = -1.0f;
+  for (size_t i = 0; i < (size_t)env->width * (size_t)env->height; ++i) {
+    const float l = env->rgb[3 * i] + env->rgb[3 * i + 1] + env->rgb[3 * i + 2];
+    if (l > lum) lum = l, best = i;
+  }
+  const float s = ((float)(best % (size_t)env->width) + 0.5f) / (float)env->width,
+              t = ((float)(best / (size_t)env->width) + 0.5f) / (float)env->height;
+  return iris_envmap_st_to_dir(env, s, t);
+}
+
+/* The point of the sphere whose mirror reflection of the direction to x is
+ * `sun`: its normal bisects the sun and the direction to x (fixed point). */
+static bool mirror_point(iris_vec3 x, iris_vec3 sun, iris_vec3 *p) {
+  iris_vec3 n = sun;
+  for (int i = 0; i < 400; ++i) {
+    const iris_vec3 q = iris_add(SPHERE_C, iris_scale(n, SPHERE_R));
+    const iris_vec3 r = iris_normalize(iris_sub(x, q));
+    n = iris_normalize(iris_add(iris_scale(n, 0.5f), iris_scale(iris_normalize(iris_add(sun, r)), 0.5f)));
+  }
+  *p = iris_add(SPHERE_C, iris_scale(n, SPHERE_R));
+  const iris_vec3 r = iris_normalize(iris_sub(x, *p));
+  /* converged, seen from x, and lit by the sun */
+  return iris_dot(iris_normalize(iris_add(sun, r)), n) > 0.99999f && iris_dot(r, n) > 0.05f && iris_dot(sun, n) > 0.05f;
+}
+
+static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool glints, int threads) {
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.glints = glints;
+  gp.force = true; /* lit mostly directly: the guide would be skipped */
+  return test_guide_build_in(sc, t, gp, 7, threads, 16);
+}
+
+/* A shading point on the ground (y = 0) at x, seen from above. */
+static bool ground_point(const test_guide_scene *t, iris_vec3 x, iris_shading_point *sp) {
+  iris_ray ray = {iris_add(x, iris_v3(0.0f, 0.05f, 0.0f)), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
+  iris_hit hit;
+  if (!iris_accel_intersect(t->acc, &ray, &hit)) return false;
+  iris_interaction si;
+  iris_accel_interaction(t->acc, ray.d, &hit, &si);
+  iris_integrator_shade(&t->it, &si, iris_v3(0.0f, 1.0f, 0.0f), 0, sp);
+  return fabsf(si.p.y) < 1e-3f;
+}
+
+typedef struct sampler_ctx {
+  iris_direction_sampler s;
+  const iris_shading_point *sp;
+  uint64_t calls;
+} sampler_ctx;
+
+/* The sampler draws its own numbers (chi2_run's are not the sampler's slots):
+ * independent streams, one per call. */
+static bool full_sample(void *vc, const double u[3], double dir[3]) {
+  (void)u;
+  sampler_ctx *c = vc;
+  iris_sampler rng = iris_sampler_start(0x61696e74ULL, c->calls++, 0);
+  iris_direction_sample ds;
+  memset(&ds, 0, sizeof ds);
+  if (!c->s.sample(c->s.ctx, c->sp, &rng, &ds)) return false;
+  dir[0] = ds.wi.x, dir[1] = ds.wi.y, dir[2] = ds.wi.z;
+  return true;
+}
+static double full_pdf(void *vc, const double dir[3]) {
+  sampler_ctx *c = vc;
+  return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+static void check_round_trip(const iris_guiding *g, const iris_vec3 *xs, int nx) {
+  char path[256];
+  const char *tmp = getenv("TMPDIR");
+  snprintf(path, sizeof path, "%s/iris_test_glints_%ld.guide", tmp ? tmp : "/tmp", (long)getpid());
+  iris_error err;
+  iris_error_clear(&err);
+  iris_guiding *l = NULL;
+  if (CHECK(iris_guiding_save(g, path, 1, 2, &err) == IRIS_OK) &&
+      CHECK(iris_guiding_load(path, 1, 2, 1, &l, &err) == IRIS_OK)) {
+    CHECK(l->glints.count == g->glints.count && l->glints.radius2 == g->glints.radius2 &&
+          memcmp(l->glints.photons, g->glints.photons, sizeof *g->glints.photons * g->glints.count) == 0);
+    int differ = l->cache_count != g->cache_count;
+    for (size_t i = 0; !differ && i < g->cache_count; ++i) differ += l->caches[i].glint_share != g->caches[i].glint_share;
+    for (int i = 0; i < nx; ++i) {
+      iris_guide_lamp a = {{0, 0, 0}, 0}, b = {{0, 0, 0}, 0};
+      const bool fa = iris_glints_spot(&g->glints, xs[i], iris_v3(0, 1, 0), &a),
+                 fb = iris_glints_spot(&l->glints, xs[i], iris_v3(0, 1, 0), &b);
+      differ += fa != fb || memcmp(&a, &b, sizeof a) != 0;
+    }
+    iris_check_record(!differ, __FILE__, __LINE__, "glint shares or spots differ after the guide file");
+  }
+  iris_guiding_destroy(l);
+  remove(path);
+}
+
+static void test_env_spheres(void) {
+  iris_scene *sc = NULL;
+  iris_error err;
+  iris_error_clear(&err);
+  if (!CHECK(iris_builtin_create("env-spheres", &sc, &err) == IRIS_OK)) return;
+  test_guide_scene t;
+  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
+    iris_scene_destroy(sc);
+    return;
+  }
+  const iris_vec3 sun = sun_direction(t.lights.envmap);
+  iris_guiding *g = build(sc, &t, true, 2);
+  if (!CHECK(g != NULL)) goto done;
+  printf("env-spheres: %u glint photons of %llu paths, a vertex looks %.3f m far; sun (%.2f, %.2f, %.2f)\n",
+         g->glints.count, (unsigned long long)g->glints.paths, sqrt((double)g->glints.radius2), (double)sun.x,
+         (double)sun.y, (double)sun.z);
+  CHECK(g->glints.count > 1000);
+  /* Ground points around the sphere, where its mirror shows the sun. */
+  iris_vec3 xs[64];
+  int nx = 0, eligible = 0, found = 0, holds = 0, small = 0;
+  double worst = 0.0;
+  for (int ring = 0; ring < 4; ++ring)
+    for (int k = 0; k < 16; ++k) {
+      const float d = 0.9f + 0.3f * (float)ring, phi = 6.2831853f * ((float)k + 0.5f) / 16.0f;
+      const iris_vec3 x = iris_v3(SPHERE_C.x + d * cosf(phi), 0.0f, SPHERE_C.z + d * sinf(phi));
+      iris_vec3 p;
+      if (!mirror_point(x, sun, &p)) continue;
+      /* neither the other spheres nor the ground between x and the glint */
+      iris_ray r = iris_spawn_ray_to(iris_add(x, iris_v3(0, 1e-3f, 0)), iris_v3(0, 1, 0), p, iris_normalize(iris_sub(p, SPHERE_C)));
+      if (iris_accel_occluded(t.acc, &r)) continue;
+      eligible++;
+      if (nx < 64) xs[nx++] = x;
+      iris_guide_lamp spot;
+      if (!iris_glints_spot(&g->glints, x, iris_v3(0, 1, 0), &spot)) continue;
+      found++;
+      const double miss = iris_length(iris_sub(p, spot.center)) - spot.radius;
+      holds += miss <= 0.0;
+      small += spot.radius <= 0.1f * SPHERE_R * 2.0f;
+      if (miss > worst) worst = miss;
+    }
+  printf("  %d ground points see the sun in the sphere: %d find a spot, %d of those hold the glint (worst miss %.4f m), "
+         "%d spots under 0.12 m\n",
+         eligible, found, holds, worst, small);
+  CHECK(eligible >= 20);
+  CHECK(found >= eligible * 7 / 10);
+  CHECK(holds >= found * 9 / 10);
+  CHECK(small >= found * 8 / 10);
+
+  /* The whole sampler at the first ground point that has a spot. */
+  bool tested = false;
+  iris_direction_sampler s = iris_guiding_sampler(g);
+  for (int i = 0; i < nx && !tested && CHECK(s.sample != NULL); ++i) {
+    iris_shading_point sp;
+    if (!ground_point(&t, xs[i], &sp)) continue;
+    s.prepare(s.ctx, &sp);
+    const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
+    if (!(v->glint > 0.0f && v->alpha > 0.0f)) continue;
+    tested = true;
+    sampler_ctx c = {s, &sp, 0};
+    chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
+    chi2_result r = chi2_run(&dom, full_sample, full_pdf, &c, 400000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "guided sampler with a glint: %s", r.message);
+    CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
+    printf("  sampler at (%.2f, 0, %.2f): alpha %.2f, glint share %.2f, spot radius %.3f m at %.2f m: p = %.3g, pdf "
+           "integral %.5f\n",
+           (double)xs[i].x, (double)xs[i].z, (double)v->alpha, (double)v->glint, (double)v->spot.radius,
+           (double)iris_length(iris_sub(v->spot.center, v->p)), r.p_value, r.pdf_integral);
+  }
+  CHECK(tested);
+  check_round_trip(g, xs, nx);
+
+  /* The same for 1 thread; nothing without glints. */
+  iris_guiding *g1 = build(sc, &t, true, 1), *off = build(sc, &t, false, 2);
+  if (CHECK(g1 != NULL && off != NULL)) {
+    int differ = g1->glints.count != g->glints.count || g1->cache_count != g->cache_count ||
+                 memcmp(g1->glints.photons, g->glints.photons, sizeof *g->glints.photons * g->glints.count) != 0;
+    for (size_t i = 0; !differ && i < g->cache_count; ++i) differ += g1->caches[i].glint_share != g->caches[i].glint_share;
+    iris_check_record(!differ, __FILE__, __LINE__, "glints differ between 1 and 2 threads");
+    int shared = 0;
+    for (size_t i = 0; i < off->cache_count; ++i) shared += off->caches[i].glint_share > 0.0f;
+    CHECK(off->glints.count == 0 && shared == 0);
+  }
+  iris_guiding_destroy(g1);
+  iris_guiding_destroy(off);
+  iris_guiding_destroy(g);
+done:
+  test_guide_scene_close(&t);
+  iris_scene_destroy(sc);
+}
+
+int main(void) {
+  test_env_spheres();
+  return iris_check_summary("guiding.glints");
+}
