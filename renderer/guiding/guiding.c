@@ -335,7 +335,7 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
                                                    photon_usable, &f, ids, d2, slots);
     uint32_t used = 0;
-    double power = 0.0, through = 0.0, paned = 0.0, pane[4] = {0, 0, 0, 0};
+    double power = 0.0, through = 0.0, paned = 0.0, pane[4] = {0, 0, 0, 0}, indirect = 0.0, glinted = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
       photon_dirs ph;
       memcpy(&ph, c->photon_tree->payload + (size_t)slots[j] * sizeof ph, sizeof ph);
@@ -350,13 +350,17 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
         paned += ph.energy;
         for (int k = 0; k < 4; ++k) pane[k] += ph.energy * c->photons->photons[ids[j]].pane[k];
       }
+      if (u && c->photons->photons[ids[j]].bounce > 0) indirect += ph.energy;
+      if (u && c->photons->photons[ids[j]].glint) glinted += ph.energy;
       if (u && lamps.on && c->photons->photons[ids[j]].lamp_through)
         lamp_add(&lamps, g, c->lights->entries[c->photons->photons[ids[j]].light].group, ph.energy);
     }
     cache->photons = used;
     cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
     cache->pane_share = 0.0f;
-    cache->glint_share = 0.0f; /* build_glints, once the caches' spacing is known */
+    /* the glints' share of the light the guide must find (light sampling finds
+     * the direct part); build_glints keeps it where a spot is found */
+    cache->glint_share = indirect > 0.0 ? (float)(glinted / indirect) : 0.0f;
     memset(cache->pane, 0, sizeof cache->pane);
     const double pn = sqrt(pane[0] * pane[0] + pane[1] * pane[1] + pane[2] * pane[2]);
     if (g->env && power > 0.0 && paned > 0.0 && pn > 0.5 * paned) { /* one plane's photons, not opposed ones */
@@ -405,12 +409,16 @@ static int by_float(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
-/* Traces the glint photons and gives every cache among them its share: a
- * vertex looks for them within the caches' spacing. */
+/* Traces the glint photons and gives every cache where a spot is found its
+ * share: the share of its indirect photon energy that its photons say came
+ * off smooth surfaces, within [IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX]. */
 static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons,
                                 float spacing, iris_error *err) {
-  iris_status st = iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err);
-  if (st != IRIS_OK || g->glints.count == 0) return st;
+  iris_status st = g->params.glints ? iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err) : IRIS_OK;
+  if (st != IRIS_OK || g->glints.count == 0) { /* no spot anywhere */
+    for (size_t i = 0; i < g->cache_count; ++i) g->caches[i].glint_share = 0.0f;
+    return st;
+  }
   /* A vertex looks GLINT_REACH times as far as the median distance to the
    * IRIS_GLINT_K-th nearest glint photon among themselves (a sample of them),
    * at most the caches' spacing: wide where they are sparse, no wider. */
@@ -433,8 +441,8 @@ static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, cons
     float taken = c->sky_through + c->pane_share;
     for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) taken += c->lamp_share[k];
     iris_guide_lamp spot;
-    if (iris_glints_spot(&g->glints, c->p, c->frame.n, &spot))
-      c->glint_share = fmaxf(0.0f, fminf(IRIS_GLINT_SHARE, 1.0f - taken));
+    const float want = iris_clampf(c->glint_share, IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX);
+    c->glint_share = iris_glints_spot(&g->glints, c->p, c->frame.n, &spot) ? fmaxf(0.0f, fminf(want, 1.0f - taken)) : 0.0f;
   }
   return IRIS_OK;
 }
@@ -836,7 +844,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (st == IRIS_OK)
         st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing,
                                   s->threads, err);
-      if (st == IRIS_OK && p->glints && photons.smooth_count > 0) st = build_glints(g, s, &photons, spacing, err);
+      if (st == IRIS_OK) st = build_glints(g, s, &photons, spacing, err);
       g->stats.memory_bytes = sizeof(iris_cache) * kept + (sizeof(float) + sizeof(iris_cache_alias)) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
                               sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +

@@ -143,8 +143,10 @@ typedef struct iris_cache {
   float pane[4];     /* that plane: energy-weighted normal on the sky's side, eta = n_room / n_sky */
   float glint_share;  /* of the guide's share, the probability of drawing in the cone of the
                         glint spot a vertex finds among the glint photons near it (glints.h):
-                        IRIS_GLINT_SHARE where enough of them lie within the caches' spacing,
-                        else 0 ("Glints"); with the shares above <= 1 */
+                        where a spot is found at the cache, the share of its indirect photon
+                        energy that a smooth surface reflected last (photons.h, glint), within
+                        [IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX]; else 0 ("Glints"); with
+                        the shares above <= 1 */
   uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;

@@ -52,6 +52,7 @@ static void block_push(photon_block *b, const iris_photon *ph) {
 }
 
 bool iris_photon_smooth(const iris_shading_point *sp) {
+  if (sp->lobes & IRIS_LOBE_TRANSMISSION) return false; /* glass: its caustics are the caches' */
   if (sp->delta) return true;
   return (sp->lobes & IRIS_LOBE_GLOSSY) && !(sp->lobes & IRIS_LOBE_DIFFUSE) &&
          iris_bsdf_guiding_roughness(&sp->bsdf) <= IRIS_GLINT_ROUGHNESS;
@@ -115,6 +116,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
    * exactly one delta vertex and that bent it (a single glass quad) */
   int deltas = 0;
   float pane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+  bool smooth_reflected = false; /* the last vertex reflected it off a smooth surface ("Glints") */
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -140,12 +142,15 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.lamp_through = lamp_only && straight;
       const bool paned = specular_only && deltas == 1 && !straight && pane[3] > 0.0f;
       for (int k = 0; k < 4; ++k) ph.pane[k] = paned ? pane[k] : 0.0f;
+      ph.glint = smooth_reflected && !ph.sky_through && !ph.lamp_through && !paned;
       block_push(out, &ph);
       specular_only = lamp_only = false;
     }
-    if (iris_photon_smooth(&sp)) smooth_push(out, si.p);
+    const bool smooth = iris_photon_smooth(&sp);
+    if (smooth) smooth_push(out, si.p);
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    smooth_reflected = smooth && !(ds.lobe & IRIS_LOBE_TRANSMISSION);
     if (sp.delta && specular_only && ++deltas == 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION) && sp.bsdf.ior > 0.0f &&
         sp.bsdf.ior != 1.0f) {
       /* n on the side the photon came from (the sky's); entering the

@@ -33,7 +33,9 @@ typedef struct iris_photon {
   iris_vec3 wi;     /* unit world direction back towards where the photon came from */
   float energy;     /* mean of the RGB photon power */
   uint8_t bounce;   /* 0: straight from the light (direct illumination) */
-  uint8_t transmits;/* the surface has transmission lobes (full-sphere cache) */
+  uint8_t transmits : 1; /* the surface has transmission lobes (full-sphere cache) */
+  uint8_t glint : 1;     /* its last vertex reflected it off a smooth surface (iris_photon_smooth),
+                            and it is none of the kinds below: the light glint spots find (glints.h) */
   uint8_t sky_through; /* from the environment map after delta vertices only (bounce > 0),
                           arriving along its emission direction (through a flat glass slab):
                           light that sampling the map as a direction finds and light
@@ -66,8 +68,12 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
 iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
                                     iris_photon_map *map, iris_error *err);
 void iris_photons_destroy(iris_photon_map *map);
-/* A smooth vertex: a delta BSDF, or glossy lobes of roughness <= IRIS_GLINT_ROUGHNESS
- * without a diffuse one; what turns a light into a glint. */
+/* A smooth reflector: no transmission, and a delta BSDF or glossy lobes of
+ * roughness <= IRIS_GLINT_ROUGHNESS without a diffuse one (a mirror,
+ * near-mirror metal); what turns a light into a glint. Glass is not one: the
+ * little it reflects is faint, and what it bends fills much of its surface as
+ * seen from the receiver (a lens focuses), which the caches' maps find
+ * (measured on lamp-shade and stress-caustic: docs/guiding.md, "Glints"). */
 bool iris_photon_smooth(const iris_shading_point *sp);
 
 #ifdef __cplusplus
