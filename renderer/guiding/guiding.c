@@ -595,6 +595,18 @@ static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris
 }
 
 #define INDIRECT_MIN 0.3 /* the "lit mostly directly" threshold */
+#define GLINT_PILOT_MIN 16 /* photons a smooth reflector sent that keep a named guided method's guide */
+
+/* A guided method asked for by name keeps its guide in a scene lit mostly
+ * directly where photons met mirrors or near-mirror metal: the glints they
+ * reflect are light only the guide finds ("Glints"); `auto` decides by its
+ * rules. */
+static bool keeps_for_glints(const iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons) {
+  if (!g->params.glints || s->deciding) return false;
+  size_t glinted = 0;
+  for (size_t i = 0; i < photons->count && glinted < GLINT_PILOT_MIN; ++i) glinted += photons->photons[i].glint;
+  return glinted >= GLINT_PILOT_MIN;
+}
 
 uint64_t iris_guiding_pilot_paths(uint64_t photons) {
   uint64_t n = photons / 16 > 16384 ? photons / 16 : 16384;
@@ -631,7 +643,7 @@ static iris_status pilot(iris_guiding *g, const iris_guide_setup *s, int stride,
   g->stats.pilot_paths = photons->paths;
   g->stats.pilot_share = indirect_share(s, photons);
   g->stats.pilot_seconds = iris_time_now() - t0;
-  if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN) {
+  if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN && !keeps_for_glints(g, s, photons)) {
     char why[160];
     snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons in a %llu-path pilot",
              100.0 * g->stats.pilot_share, (unsigned long long)photons->paths);
@@ -676,7 +688,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
    * sampling's job; there the guide costs more per sample than it saves
    * (docs/guiding.md, benchmark). Door 75%, Cornell 65%. */
   g->stats.indirect_share = indirect_share(s, &photons);
-  if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN) {
+  if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN && !keeps_for_glints(g, s, &photons)) {
     iris_photons_destroy(&photons);
     char why[160];
     snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons",
