@@ -17,8 +17,6 @@
  * neighbour whose distance is a target's jitter radius. */
 #define MAX_TARGETS 65536u
 #define TARGET_NEIGHBOUR 4u
-/* cos of the largest turn that still counts as straight through glass (as photons.c) */
-#define STRAIGHT_COS 0.99996f
 /* Two glint photons come from one spot when their smooth points lie within
  * SLIDE of their landing points' distance (a glint seen from a nearby point
  * leaves the surface about that much nearer: half on a flat mirror, less on
@@ -90,7 +88,6 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
   }
   ray.tmin = 0.0f;
   ray.tmax = INFINITY;
-  const iris_vec3 d0 = ray.d;
   iris_vec3 beta = iris_v3(1.0f, 1.0f, 1.0f), y = t;
   bool smooth_seen = false;
   for (int bounce = 0; bounce < MAX_BOUNCES; ++bounce) {
@@ -103,9 +100,8 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
     iris_shading_point sp;
     iris_integrator_shade(s->integrator, &si, wo, bounce, &sp);
     if (!iris_photon_smooth(&sp)) {
-      /* landed: a glint if it left a smooth surface, bent (straight through
-       * glass is light the map's and the lamps' own sampling find) */
-      if (!smooth_seen || iris_dot(wo, d0) < -STRAIGHT_COS) return;
+      /* landed: a glint if a smooth reflector sent it here */
+      if (!smooth_seen) return;
       const float e = weight * iris_avg3(beta);
       if (!(e > 0.0f) || !isfinite(e)) return;
       iris_glint_photon g = {si.p, sp.frame.n, y, e};
@@ -116,10 +112,6 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
     y = si.p;
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
-    /* reflections only: glass bends a light into a caustic that fills much of
-     * its surface as seen from the receiver (a lens focuses), which the
-     * caches' maps find, and a spot would not hold (measured: docs/guiding.md, "Glints") */
-    if (ds.lobe & IRIS_LOBE_TRANSMISSION) return;
     const float cosv = fabsf(iris_dot(ds.wi, sp.frame.n));
     beta = iris_scale(iris_mul(beta, iris_scale(ds.f, cosv)), 1.0f / ds.pdf);
     if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;

@@ -1,6 +1,6 @@
 /* Glints (docs/guiding.md, "Glints"): the sun seen in a near-mirror sphere
  * from the ground, a lamp in a chrome fitting seen from a wall. Such light
- * reaches a rough surface off a smooth one (a mirror, glass, metal of
+ * reaches a rough surface off a smooth reflector (a mirror, metal of
  * roughness <= IRIS_GLINT_ROUGHNESS) from a spot far smaller than a cache's
  * texel, and the spot moves across the smooth surface as the receiving point
  * moves, so no per-cache map holds it. Glint photons are aimed at the points
@@ -53,9 +53,8 @@ typedef struct iris_glints {
 } iris_glints;
 
 /* Traces `paths` glint photon paths aimed at map->smooth (nothing when it is
- * empty), keeps those that land on a rough surface after smooth vertices
- * only (not straight through: "Sky behind glass" and "Lamps behind glass"
- * find that light) and builds their tree. Deterministic for any thread count
+ * empty), keeps those that land on a rough surface after smooth reflections
+ * only (iris_photon_smooth) and builds their tree. Deterministic for any thread count
  * (path i draws from a hash of (seed, i)). out->radius2 is left 0 (the
  * caller sets it once the caches' spacing is known). */
 iris_status iris_glints_trace(const iris_guide_setup *setup, const iris_photon_map *map, uint64_t paths,
