@@ -4,7 +4,7 @@
 # --force-guiding: without glints the 30% rule would skip the guide), each
 # an `iris render --time T` per seed and budget, relMSE (the benchmarks'
 # trimmed metric, bench/render/relmse) against REFDIR/ref_SCENE.exr, made here
-# when missing (guided-nee with glints, 8192 spp, seed 999, with its variance:
+# when missing (guided-nee with glints, 8192 spp or $REFSPP, seed 999, with its variance:
 # `relmse --own` says how converged it is), 108 x 72, 2 threads. Prints one
 # line per method and budget: the relMSE per seed, their geometric mean, and
 # the mean spp reached.
@@ -19,7 +19,7 @@ trap 'rm -rf "$OUT"' EXIT
 for sc in $SCENES; do
   ref="$R/ref_$sc.exr"
   if [ ! -f "$ref" ]; then
-    "$B/tools/iris" render "$sc" --method guided-nee --spp 8192 --width 108 --height 72 --seed 999 --threads 2 \
+    "$B/tools/iris" render "$sc" --method guided-nee --spp "${REFSPP:-8192}" --width 108 --height 72 --seed 999 --threads 2 \
       --variance --quiet -o "$ref"
   fi
   echo "$sc: reference $ref, own relMSE $("$B/bench/render/relmse" --own "$ref")"

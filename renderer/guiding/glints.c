@@ -2,6 +2,7 @@
 #include "renderer/guiding/glints.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -205,10 +206,23 @@ iris_status iris_glints_trace(const iris_guide_setup *setup, const iris_photon_m
   return st;
 }
 
+/* What the query's filter reads of a glint photon, kept in the tree's order
+ * next to its position (iris_kdtree_set_payload): n and y, adjacent in
+ * iris_glint_photon, so the filter does not chase the photon array. */
+typedef struct glint_dirs {
+  iris_vec3 n, y;
+} glint_dirs;
+_Static_assert(offsetof(iris_glint_photon, y) == offsetof(iris_glint_photon, n) + sizeof(iris_vec3) &&
+                   sizeof(glint_dirs) == 2 * sizeof(iris_vec3),
+               "glint_dirs mirrors iris_glint_photon's n, y");
+
 iris_status iris_glints_index(iris_glints *gl, int threads, iris_error *err) {
   iris_kdtree_destroy(&gl->tree);
   if (gl->count == 0) return IRIS_OK;
-  return iris_kdtree_build_threads(&gl->tree, &gl->photons[0].p, sizeof *gl->photons, gl->count, threads, err);
+  iris_status st = iris_kdtree_build_threads(&gl->tree, &gl->photons[0].p, sizeof *gl->photons, gl->count, threads, err);
+  if (st == IRIS_OK)
+    st = iris_kdtree_set_payload(&gl->tree, &gl->photons[0].n, sizeof *gl->photons, sizeof(glint_dirs), threads, err);
+  return st;
 }
 
 size_t iris_glints_bytes(size_t count) {
@@ -222,32 +236,32 @@ void iris_glints_destroy(iris_glints *gl) {
 }
 
 typedef struct accept_ctx {
-  const iris_glint_photon *photons;
   iris_vec3 x, n;
 } accept_ctx;
 
 /* On a surface facing like the vertex's, from a smooth point above it. */
-static bool accept(void *ctx, uint32_t id) {
+static bool accept(void *ctx, const void *payload) {
   const accept_ctx *a = ctx;
-  const iris_glint_photon *g = &a->photons[id];
-  return iris_dot(g->n, a->n) >= FACING_COS && iris_dot(iris_sub(g->y, a->x), a->n) > 0.0f;
+  glint_dirs g;
+  memcpy(&g, payload, sizeof g);
+  return iris_dot(g.n, a->n) >= FACING_COS && iris_dot(iris_sub(g.y, a->x), a->n) > 0.0f;
 }
 
 uint32_t iris_glints_near(const iris_glints *gl, iris_vec3 p, iris_vec3 n, uint32_t k_max) {
   if (gl->count == 0 || !(gl->radius2 > 0.0f) || k_max == 0) return 0;
   uint32_t ids[IRIS_GLINT_K];
   float d2[IRIS_GLINT_K];
-  accept_ctx a = {gl->photons, p, n};
-  return iris_kdtree_knn_if(&gl->tree, p, k_max < IRIS_GLINT_K ? k_max : IRIS_GLINT_K, gl->radius2, accept, &a, ids,
-                            d2);
+  accept_ctx a = {p, n};
+  return iris_kdtree_knn_payload_if(&gl->tree, p, k_max < IRIS_GLINT_K ? k_max : IRIS_GLINT_K, gl->radius2, accept,
+                                    &a, ids, d2, NULL);
 }
 
 bool iris_glints_spot(const iris_glints *gl, iris_vec3 x, iris_vec3 n, iris_guide_lamp *spot) {
   if (gl->count == 0 || !(gl->radius2 > 0.0f)) return false;
   uint32_t ids[IRIS_GLINT_K];
   float d2[IRIS_GLINT_K];
-  accept_ctx a = {gl->photons, x, n};
-  const uint32_t m = iris_kdtree_knn_if(&gl->tree, x, IRIS_GLINT_K, gl->radius2, accept, &a, ids, d2);
+  accept_ctx a = {x, n};
+  const uint32_t m = iris_kdtree_knn_payload_if(&gl->tree, x, IRIS_GLINT_K, gl->radius2, accept, &a, ids, d2, NULL);
   if (m < IRIS_GLINT_MIN) return false;
   /* A bright glint is many photons from one spot; dim light off the same
    * surface (the sky in a mirror) comes from anywhere on it. Photon j agrees

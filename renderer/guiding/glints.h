@@ -29,8 +29,9 @@ extern "C" {
 
 /* Of the guide's share at a vertex with a glint spot, the probability of the
  * spot's cone: the share of the cache's indirect photon energy that left a
- * smooth surface last, within these bounds (measured: docs/guiding.md, "Glints"). */
-#define IRIS_GLINT_SHARE_MIN 0.05f
+ * smooth reflector last, at most the maximum; none below the minimum
+ * (measured: docs/guiding.md, "Glints"). */
+#define IRIS_GLINT_SHARE_MIN 0.1f
 #define IRIS_GLINT_SHARE_MAX 0.5f
 /* Glint photons a vertex looks at, and how many it needs for a spot. */
 #define IRIS_GLINT_K 8

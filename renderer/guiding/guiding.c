@@ -411,7 +411,9 @@ static int by_float(const void *a, const void *b) {
 
 /* Traces the glint photons and gives every cache where a spot is found its
  * share: the share of its indirect photon energy that its photons say came
- * off smooth surfaces, within [IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX]. */
+ * off smooth reflectors, at most IRIS_GLINT_SHARE_MAX; none below
+ * IRIS_GLINT_SHARE_MIN, where the spot's query would cost more than the
+ * glints it finds bring. */
 static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons,
                                 float spacing, iris_error *err) {
   iris_status st = g->params.glints ? iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err) : IRIS_OK;
@@ -441,8 +443,10 @@ static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, cons
     float taken = c->sky_through + c->pane_share;
     for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) taken += c->lamp_share[k];
     iris_guide_lamp spot;
-    const float want = iris_clampf(c->glint_share, IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX);
-    c->glint_share = iris_glints_spot(&g->glints, c->p, c->frame.n, &spot) ? fmaxf(0.0f, fminf(want, 1.0f - taken)) : 0.0f;
+    const float want = fminf(c->glint_share, IRIS_GLINT_SHARE_MAX);
+    c->glint_share = want >= IRIS_GLINT_SHARE_MIN && iris_glints_spot(&g->glints, c->p, c->frame.n, &spot)
+                         ? fmaxf(0.0f, fminf(want, 1.0f - taken))
+                         : 0.0f;
   }
   return IRIS_OK;
 }
