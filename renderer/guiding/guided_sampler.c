@@ -61,6 +61,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->light = 1.0f;
   v->pane = 0xff;
   v->glint = 0.0f;
+  v->spot = (iris_guide_lamp){{0.0f, 0.0f, 0.0f}, 0.0f};
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
