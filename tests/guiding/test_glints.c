@@ -6,7 +6,8 @@
  *    direction to x is the sun's), found by iteration on the sphere; most
  *    such points find a spot, and the spots are small (a tenth of the
  *    sphere); nothing with params.glints off; the same glint photons and
- *    shares for 1 and 2 threads and after a guide file;
+ *    shares for 1 and 2 threads and after a guide file, which refuses a
+ *    glint photon with a NaN or a zero energy (checksum resealed);
  *  - the whole guided sampler (BSDF, caches, the spot's cone) at a ground
  *    point that has a spot, against its own pdf: chi-square over the sphere
  *    and the pdf's integral. Fails when glint photons are not kept or keep
@@ -19,6 +20,7 @@
 #include <unistd.h>
 
 #include "check.h"
+#include "core/fileio.h"
 #include "chi2.h"
 #include "guide_fixture.h"
 #include "renderer/guiding/guide_file.h"
@@ -122,6 +124,39 @@ static void check_round_trip(const iris_guiding *g, const iris_vec3 *xs, int nx)
     iris_check_record(!differ, __FILE__, __LINE__, "glint shares or spots differ after the guide file");
   }
   iris_guiding_destroy(l);
+  l = NULL;
+  /* Forged with a valid checksum: a NaN in the first glint photon (they come last), and an
+   * energy of 0 in the last one: each refused in one line naming the file and the photon. */
+  char *data = NULL;
+  size_t n = 0;
+  if (CHECK(iris_file_read(path, 0, &data, &n, &err) == IRIS_OK) && CHECK(n > 40u * g->glints.count + 48)) {
+    const size_t first = n - 40u * g->glints.count, last_energy = n - 4;
+    const struct {
+      size_t at;
+      uint32_t bits;
+      const char *want;
+    } forges[] = {{first, 0x7fc00000u, "glint photon 0: invalid values"},
+                  {last_energy, 0u, "invalid values"}};
+    for (size_t f = 0; f < sizeof forges / sizeof forges[0]; ++f) {
+      unsigned char *c = malloc(n);
+      if (!CHECK(c)) break;
+      memcpy(c, data, n);
+      for (int i = 0; i < 4; ++i) c[forges[f].at + (size_t)i] = (unsigned char)(forges[f].bits >> (8 * i));
+      const uint64_t sum = iris_guide_file_checksum(c, n);
+      for (int i = 0; i < 8; ++i) c[40 + i] = (unsigned char)(sum >> (8 * i));
+      FILE *fp = fopen(path, "wb");
+      bool written = fp && fwrite(c, 1, n, fp) == n;
+      if (fp) written = fclose(fp) == 0 && written;
+      free(c);
+      iris_error_clear(&err);
+      const bool refused = written && iris_guiding_load(path, 1, 2, 1, &l, &err) == IRIS_ERR_PARSE && !l &&
+                           strcmp(err.file, path) == 0 && strstr(err.message, forges[f].want);
+      iris_check_record(refused, __FILE__, __LINE__, "forged glint photon %zu not refused: %s", f, err.message);
+      iris_guiding_destroy(l);
+      l = NULL;
+    }
+  }
+  free(data);
   remove(path);
 }
 
