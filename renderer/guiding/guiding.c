@@ -602,14 +602,20 @@ static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris
 #define GLINT_PILOT_MIN 16 /* photons a smooth reflector sent that keep a named guided method's guide */
 
 /* A guided method asked for by name keeps its guide in a scene lit mostly
- * directly where photons met mirrors or near-mirror metal: the glints they
- * reflect are light only the guide finds ("Glints"); `auto` decides by its
- * rules. */
+ * directly where photons met mirrors or near-mirror metal and the glints
+ * they reflect carry at least IRIS_GLINT_SHARE_MIN of the indirect light
+ * (env-spheres 0.18, veach-mis's plates 0.01): light only the guide finds
+ * ("Glints"). `auto` decides by its rules. */
 static bool keeps_for_glints(const iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons) {
   if (!g->params.glints || s->deciding) return false;
   size_t glinted = 0;
-  for (size_t i = 0; i < photons->count && glinted < GLINT_PILOT_MIN; ++i) glinted += photons->photons[i].glint;
-  return glinted >= GLINT_PILOT_MIN;
+  double glint_energy = 0.0, indirect = 0.0;
+  for (size_t i = 0; i < photons->count; ++i) {
+    const iris_photon *ph = &photons->photons[i];
+    if (ph->bounce > 0) indirect += ph->energy;
+    if (ph->glint) glint_energy += ph->energy, glinted++;
+  }
+  return glinted >= GLINT_PILOT_MIN && glint_energy >= IRIS_GLINT_SHARE_MIN * indirect;
 }
 
 uint64_t iris_guiding_pilot_paths(uint64_t photons) {
