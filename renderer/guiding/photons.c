@@ -9,6 +9,9 @@
 #include "core/rng.h"
 
 #define BLOCK_PATHS 4096u
+/* Paths whose first SMOOTH_PER_PATH smooth vertices become glint targets (iris_photon_map.smooth). */
+#define SMOOTH_PATHS 262144u
+#define SMOOTH_PER_PATH 4
 /* cos of the largest angle between a photon's arrival and emission directions
  * that still counts as travelling straight through glass (0.5 degrees) */
 #define SKY_THROUGH_COS 0.99996f
@@ -117,6 +120,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
   int deltas = 0;
   float pane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   bool smooth_reflected = false; /* the last vertex reflected it off a smooth surface ("Glints") */
+  int smooth_seen = 0;           /* smooth vertices recorded as glint targets */
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -147,7 +151,10 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       specular_only = lamp_only = false;
     }
     const bool smooth = iris_photon_smooth(&sp);
-    if (smooth) smooth_push(out, si.p);
+    /* the glints' targets: a path's first SMOOTH_PER_PATH smooth vertices, of
+     * the first SMOOTH_PATHS paths (bounded: a hall of mirrors would
+     * otherwise keep up to 32 points of every path) */
+    if (smooth && smooth_seen < SMOOTH_PER_PATH && index < SMOOTH_PATHS) smooth_push(out, si.p), smooth_seen++;
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
     smooth_reflected = smooth && !(ds.lobe & IRIS_LOBE_TRANSMISSION);

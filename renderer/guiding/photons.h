@@ -51,7 +51,8 @@ typedef struct iris_photon {
 typedef struct iris_photon_map {
   iris_photon *photons;
   size_t count;
-  iris_vec3 *smooth;    /* where photon paths met smooth surfaces (iris_photon_smooth), in path
+  iris_vec3 *smooth;    /* where photon paths met smooth reflectors (iris_photon_smooth): the
+                           first 4 such points of each of the first 262144 paths, in path
                            order: the targets of the glint photons (glints.h) */
   size_t smooth_count;
   uint64_t paths;     /* photon paths emitted */
