@@ -247,15 +247,6 @@ static bool accept(void *ctx, const void *payload) {
   return iris_dot(g.n, a->n) >= FACING_COS && iris_dot(iris_sub(g.y, a->x), a->n) > 0.0f;
 }
 
-uint32_t iris_glints_near(const iris_glints *gl, iris_vec3 p, iris_vec3 n, uint32_t k_max) {
-  if (gl->count == 0 || !(gl->radius2 > 0.0f) || k_max == 0) return 0;
-  uint32_t ids[IRIS_GLINT_K];
-  float d2[IRIS_GLINT_K];
-  accept_ctx a = {p, n};
-  return iris_kdtree_knn_payload_if(&gl->tree, p, k_max < IRIS_GLINT_K ? k_max : IRIS_GLINT_K, gl->radius2, accept,
-                                    &a, ids, d2, NULL);
-}
-
 bool iris_glints_spot(const iris_glints *gl, iris_vec3 x, iris_vec3 n, iris_guide_lamp *spot) {
   if (gl->count == 0 || !(gl->radius2 > 0.0f)) return false;
   uint32_t ids[IRIS_GLINT_K];

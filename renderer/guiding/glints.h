@@ -76,8 +76,6 @@ size_t iris_glints_bytes(size_t count);
  * one). False (no spot) when fewer than IRIS_GLINT_MIN are found or x lies
  * inside the sphere. */
 bool iris_glints_spot(const iris_glints *gl, iris_vec3 x, iris_vec3 n, iris_guide_lamp *spot);
-/* How many glint photons lie within radius2 of p on a surface facing like n. */
-uint32_t iris_glints_near(const iris_glints *gl, iris_vec3 p, iris_vec3 n, uint32_t k_max);
 
 #ifdef __cplusplus
 }
