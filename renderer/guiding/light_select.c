@@ -292,7 +292,13 @@ bool iris_light_select_choose(const iris_light_select *sel, iris_vec3 p, iris_ve
   }
   float fv = (float)v, tree_pmf;
   if (!(fv < 1.0f)) fv = 0x1.fffffep-1f;
-  if (!iris_light_tree_sample(sel->tree, p, n, fv, light, &tree_pmf)) tree_pmf = 0.0f;
+  /* Where the tree's descent ends in nothing (lights only behind the
+   * surface), no light is chosen: its `light` is no sample, and naming it with
+   * the mixture's pmf would count that light twice. */
+  if (!iris_light_tree_sample(sel->tree, p, n, fv, light, &tree_pmf)) {
+    *light = 0;
+    return false;
+  }
   /* iris_light_tree_sample's pmf is iris_light_tree_pmf's, bit for bit */
   *pmf = mixture_pmf(sel, ids, m, *light, tree_pmf);
   return *pmf > 0.0f;
