@@ -382,7 +382,7 @@ static float power_heuristic(float pa, float pb) {
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, float u_region, const iris_sampler *rng, bool mis,
-                               float p_light, iris_path_stats *stats, int8_t *outcome) {
+                               float p_light, iris_path_stats *stats, int8_t *outcome, float *value) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -416,9 +416,11 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   /* light sampling ran with probability p_light (1 unless the guide makes it
    * optional here): its density is p_light ls.pdf, for the weight too */
   const float pdf = p_light * ls.pdf;
+  const iris_vec3 fl = iris_mul(f, ls.L);
+  *value = iris_avg3(fl) * fabsf(wl.z) / pdf;
   float w = 1.0f;
   if (mis && !ls.delta) w = power_heuristic(pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
-  return iris_scale(iris_mul(f, ls.L), fabsf(wl.z) * w / pdf);
+  return iris_scale(fl, fabsf(wl.z) * w / pdf);
 }
 
 static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
@@ -499,12 +501,13 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     }
     iris_integrator_prepare_direction(it, &sp);
     int8_t light_outcome = -1; /* for the recorded vertex: -1 no shadow ray, 0 blocked, 1 lit */
+    float light_value = 0.0f;  /* ... and what it brought before the MIS weight */
     float p_light = 1.0f;
     if (nee && !sp.delta) {
       if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
       if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
         L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, p_light, stats,
-                                                     &light_outcome)));
+                                                     &light_outcome, &light_value)));
     }
 
     iris_direction_sample ds;
@@ -532,6 +535,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->miss = iris_v3(0, 0, 0);
       last->beta = beta; /* replaced after Russian roulette; a killed path brings 0 */
       last->light = light_outcome;
+      last->light_id = choice.light;
+      last->light_value = light_value;
     }
     prev_delta = ds.delta;
     prev_pdf = ds.pdf;

@@ -249,6 +249,10 @@ typedef struct iris_path_vertex {
   iris_vec3 beta, L, miss;
   int8_t light;            /* this vertex's light sample: -1 none traced, 0 its shadow ray was
                               blocked (or it brought nothing), 1 it brought light */
+  uint32_t light_id;       /* ... the light it chose (where light >= 0) */
+  float light_value;       /* ... mean over RGB of f Le |cos| V / pdf, without the MIS weight: an
+                              unbiased estimate of the direct light the vertex reflects, whose
+                              share by light tells which lights matter there (0 where blocked) */
 } iris_path_vertex;
 
 #define IRIS_PATH_RECORD_MAX 16

@@ -269,8 +269,12 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     snprintf(res->method_reason, sizeof res->method_reason, "auto: %s (%s)", iris_method_name(p.method), why);
     if (!use) {
       memset(&it.guide, 0, sizeof it.guide);
-      if (guide_state && p.guide->destroy) p.guide->destroy(guide_state);
-      guide_state = NULL;
+      /* The race chose mis: the trained guide's learned light tables serve it
+       * (learned from the training's light samples too, and not built twice). */
+      if (!(learned && res->raced)) {
+        if (guide_state && p.guide->destroy) p.guide->destroy(guide_state);
+        guide_state = NULL;
+      }
     }
   }
   if (st == IRIS_OK && learned && guide_state) lights.learned = p.guide->light_select(guide_state);

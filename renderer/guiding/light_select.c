@@ -1,6 +1,7 @@
 /* Learned light selection: light_select.h, docs/guiding.md "Learned light selection". */
 #include "renderer/guiding/light_select.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -123,6 +124,7 @@ static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
       s[j].leaf = sums[j].leaf;
       s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / total);
     }
+    sel->photon_count[i] = (uint8_t)used;
     /* Where the tree's choice is rarely hidden, the table has nothing to add
      * (and its noise to lose): the tree alone. */
     if (used && hidden_share(c, cache, i) < IRIS_LIGHT_SELECT_HIDDEN_MIN) used = 0;
@@ -157,12 +159,13 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
   c.max_d2 = IRIS_LIGHT_SELECT_RADIUS * IRIS_LIGHT_SELECT_RADIUS * g->pick_radius2 / 9.0f;
   direct_photon *dp = malloc(sizeof *dp * nd);
   sel->count = calloc(g->cache_count, 1);
+  sel->photon_count = calloc(g->cache_count, 1);
   sel->slots = calloc(g->cache_count * IRIS_LIGHT_SELECT_SLOTS, sizeof *sel->slots);
   if (threads <= 0) threads = iris_parallel_default_threads();
   c.ids = calloc((size_t)threads, sizeof *c.ids);
   c.d2 = calloc((size_t)threads, sizeof *c.d2);
   c.sums = calloc((size_t)threads, sizeof *c.sums);
-  bool ok = dp && sel->count && sel->slots && c.ids && c.d2 && c.sums;
+  bool ok = dp && sel->count && sel->photon_count && sel->slots && c.ids && c.d2 && c.sums;
   for (int i = 0; ok && i < threads; ++i) {
     c.ids[i] = malloc(sizeof(uint32_t) * (size_t)k);
     c.d2[i] = malloc(sizeof(float) * (size_t)k);
@@ -207,10 +210,71 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
 
 void iris_light_select_destroy(iris_light_select *sel) {
   free(sel->count);
+  free(sel->photon_count);
   free(sel->slots);
   float beta = sel->beta;
   memset(sel, 0, sizeof *sel);
   sel->beta = beta;
+}
+
+void iris_light_select_nee_add(iris_light_select_nee *slots, uint32_t leaf, float value) {
+  uint32_t h = (uint32_t)(iris_mix64(leaf) % IRIS_LIGHT_SELECT_NEE_SLOTS);
+  for (uint32_t k = 0; k < IRIS_LIGHT_SELECT_NEE_SLOTS; ++k) {
+    iris_light_select_nee *e = &slots[(h + k) % IRIS_LIGHT_SELECT_NEE_SLOTS];
+    if (e->leaf1 == 0) e->leaf1 = leaf + 1;
+    if (e->leaf1 == leaf + 1) {
+      e->sum += (double)value;
+      return;
+    }
+  }
+}
+
+void iris_light_select_learn_nee(iris_light_select *sel, const iris_light_select_nee *nee, const uint32_t *tries,
+                                 const uint32_t *lit) {
+  if (!sel->count || !sel->photon_count) return;
+  leaf_energy sums[IRIS_LIGHT_SELECT_SLOTS + IRIS_LIGHT_SELECT_NEE_SLOTS];
+  sel->learned_caches = sel->nee_caches = 0;
+  for (size_t i = 0; i < sel->cache_count; ++i) {
+    iris_light_select_slot *s = &sel->slots[i * IRIS_LIGHT_SELECT_SLOTS];
+    const iris_light_select_nee *e = &nee[i * IRIS_LIGHT_SELECT_NEE_SLOTS];
+    double total = 0.0;
+    for (uint32_t k = 0; k < IRIS_LIGHT_SELECT_NEE_SLOTS; ++k) total += e[k].sum;
+    if (tries[i] < IRIS_LIGHT_SELECT_NEE_MIN || !(total > 0.0) || !isfinite(total)) {
+      sel->learned_caches += sel->count[i] > 0;
+      continue;
+    }
+    const uint32_t photon = sel->photon_count[i];
+    const double lambda = photon ? (double)tries[i] / ((double)tries[i] + IRIS_LIGHT_SELECT_NEE_PRIOR) : 1.0;
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < photon; ++k)
+      sums[n++] = (leaf_energy){s[k].leaf, (1.0 - lambda) * (double)(s[k].cdf - (k ? s[k - 1].cdf : 0.0f))};
+    for (uint32_t k = 0; k < IRIS_LIGHT_SELECT_NEE_SLOTS; ++k)
+      if (e[k].leaf1 && e[k].sum > 0.0) sums[n++] = (leaf_energy){e[k].leaf1 - 1, lambda * e[k].sum / total};
+    qsort(sums, n, sizeof *sums, by_leaf);
+    uint32_t leaves = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+      if (leaves > 0 && sums[leaves - 1].leaf == sums[j].leaf) sums[leaves - 1].energy += sums[j].energy;
+      else sums[leaves++] = sums[j];
+    }
+    qsort(sums, leaves, sizeof *sums, by_energy);
+    uint32_t used = leaves < IRIS_LIGHT_SELECT_SLOTS ? leaves : IRIS_LIGHT_SELECT_SLOTS;
+    double kept = 0.0, acc = 0.0;
+    for (uint32_t j = 0; j < used; ++j) kept += sums[j].energy;
+    if (!(kept > 0.0)) used = 0;
+    for (uint32_t j = 0; j < used; ++j) {
+      acc += sums[j].energy;
+      s[j].leaf = sums[j].leaf;
+      s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / kept);
+    }
+    /* the tree's own light samples at the cache's vertices: how many were hidden */
+    const double hidden = 1.0 - (double)lit[i] / (double)tries[i];
+    if (hidden < IRIS_LIGHT_SELECT_HIDDEN_MIN) used = 0;
+    sel->count[i] = (uint8_t)used;
+    sel->learned_caches += used > 0;
+    sel->nee_caches += used > 0;
+  }
+  free(sel->photon_count);
+  sel->photon_count = NULL;
 }
 
 bool iris_light_select_attach(iris_light_select *sel, const iris_guiding *g, const iris_lights *lights) {

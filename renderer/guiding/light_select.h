@@ -49,6 +49,26 @@ struct iris_guiding;
 /* ... and learned from at least this many direct photons. */
 #define IRIS_LIGHT_SELECT_MIN_PHOTONS 32
 
+/* Leaves whose light samples a cache's training vertices remember. */
+#define IRIS_LIGHT_SELECT_NEE_SLOTS 32
+/* Light samples a cache's vertices must have traced in training before they
+ * re-learn its table (fewer: the photons' table and the probes decide). */
+#define IRIS_LIGHT_SELECT_NEE_MIN 32
+/* The light samples' share of a table is n / (n + this), n their number. */
+#define IRIS_LIGHT_SELECT_NEE_PRIOR 32.0
+
+/* What a cache's training vertices' light samples brought from one leaf: the
+ * sum of their iris_path_vertex.light_value. leaf1 = leaf + 1 (0: empty). */
+typedef struct iris_light_select_nee {
+  uint32_t leaf1;
+  double sum;
+} iris_light_select_nee;
+
+/* Adds one light sample's value to a cache's IRIS_LIGHT_SELECT_NEE_SLOTS
+ * (open addressing; a sample of a 33rd leaf is not remembered). Callers add a
+ * cache's samples in a fixed order: the sums are deterministic. */
+void iris_light_select_nee_add(iris_light_select_nee *slots, uint32_t leaf, float value);
+
 typedef struct iris_light_select_slot {
   uint32_t leaf; /* node index of a light-tree leaf */
   float cdf;     /* cumulative probability up to and including this slot (the last is 1) */
@@ -59,10 +79,13 @@ typedef struct iris_light_select {
   const iris_light_tree *tree;   /* the lights' tree the leaves belong to */
   size_t cache_count;
   uint8_t *count;                /* per cache: slots used (0: nothing learned) */
+  uint8_t *photon_count;         /* per cache, until training re-learns the tables: slots the
+                                    photons filled, kept or not by the probes */
   iris_light_select_slot *slots; /* per cache: IRIS_LIGHT_SELECT_SLOTS */
   float beta;
   uint64_t direct_photons;       /* photons the tables were learned from */
   uint64_t learned_caches;       /* caches with a table */
+  uint64_t nee_caches;           /* ... of them re-learned from training's light samples */
 } iris_light_select;
 
 /* Learns the tables of g's caches from the photons' direct hits (the k =
@@ -75,6 +98,15 @@ iris_status iris_light_select_build(iris_light_select *sel, const struct iris_gu
                                     const iris_lights *lights, const iris_photon_map *photons, int k,
                                     uint64_t seed, int threads, iris_error *err);
 void iris_light_select_destroy(iris_light_select *sel);
+/* After training (train.c): each cache whose vertices traced at least
+ * IRIS_LIGHT_SELECT_NEE_MIN light samples (tries[i], of which lit[i] brought
+ * light) learns its table again from the mixture of the photons' table and
+ * what its light samples brought by leaf (nee, IRIS_LIGHT_SELECT_NEE_SLOTS per
+ * cache), and keeps it where at least IRIS_LIGHT_SELECT_HIDDEN_MIN of those
+ * samples (the tree's own choice) found their light hidden. Frees
+ * photon_count. */
+void iris_light_select_learn_nee(iris_light_select *sel, const iris_light_select_nee *nee, const uint32_t *tries,
+                                 const uint32_t *lit);
 /* Ties tables read from a guide file (guide_file.h) to g and the lights'
  * tree: false when they do not fit it (a leaf that is not one of the tree's
  * leaves, a cdf that does not rise to 1, beta outside [0, 1)). */

@@ -125,9 +125,11 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
   else iris_infof("%s", line);
   if (g->lights.count)
-    iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons, beta %.2f",
+    iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons (%llu of them again "
+               "with the training's light samples), beta %.2f",
                (unsigned long long)g->lights.learned_caches, g->lights.cache_count,
-               (unsigned long long)g->lights.direct_photons, (double)g->lights.beta);
+               (unsigned long long)g->lights.direct_photons, (unsigned long long)g->lights.nee_caches,
+               (double)g->lights.beta);
   g->env = setup->lights->envmap; /* the map the caches' sky behind glass is sampled from */
   *out = iris_guiding_sampler(g);
   *state = g;

@@ -72,6 +72,8 @@ typedef struct train_sample {
   float pb;  /* BSDF density */
   float pc;  /* the tied caches' density (tables of this pass) */
   int8_t light; /* the vertex's light sample (iris_path_vertex.light) */
+  uint32_t light_leaf; /* ... the light-tree leaf of the light it chose (UINT32_MAX: none, no tree) */
+  float light_value;   /* ... and its value (iris_path_vertex.light_value) */
 } train_sample;
 
 typedef struct sample_buffer {
@@ -134,6 +136,14 @@ static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_en
     t.pb = pv->pdf_bsdf;
     t.pc = iris_guide_vertex_guide_pdf(c->g, v, pv->wi);
     t.light = pv->light;
+    t.light_leaf = UINT32_MAX;
+    t.light_value = 0.0f;
+    const iris_light_tree *tree = c->it->lights->tree;
+    if (pv->light > 0 && tree && pv->light_id < tree->light_count && pv->light_value > 0.0f &&
+        isfinite(pv->light_value)) {
+      t.light_leaf = tree->node_of_light[pv->light_id];
+      t.light_value = pv->light_value;
+    }
     if (!isfinite(t.li) || !isfinite(t.h) || !(t.q > 0.0f)) continue;
     if (!buffer_push(out, &t)) return false;
   }
@@ -183,6 +193,8 @@ typedef struct train_state {
   uint32_t *fine_n;             /* per sub-table: samples */
   uint32_t *light_tries, *light_lit; /* per cache, over all passes: light samples traced at the
                                         vertices it served, and those that brought light */
+  iris_light_select_nee *nee;        /* per cache, IRIS_LIGHT_SELECT_NEE_SLOTS: what the light samples
+                                        brought by tree leaf (NULL: no learned light selection) */
 } train_state;
 
 /* Adds a tile's samples to the caches whose id is `lane` modulo `lanes`:
@@ -199,6 +211,8 @@ static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer 
       float cosc = fabsf(wl.z);
       ts->n[id]++;
       if (t->light >= 0) ts->light_tries[id]++, ts->light_lit[id] += (uint32_t)t->light;
+      if (ts->nee && t->light_leaf != UINT32_MAX)
+        iris_light_select_nee_add(ts->nee + (size_t)id * IRIS_LIGHT_SELECT_NEE_SLOTS, t->light_leaf, t->light_value);
       iris_alpha_learner_add(&ts->learner[id], t->h, t->q, t->pb, t->pc);
       if (!(t->li > 0.0f)) continue;
       /* Li cos / q estimates the integral of Li cos over the sphere; splatted
@@ -284,7 +298,9 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   train_state ts = {malloc(caches * sizeof(float)), calloc(floats ? floats : 1, sizeof(float)),
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
                     calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL,
-                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t))};
+                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t)), NULL};
+  const bool learn_nee = g->lights.count != NULL && g->lights.tree != NULL;
+  if (learn_nee) ts.nee = calloc(caches * IRIS_LIGHT_SELECT_NEE_SLOTS, sizeof *ts.nee);
   if (ts.radiance_photons)
     for (size_t i = 0; i < caches; ++i) ts.radiance_photons[i] = g->caches[i].radiance;
   const size_t subs = g->refine_slot ? (floats / g->hemi.texel_count + 1) * IRIS_REFINE_MAX : 0;
@@ -298,7 +314,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
   iris_status st = IRIS_OK;
   if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf || !ts.light_tries ||
-      !ts.light_lit ||
+      !ts.light_lit || (learn_nee && !ts.nee) ||
       (subs && (!ts.fine_acc || !ts.fine_n || !ts.photon_sub)))
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
 
@@ -378,6 +394,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   if (st == IRIS_OK && p->light_min < 1.0f)
     for (size_t i = 0; i < caches; ++i)
       if (ts.light_tries[i] >= LIGHT_MIN_TRIES && ts.light_lit[i] == 0) g->caches[i].light = p->light_min;
+  /* The learned light tables again, now with what the light samples brought */
+  if (st == IRIS_OK && learn_nee) iris_light_select_learn_nee(&g->lights, ts.nee, ts.light_tries, ts.light_lit);
   for (int t = 0; t < TRAIN_BATCH_TILES && buf; ++t) free(buf[t].s);
   free(buf);
   free(hist);
@@ -391,6 +409,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   free(ts.photon_sub);
   free(ts.light_tries);
   free(ts.light_lit);
+  free(ts.nee);
   free(g->photon_hist);
   g->photon_hist = NULL;
   g->stats.train_spp = done;
