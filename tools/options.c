@@ -138,6 +138,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("no-glints", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, glints,
         "do not aim guided directions at the spots where a mirror,\n"
         "glass or near-mirror metal reflects a light (glints)"),
+    OPT("no-light-samples", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, light_samples,
+        "with --light-sampler learned: learn the caches' light tables\n"
+        "from the photons alone, not also from training's light samples"),
     OPT("light-min", 0, IRIS_OPT_FLOAT, "P", 0.001, 1, iris_guiding_params, light_min,
         "probability of light sampling where the caches' training\n"
         "found it brings no light (default 0.1; 1: always)"),

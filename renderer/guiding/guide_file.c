@@ -728,6 +728,8 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   if (s->lights && s->lights->tree) h = mix_u64(h, 0x7ee11ULL);
   /* --light-sampler learned: the file holds the caches' light tables */
   if (s->learn_lights) h = mix_u64(h, 0x1ea4edULL);
+  /* ... learned from training's light samples too (guides before that differ) */
+  if (s->learn_lights && p->light_samples) h = mix_u64(h, 0x5a3b1eULL);
   /* The guiding options as requested (auto values resolve the same way from
    * the same scene and camera). train_spp enters as given: with -1 (auto)
    * the training budget follows the writer's spp/time, which are left out so

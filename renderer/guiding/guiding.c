@@ -43,6 +43,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.refine = -1;
   p.lamp_glass = true;
   p.glints = true;
+  p.light_samples = true;
   p.light_min = IRIS_GUIDING_LIGHT_MIN;
   return p;
 }

@@ -89,6 +89,9 @@ typedef struct iris_guiding_params {
                            metal) mark where their reflections of the lights land, and the guide
                            draws directions in the cone of the spot a vertex's nearest ones left
                            (default on; --no-glints; glints.h, docs/guiding.md "Glints") */
+  bool light_samples;   /* --light-sampler learned: training's light samples teach the caches' light
+                           tables too (default on; --no-light-samples: the photons alone;
+                           light_select.h, docs/guiding.md "Learned light selection") */
   float light_min;      /* light sampling's probability at vertices whose caches' training traced
                            >= 32 light samples and none brought light (--light-min; 1: always
                            sample lights; docs/guiding.md, "Light sampling where no light arrives") */

@@ -125,11 +125,13 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   if (p.guide_in) iris_infof("%s (read from %s)", line, p.guide_in);
   else iris_infof("%s", line);
   if (g->lights.count)
-    iris_infof("learned light selection: %llu of %zu caches learned from %llu direct photons (%llu of them again "
-               "with the training's light samples), beta %.2f",
-               (unsigned long long)g->lights.learned_caches, g->lights.cache_count,
-               (unsigned long long)g->lights.direct_photons, (unsigned long long)g->lights.nee_caches,
-               (double)g->lights.beta);
+    iris_infof("learned light selection: %llu of %zu caches learned%s from %llu direct photons%s, beta %.2f",
+               (unsigned long long)g->lights.learned_caches, g->lights.cache_count, p.guide_in ? " (read)" : "",
+               (unsigned long long)g->lights.direct_photons,
+               g->lights.nee_caches ? " and, in training, from light samples" : "", (double)g->lights.beta);
+  if (g->lights.nee_caches)
+    iris_infof("learned light selection: %llu tables from the training's light samples too",
+               (unsigned long long)g->lights.nee_caches);
   g->env = setup->lights->envmap; /* the map the caches' sky behind glass is sampled from */
   *out = iris_guiding_sampler(g);
   *state = g;

@@ -299,7 +299,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
                     calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL,
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t)), NULL};
-  const bool learn_nee = g->lights.count != NULL && g->lights.tree != NULL;
+  const bool learn_nee = p->light_samples && g->lights.count != NULL && g->lights.tree != NULL;
   if (learn_nee) ts.nee = calloc(caches * IRIS_LIGHT_SELECT_NEE_SLOTS, sizeof *ts.nee);
   if (ts.radiance_photons)
     for (size_t i = 0; i < caches; ++i) ts.radiance_photons[i] = g->caches[i].radiance;
