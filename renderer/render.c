@@ -1,5 +1,6 @@
 /* The render loop: set-up, passes of samples over all pixels, output files. */
 #include "renderer/render.h"
+#include "renderer/light_hidden.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,6 +96,7 @@ iris_status iris_render(const iris_scene *scene, const iris_render_params *param
 static iris_status render(const iris_scene *scene, const iris_render_params *params_in,
                           iris_render_result *res, iris_error *err) {
   memset(res, 0, sizeof *res);
+  res->light_hidden_share = -1.0;
   iris_render_params p = *params_in;
   const bool adaptive = p.adaptive.rule != IRIS_ADAPTIVE_OFF;
   if (adaptive && p.spp <= 0) p.spp = IRIS_RENDER_ADAPTIVE_DEFAULT_CAP; /* a cap, not the scene's count */
@@ -202,8 +204,24 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   const bool resolve = p.method == IRIS_METHOD_AUTO;
   /* --light-sampler learned: the guide's caches learn which lights they see
    * (a tree of more than one leaf to learn over, a provider that can). */
-  const bool learned = st == IRIS_OK && p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && lights.tree && p.guide &&
-                       p.guide->light_select && p.guide->build_lights && iris_method_uses_nee(resolve ? IRIS_METHOD_MIS : p.method);
+  bool learned = st == IRIS_OK && p.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && lights.tree && p.guide &&
+                 p.guide->light_select && p.guide->build_lights && iris_method_uses_nee(resolve ? IRIS_METHOD_MIS : p.method);
+  if (learned) {
+    /* Where the tree's choices at what the camera sees are rarely hidden,
+     * there is nothing to learn: the tree alone, without the photons. */
+    int valid = 0;
+    double hidden = iris_lights_camera_hidden_share(&lights, accel, &res->camera, p.seed, &valid);
+    res->light_hidden_share = hidden;
+    if (hidden < IRIS_LIGHTS_HIDDEN_MIN) {
+      learned = false;
+      iris_infof("learned light selection: the tree alone (%.1f%% of its choices at %d points the camera sees are "
+                 "hidden, < %.0f%%)",
+                 100.0 * hidden, valid, 100.0 * IRIS_LIGHTS_HIDDEN_MIN);
+    } else {
+      iris_infof("learned light selection: %.1f%% of the tree's choices at %d points the camera sees are hidden",
+                 100.0 * hidden, valid);
+    }
+  }
   void *light_state = NULL; /* the guide built for the light choice alone (nee, mis) */
   if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the light tables */

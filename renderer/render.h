@@ -164,6 +164,8 @@ typedef struct iris_render_result {
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;
   iris_light_sampler light_sampler;
+  double light_hidden_share; /* learned: the tree's hidden share at what the camera sees (light_hidden.h;
+                                below IRIS_LIGHTS_HIDDEN_MIN the tree alone); -1 not measured */
   int spp;               /* samples per pixel completed in the image passes; adaptive: the
                             cap, the sample indices reserved (offset .. offset+spp-1; each
                             pixel's count is in the film) */
