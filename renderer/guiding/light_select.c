@@ -33,6 +33,20 @@ static bool accept_photon(void *ctx, uint32_t id) {
   return a->sphere || iris_dot(ph->wi, a->n) > 0.0f;
 }
 
+uint32_t iris_light_select_leaf_of(const iris_light_tree *t, uint32_t light) {
+  if (light >= t->light_count) return UINT32_MAX;
+  if (t->node_of_light[light] != UINT32_MAX) return t->node_of_light[light];
+  for (size_t k = 0; k < t->infinite_count; ++k)
+    if (t->infinite[k] == light) return IRIS_LIGHT_SELECT_INFINITE | (uint32_t)k;
+  return UINT32_MAX;
+}
+
+/* A slot's light: the leaf's by power (v in [0, 1)), or the infinite light. */
+static uint32_t slot_light(const iris_light_tree *t, uint32_t leaf, double v) {
+  if (leaf & IRIS_LIGHT_SELECT_INFINITE) return t->infinite[leaf & ~IRIS_LIGHT_SELECT_INFINITE];
+  return iris_light_tree_leaf_choose(t, leaf, v);
+}
+
 typedef struct leaf_energy {
   uint32_t leaf;
   double energy;
@@ -146,7 +160,7 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
   size_t nd = 0;
   for (size_t i = 0; i < photons->count; ++i) {
     const iris_photon *ph = &photons->photons[i];
-    nd += ph->bounce == 0 && ph->light < t->light_count && t->node_of_light[ph->light] != UINT32_MAX;
+    nd += ph->bounce == 0 && iris_light_select_leaf_of(t, ph->light) != UINT32_MAX;
   }
   if (nd == 0 || nd > UINT32_MAX) return IRIS_OK;
   build_ctx c;
@@ -179,8 +193,9 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
     size_t at = 0;
     for (size_t i = 0; i < photons->count; ++i) {
       const iris_photon *ph = &photons->photons[i];
-      if (!(ph->bounce == 0 && ph->light < t->light_count && t->node_of_light[ph->light] != UINT32_MAX)) continue;
-      dp[at++] = (direct_photon){ph->p, ph->n, ph->wi, ph->energy, t->node_of_light[ph->light]};
+      const uint32_t leaf = ph->bounce == 0 ? iris_light_select_leaf_of(t, ph->light) : UINT32_MAX;
+      if (leaf == UINT32_MAX) continue;
+      dp[at++] = (direct_photon){ph->p, ph->n, ph->wi, ph->energy, leaf};
     }
     c.dp = dp;
     st = iris_kdtree_build_threads(&c.tree, &dp[0].p, sizeof *dp, (uint32_t)nd, threads, err);
@@ -285,7 +300,12 @@ bool iris_light_select_attach(iris_light_select *sel, const iris_guiding *g, con
     if (sel->count[i] > IRIS_LIGHT_SELECT_SLOTS) return false;
     float prev = 0.0f;
     for (uint32_t k = 0; k < sel->count[i]; ++k) {
-      if (s[k].leaf >= t->node_count || !(t->nodes[s[k].leaf].flags & IRIS_LIGHT_NODE_LEAF)) return false;
+      const uint32_t leaf = s[k].leaf;
+      if (leaf & IRIS_LIGHT_SELECT_INFINITE) {
+        if ((leaf & ~IRIS_LIGHT_SELECT_INFINITE) >= t->infinite_count) return false;
+      } else if (leaf >= t->node_count || !(t->nodes[leaf].flags & IRIS_LIGHT_NODE_LEAF)) {
+        return false;
+      }
       if (!(s[k].cdf >= prev && s[k].cdf <= 1.0f)) return false;
       prev = s[k].cdf;
     }
@@ -319,10 +339,11 @@ static float slot_probability(const iris_light_select *sel, uint32_t c, uint32_t
 static float mixture_pmf(const iris_light_select *sel, const uint32_t *ids, int m, uint32_t light, float tree_pmf) {
   if (m == 0) return tree_pmf;
   float learned = 0.0f;
-  uint32_t leaf = light < sel->tree->light_count ? sel->tree->node_of_light[light] : UINT32_MAX;
+  uint32_t leaf = iris_light_select_leaf_of(sel->tree, light);
   if (leaf != UINT32_MAX) {
     for (int j = 0; j < m; ++j) learned += slot_probability(sel, ids[j], leaf);
-    learned = learned / (float)m * sel->tree->pmf_in_leaf[light];
+    learned /= (float)m;
+    if (!(leaf & IRIS_LIGHT_SELECT_INFINITE)) learned *= sel->tree->pmf_in_leaf[light]; /* an infinite light is its slot */
   }
   return (1.0f - sel->beta) * tree_pmf + sel->beta * learned;
 }
@@ -346,7 +367,7 @@ bool iris_light_select_choose(const iris_light_select *sel, iris_vec3 p, iris_ve
     v = width > 0.0 ? (v - lo) / width : 0.0;
     if (!(v < 1.0)) v = 0x1.fffffffffffffp-1;
     if (v < 0.0) v = 0.0;
-    *light = iris_light_tree_leaf_choose(sel->tree, s[k].leaf, v);
+    *light = slot_light(sel->tree, s[k].leaf, v);
     *pmf = mixture_pmf(sel, ids, m, *light, iris_light_tree_pmf(sel->tree, p, n, *light));
     return *pmf > 0.0f;
   }

@@ -69,8 +69,16 @@ typedef struct iris_light_select_nee {
  * cache's samples in a fixed order: the sums are deterministic. */
 void iris_light_select_nee_add(iris_light_select_nee *slots, uint32_t leaf, float value);
 
+/* A table's slot names a light-tree leaf by its node index, or an infinite
+ * light (environment map, distant light: beside the tree) k of
+ * tree->infinite as IRIS_LIGHT_SELECT_INFINITE | k: without them a table
+ * would take beta of the sky's probability away where it lights the cache. */
+#define IRIS_LIGHT_SELECT_INFINITE 0x80000000u
+/* The slot name of `light` (UINT32_MAX: none, e.g. zero power). */
+uint32_t iris_light_select_leaf_of(const iris_light_tree *tree, uint32_t light);
+
 typedef struct iris_light_select_slot {
-  uint32_t leaf; /* node index of a light-tree leaf */
+  uint32_t leaf; /* node index of a light-tree leaf, or IRIS_LIGHT_SELECT_INFINITE | k */
   float cdf;     /* cumulative probability up to and including this slot (the last is 1) */
 } iris_light_select_slot;
 

@@ -139,9 +139,8 @@ static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_en
     t.light_leaf = UINT32_MAX;
     t.light_value = 0.0f;
     const iris_light_tree *tree = c->it->lights->tree;
-    if (pv->light > 0 && tree && pv->light_id < tree->light_count && pv->light_value > 0.0f &&
-        isfinite(pv->light_value)) {
-      t.light_leaf = tree->node_of_light[pv->light_id];
+    if (pv->light > 0 && tree && pv->light_value > 0.0f && isfinite(pv->light_value)) {
+      t.light_leaf = iris_light_select_leaf_of(tree, pv->light_id);
       t.light_value = pv->light_value;
     }
     if (!isfinite(t.li) || !isfinite(t.h) || !(t.q > 0.0f)) continue;

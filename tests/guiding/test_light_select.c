@@ -14,6 +14,9 @@
  *    with the tree within statistical error (office, corridor-rooms; nee and
  *    mis on veach-mis), and a learned render is the same for 1 and 2 threads;
  *  - where the tree's descent ends in nothing, no light is chosen (corridor-rooms);
+ *  - infinite lights (the sky) have slots of their own in the tables, pass
+ *    the same chi-square, and come back from a guide file (sky-room with
+ *    two lamps);
  *  - a scene whose tree's choices at what the camera sees are rarely hidden
  *    (the office) renders `learned` as the tree, bit for bit;
  *  - a trained guide's tables learn from the light samples (corridor-rooms):
@@ -57,11 +60,31 @@ static bool world_build_trained(world *w, const char *name, int threads, int tra
 static bool world_build(world *w, const char *name, int threads) { return world_build_trained(w, name, threads, 0); }
 
 /* train_spp > 0: the guide of guided-nee, trained (its tables learn from the light samples too) */
+/* sky-room with two point lamps under its ceiling: the sky through the
+ * window is an infinite light beside the tree's two leaves */
+static iris_status sky_room_lamps(iris_scene **s, iris_error *err) {
+  iris_status st = iris_builtin_create("sky-room", s, err);
+  for (int k = 0; st == IRIS_OK && k < 2; k++) {
+    iris_light l;
+    memset(&l, 0, sizeof l);
+    l.type = IRIS_LIGHT_POINT;
+    l.color[0] = l.color[1] = l.color[2] = 1.0f;
+    l.intensity = 3.0f;
+    l.position[0] = -1.5f;
+    l.position[1] = 2.2f;
+    l.position[2] = k ? 1.5f : -1.5f;
+    if (iris_scene_add_light(*s, &l) < 0) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
+  }
+  return st;
+}
+
 static bool world_build_trained(world *w, const char *name, int threads, int train_spp) {
   memset(w, 0, sizeof *w);
   iris_error err;
   iris_error_clear(&err);
-  if (!ok(iris_builtin_create(name, &w->s, &err), &err)) return false;
+  if (!ok(strcmp(name, "sky-room-lamps") == 0 ? sky_room_lamps(&w->s, &err) : iris_builtin_create(name, &w->s, &err),
+          &err))
+    return false;
   if (!ok(iris_pinhole_setup(w->s, NULL, 96, 64, &w->cam, &err), &err)) return false;
   if (!ok(iris_accel_build(w->s, &w->accel, &err), &err)) return false;
   if (!ok(iris_textures_load(w->s, &w->tex, &err), &err)) return false;
@@ -334,6 +357,52 @@ int main(void) {
     CHECK(points >= 32);
     iris_check_record(h_table < 0.5 * h_tree, __FILE__, __LINE__, "tables' choices hidden %.3f, the tree's %.3f", h_table,
                       h_tree);
+    world_destroy(&w);
+  }
+
+  /* Infinite lights in the tables: in sky-room with two lamps the caches by
+   * the window learn the sky as a slot of its own (IRIS_LIGHT_SELECT_INFINITE |
+   * k), so a table does not take beta of the sky's probability away where it
+   * lights the room; the choice keeps its pmf there, and a guide file keeps
+   * such slots and refuses one past the infinite lights. */
+  if (world_build_trained(&w, "sky-room-lamps", 2, 8)) {
+    const iris_light_select *sel = &w.g->lights;
+    size_t sky = 0, first = SIZE_MAX;
+    for (size_t i = 0; i < sel->cache_count; ++i)
+      for (int k = 0; k < sel->count[i]; k++)
+        if (sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + k].leaf & IRIS_LIGHT_SELECT_INFINITE) {
+          sky++;
+          if (first == SIZE_MAX) first = i;
+        }
+    printf("sky-room-lamps: %llu tables, %zu with the sky's slot\n", (unsigned long long)sel->learned_caches, sky);
+    if (CHECK(sky > 0)) {
+      int k = 0;
+      for (size_t i = first; i < sel->cache_count && k < 3; i += 7) {
+        bool has = false;
+        for (int j = 0; j < sel->count[i]; j++) has |= (sel->slots[i * IRIS_LIGHT_SELECT_SLOTS + j].leaf & IRIS_LIGHT_SELECT_INFINITE) != 0;
+        if (!has) continue;
+        check_point(&w, w.g->caches[i].p, w.g->caches[i].frame.n, 200 + k, 3);
+        k++;
+      }
+      CHECK(k > 0);
+      iris_error err;
+      iris_error_clear(&err);
+      const char *path = "test_light_select_sky.guide";
+      iris_guiding *back = NULL;
+      CHECK_OK(iris_guiding_save(w.g, path, 1, 2, &err), &err);
+      CHECK_OK(iris_guiding_load(path, 1, 2, 1, &back, &err), &err);
+      if (CHECK(back != NULL)) {
+        CHECK(iris_light_select_attach(&back->lights, back, &w.lights));
+        CHECK(memcmp(back->lights.slots, sel->slots, sel->cache_count * IRIS_LIGHT_SELECT_SLOTS * sizeof *sel->slots) == 0);
+        for (int j = 0; j < back->lights.count[first]; j++)
+          if (back->lights.slots[first * IRIS_LIGHT_SELECT_SLOTS + j].leaf & IRIS_LIGHT_SELECT_INFINITE)
+            back->lights.slots[first * IRIS_LIGHT_SELECT_SLOTS + j].leaf =
+                IRIS_LIGHT_SELECT_INFINITE | (uint32_t)w.lights.tree->infinite_count;
+        CHECK(!iris_light_select_attach(&back->lights, back, &w.lights));
+        iris_guiding_destroy(back);
+      }
+      remove(path);
+    }
     world_destroy(&w);
   }
 
