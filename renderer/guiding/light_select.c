@@ -63,6 +63,8 @@ static int by_energy(const void *a, const void *b) {
   return x->leaf < y->leaf ? -1 : x->leaf > y->leaf;
 }
 
+static void mark_near(iris_light_select *sel);
+
 typedef struct build_ctx {
   iris_light_select *sel;
   const iris_lights *lights;
@@ -208,6 +210,7 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
     iris_parallel_for(g->cache_count, 64, threads, learn_caches, &c);
     if (iris_cancel_requested()) st = iris_cancel_error(err);
     for (size_t i = 0; i < g->cache_count; ++i) sel->learned_caches += sel->count[i] > 0;
+    mark_near(sel);
   }
   iris_kdtree_destroy(&c.tree);
   for (int i = 0; i < threads; ++i) {
@@ -223,7 +226,24 @@ iris_status iris_light_select_build(iris_light_select *sel, const iris_guiding *
   return st;
 }
 
+/* sel->near from the tables (after every change of count). */
+static void mark_near(iris_light_select *sel) {
+  free(sel->near);
+  sel->near = NULL;
+  const iris_pick_grid *grid = &sel->g->grid;
+  if (!grid->n[0] || !grid->id_count || !sel->count) return;
+  sel->near = calloc(grid->id_count, 1);
+  if (!sel->near) return; /* the caches are read instead */
+  for (size_t c = 0; c < grid->cells; ++c) {
+    const uint32_t a = grid->answer[c], n = a >> 29, at = a & 0x1fffffffu;
+    uint8_t any = 0;
+    for (uint32_t i = 0; i < n; ++i) any |= sel->count[grid->ids[at + i]] > 0;
+    if (n) sel->near[at] = any;
+  }
+}
+
 void iris_light_select_destroy(iris_light_select *sel) {
+  free(sel->near);
   free(sel->count);
   free(sel->photon_count);
   free(sel->slots);
@@ -290,6 +310,7 @@ void iris_light_select_learn_nee(iris_light_select *sel, const iris_light_select
   }
   free(sel->photon_count);
   sel->photon_count = NULL;
+  mark_near(sel);
 }
 
 bool iris_light_select_attach(iris_light_select *sel, const iris_guiding *g, const iris_lights *lights) {
@@ -313,12 +334,23 @@ bool iris_light_select_attach(iris_light_select *sel, const iris_guiding *g, con
   }
   sel->g = g;
   sel->tree = t;
+  mark_near(sel);
   return true;
 }
 
 /* The tied caches at (p, n) that learned something; 0 where the mixture is the tree alone. */
 static int learned_caches(const iris_light_select *sel, iris_vec3 p, iris_vec3 n, uint32_t ids[IRIS_GUIDING_PICK_K]) {
   if (!sel->count || (n.x == 0.0f && n.y == 0.0f && n.z == 0.0f)) return 0;
+  if (sel->near) { /* the grid cell's caches: none with a table, nothing to read */
+    const iris_pick_grid *grid = &sel->g->grid;
+    float fx = (p.x - grid->lo[0]) * grid->inv_cell, fy = (p.y - grid->lo[1]) * grid->inv_cell,
+          fz = (p.z - grid->lo[2]) * grid->inv_cell;
+    if (!(fx >= 0.0f && fy >= 0.0f && fz >= 0.0f)) return 0;
+    int ix = (int)fx, iy = (int)fy, iz = (int)fz;
+    if (ix >= grid->n[0] || iy >= grid->n[1] || iz >= grid->n[2]) return 0;
+    const uint32_t a = grid->answer[((size_t)iz * (size_t)grid->n[1] + (size_t)iy) * (size_t)grid->n[0] + (size_t)ix];
+    if ((a >> 29) == 0 || !sel->near[a & 0x1fffffffu]) return 0;
+  }
   uint32_t all[IRIS_GUIDING_PICK_K];
   int m = iris_guiding_pick(sel->g, p, n, all), kept = 0;
   for (int j = 0; j < m; ++j)

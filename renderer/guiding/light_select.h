@@ -90,6 +90,9 @@ typedef struct iris_light_select {
   uint8_t *photon_count;         /* per cache, until training re-learns the tables: slots the
                                     photons filled, kept or not by the probes */
   iris_light_select_slot *slots; /* per cache: IRIS_LIGHT_SELECT_SLOTS */
+  uint8_t *near;                 /* per answer of the caches' pick grid (indexed by its first id's
+                                    offset): 1 when one of its caches has a table; where none
+                                    has, a light choice reads no cache (NULL: no grid) */
   float beta;
   uint64_t direct_photons;       /* photons the tables were learned from */
   uint64_t learned_caches;       /* caches with a table */

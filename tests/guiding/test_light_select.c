@@ -323,6 +323,37 @@ int main(void) {
             memcmp(w2.g->lights.slots, sel->slots, sel->cache_count * IRIS_LIGHT_SELECT_SLOTS * sizeof *sel->slots) == 0);
       world_destroy(&w2);
     }
+    /* The grid's shortcut (a cell whose caches have no table reads none of
+     * them) answers as reading them does: at points around every 4th cache,
+     * with and without it, the same pmf of every 9th light. */
+    {
+      iris_light_select *ms = &w.g->lights;
+      uint8_t *near = ms->near;
+      size_t differ = 0, asked = 0, skipped = 0;
+      uint64_t ps = 5;
+      CHECK(near != NULL);
+      for (size_t i = 0; i < ms->cache_count; i += 4) {
+        const iris_cache *cache = &w.g->caches[i];
+        iris_vec3 p = iris_add(cache->p, iris_v3((float)chi2_uniform(&ps) - 0.5f, (float)chi2_uniform(&ps) - 0.5f,
+                                                 (float)chi2_uniform(&ps) - 0.5f));
+        uint32_t ids[IRIS_GUIDING_PICK_K];
+        int m = iris_guiding_pick(w.g, p, cache->frame.n, ids), with = 0;
+        for (int j = 0; j < m; j++) with += ms->count[ids[j]] > 0;
+        skipped += with == 0;
+        for (uint32_t l = 0; l < w.lights.count; l += 9) {
+          ms->near = near;
+          float a = iris_light_select_pmf(ms, p, cache->frame.n, l);
+          ms->near = NULL;
+          float b = iris_light_select_pmf(ms, p, cache->frame.n, l);
+          differ += a != b;
+          asked++;
+        }
+      }
+      ms->near = near;
+      printf("corridor-rooms: the grid's shortcut: %zu of %zu pmfs differ (%zu points without a table near)\n", differ,
+             asked, skipped);
+      CHECK(differ == 0 && skipped > 0);
+    }
     /* What the tables learned is what the walls let through: at the caches
      * that learned from light samples, the lights the tables alone choose (u <
      * beta) are hidden from the cache far less often than the tree's. Leaves
