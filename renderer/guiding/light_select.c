@@ -108,6 +108,29 @@ static double hidden_share(const build_ctx *c, const iris_cache *cache, uint64_t
   return valid ? (double)hidden / (double)valid : 0.0;
 }
 
+/* A table from (leaf, weight) pairs, leaves repeated: sums them by leaf, keeps
+ * the IRIS_LIGHT_SELECT_SLOTS heaviest and writes their CDF into s; returns
+ * the slots used (0 when nothing weighs). Reorders sums. */
+static uint32_t write_table(leaf_energy *sums, uint32_t n, iris_light_select_slot *s) {
+  qsort(sums, n, sizeof *sums, by_leaf);
+  uint32_t leaves = 0;
+  for (uint32_t j = 0; j < n; ++j) {
+    if (leaves > 0 && sums[leaves - 1].leaf == sums[j].leaf) sums[leaves - 1].energy += sums[j].energy;
+    else sums[leaves++] = sums[j];
+  }
+  qsort(sums, leaves, sizeof *sums, by_energy);
+  uint32_t used = leaves < IRIS_LIGHT_SELECT_SLOTS ? leaves : IRIS_LIGHT_SELECT_SLOTS;
+  double total = 0.0, acc = 0.0;
+  for (uint32_t j = 0; j < used; ++j) total += sums[j].energy;
+  if (!(total > 0.0)) return 0;
+  for (uint32_t j = 0; j < used; ++j) {
+    acc += sums[j].energy;
+    s[j].leaf = sums[j].leaf;
+    s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / total);
+  }
+  return used;
+}
+
 static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   build_ctx *c = ctx;
   iris_light_select *sel = c->sel;
@@ -123,23 +146,8 @@ static void learn_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
       sums[j].leaf = c->dp[ids[j]].leaf;
       sums[j].energy = c->dp[ids[j]].energy;
     }
-    qsort(sums, n, sizeof *sums, by_leaf);
-    uint32_t leaves = 0;
-    for (uint32_t j = 0; j < n; ++j) {
-      if (leaves > 0 && sums[leaves - 1].leaf == sums[j].leaf) sums[leaves - 1].energy += sums[j].energy;
-      else sums[leaves++] = sums[j];
-    }
-    qsort(sums, leaves, sizeof *sums, by_energy);
-    uint32_t used = leaves < IRIS_LIGHT_SELECT_SLOTS ? leaves : IRIS_LIGHT_SELECT_SLOTS;
-    double total = 0.0, acc = 0.0;
-    for (uint32_t j = 0; j < used; ++j) total += sums[j].energy;
-    if (!(total > 0.0) || n < IRIS_LIGHT_SELECT_MIN_PHOTONS) used = 0;
-    iris_light_select_slot *s = &sel->slots[i * IRIS_LIGHT_SELECT_SLOTS];
-    for (uint32_t j = 0; j < used; ++j) {
-      acc += sums[j].energy;
-      s[j].leaf = sums[j].leaf;
-      s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / total);
-    }
+    uint32_t used = write_table(sums, n, &sel->slots[i * IRIS_LIGHT_SELECT_SLOTS]);
+    if (n < IRIS_LIGHT_SELECT_MIN_PHOTONS) used = 0;
     sel->photon_count[i] = (uint8_t)used;
     /* Where the tree's choice is rarely hidden, the table has nothing to add
      * (and its noise to lose): the tree alone. */
@@ -285,22 +293,7 @@ void iris_light_select_learn_nee(iris_light_select *sel, const iris_light_select
       sums[n++] = (leaf_energy){s[k].leaf, (1.0 - lambda) * (double)(s[k].cdf - (k ? s[k - 1].cdf : 0.0f))};
     for (uint32_t k = 0; k < IRIS_LIGHT_SELECT_NEE_SLOTS; ++k)
       if (e[k].leaf1 && e[k].sum > 0.0) sums[n++] = (leaf_energy){e[k].leaf1 - 1, lambda * e[k].sum / total};
-    qsort(sums, n, sizeof *sums, by_leaf);
-    uint32_t leaves = 0;
-    for (uint32_t j = 0; j < n; ++j) {
-      if (leaves > 0 && sums[leaves - 1].leaf == sums[j].leaf) sums[leaves - 1].energy += sums[j].energy;
-      else sums[leaves++] = sums[j];
-    }
-    qsort(sums, leaves, sizeof *sums, by_energy);
-    uint32_t used = leaves < IRIS_LIGHT_SELECT_SLOTS ? leaves : IRIS_LIGHT_SELECT_SLOTS;
-    double kept = 0.0, acc = 0.0;
-    for (uint32_t j = 0; j < used; ++j) kept += sums[j].energy;
-    if (!(kept > 0.0)) used = 0;
-    for (uint32_t j = 0; j < used; ++j) {
-      acc += sums[j].energy;
-      s[j].leaf = sums[j].leaf;
-      s[j].cdf = j + 1 == used ? 1.0f : (float)(acc / kept);
-    }
+    uint32_t used = write_table(sums, n, s);
     /* the tree's own light samples at the cache's vertices: how many were hidden */
     const double hidden = 1.0 - (double)lit[i] / (double)tries[i];
     if (hidden < IRIS_LIGHT_SELECT_HIDDEN_MIN) used = 0;
