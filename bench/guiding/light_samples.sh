@@ -44,7 +44,9 @@ for s in $SCENES; do
   g="--train-spp 8 --discard-training"
   echo "== $s: direct light, 16 spp"
   row "$s" "mis tree" "$ref0" "$OUT/d-$s-mis" --method mis $d
-  row "$s" "mis learned (photons)" "$ref0" "$OUT/d-$s-misl" --method mis --light-sampler learned $d
+  row "$s" "mis learned, photons alone" "$ref0" "$OUT/d-$s-mislp" --method mis --light-sampler learned \
+    --no-light-samples $d
+  row "$s" "mis learned, + light samples" "$ref0" "$OUT/d-$s-misl" --method mis --light-sampler learned $d
   row "$s" "guided-nee tree" "$ref0" "$OUT/d-$s-gn" --method guided-nee $d $g
   row "$s" "guided-nee learned, photons" "$ref0" "$OUT/d-$s-gnp" --method guided-nee --light-sampler learned \
     --no-light-samples $d $g
@@ -58,7 +60,9 @@ for s in $SCENES; do
   e="--time $T --width 108 --height 72"
   echo "== $s: whole path, $T s"
   row "$s" "mis tree" "$ref" "$OUT/e-$s-mis" --method mis $e
-  row "$s" "mis learned" "$ref" "$OUT/e-$s-misl" --method mis --light-sampler learned $e
+  row "$s" "mis learned, photons alone" "$ref" "$OUT/e-$s-mislp" --method mis --light-sampler learned \
+    --no-light-samples $e
+  row "$s" "mis learned, + light samples" "$ref" "$OUT/e-$s-misl" --method mis --light-sampler learned $e
   row "$s" "guided-nee tree" "$ref" "$OUT/e-$s-gn" --method guided-nee $e
   row "$s" "guided-nee learned, photons" "$ref" "$OUT/e-$s-gnp" --method guided-nee --light-sampler learned \
     --no-light-samples $e

@@ -138,14 +138,21 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   return IRIS_OK;
 }
 
-/* For methods without a guide of their own: the caches only (built whatever
- * the skip rules say, no training, no file), for the learned light choice. */
+/* Training spp of the light-only passes for methods without a guide of their own. */
+#define LIGHTS_TRAIN_SPP 4
+
+/* For methods without a guide of their own: the caches (built whatever the
+ * skip rules say, no file) for the learned light choice, and, unless
+ * --no-light-samples, LIGHTS_TRAIN_SPP training passes of direct light alone
+ * (camera ray, a light sample and a direction at the first surface: about
+ * three rays a sample) whose light samples teach the tables what the camera
+ * sees, as guided-nee's training does. */
 static iris_status provider_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
   iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
                                          : iris_guiding_params_default();
   p.use_nee = true;
   p.force = true;
-  p.train_spp = 0;
+  p.train_spp = p.light_samples ? LIGHTS_TRAIN_SPP : 0;
   p.pilot_paths = 0;
   p.sky_probes = 0;
   p.guide_in = p.guide_out = NULL;
@@ -153,6 +160,13 @@ static iris_status provider_build_lights(const iris_guide_setup *setup, void **s
   p.marks = NULL;
   iris_direction_sampler unused;
   iris_guide_setup s = *setup;
+  iris_integrator direct;
+  if (setup->integrator) { /* training traces guided-nee's first vertex only */
+    direct = *setup->integrator;
+    direct.method = IRIS_METHOD_GUIDED_NEE;
+    direct.max_depth = 0;
+    s.integrator = &direct;
+  }
   s.options = &p;
   s.film = NULL;
   s.deciding = false;

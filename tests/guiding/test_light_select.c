@@ -323,6 +323,32 @@ int main(void) {
             memcmp(w2.g->lights.slots, sel->slots, sel->cache_count * IRIS_LIGHT_SELECT_SLOTS * sizeof *sel->slots) == 0);
       world_destroy(&w2);
     }
+    /* mis and nee train no guide: the tables built for them alone
+     * (build_lights) run light-only training passes (guided-nee's first
+     * vertex) and learn from their light samples too; --no-light-samples not. */
+    {
+      iris_integrator it = iris_integrator_default(w.s, w.accel, &w.lights, &w.tex);
+      it.method = IRIS_METHOD_MIS;
+      for (int samples = 1; samples >= 0; samples--) {
+        iris_guiding_params gp = iris_guiding_params_default();
+        gp.light_samples = samples != 0;
+        iris_guide_setup gs = {w.s, w.accel, &w.lights, &w.tex, &w.cam, &it, 7, 2, &gp, 16, 0.0,
+                               IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true};
+        iris_error err;
+        iris_error_clear(&err);
+        void *state = NULL;
+        CHECK_OK(iris_guiding_provider.build_lights(&gs, &state, &err), &err);
+        if (CHECK(state != NULL)) {
+          const iris_guiding *lg = state;
+          printf("corridor-rooms, mis's own tables (light samples %s): %llu tables, %llu from light samples, "
+                 "%d training spp\n", samples ? "on" : "off", (unsigned long long)lg->lights.learned_caches,
+                 (unsigned long long)lg->lights.nee_caches, lg->stats.train_spp);
+          if (samples) CHECK(lg->lights.nee_caches > lg->lights.cache_count / 8 && lg->stats.train_spp > 0);
+          else CHECK(lg->lights.nee_caches == 0 && lg->stats.train_spp == 0);
+          iris_guiding_provider.destroy(state);
+        }
+      }
+    }
     /* The grid's shortcut (a cell whose caches have no table reads none of
      * them) answers as reading them does: at points around every 4th cache,
      * with and without it, the same pmf of every 9th light. */
