@@ -7,7 +7,8 @@
 #
 #   bench/guiding/light_samples.sh BUILD_DIR OUT_DIR [SEEDS] [SCENES] [TIME]
 #
-# (1) --max-depth 0, 144 x 96, 16 spp (guided-nee: 8 training spp, discarded),
+# (1) --max-depth 0, 144 x 96, 16 spp (guided-nee: 8 training spp, discarded;
+#     mis learned: 8 light-only training spp, never in the image),
 #     against mis with the tree, --max-depth 0, 1024 spp, seed 99.
 # (2) 108 x 72, TIME seconds (default 4) on 2 threads, against mis with the
 #     tree, 4096 spp, independent sampler, seed 1000003 (rendered once into
@@ -46,7 +47,8 @@ for s in $SCENES; do
   row "$s" "mis tree" "$ref0" "$OUT/d-$s-mis" --method mis $d
   row "$s" "mis learned, photons alone" "$ref0" "$OUT/d-$s-mislp" --method mis --light-sampler learned \
     --no-light-samples $d
-  row "$s" "mis learned, + light samples" "$ref0" "$OUT/d-$s-misl" --method mis --light-sampler learned $d
+  row "$s" "mis learned, + light samples" "$ref0" "$OUT/d-$s-misl" --method mis --light-sampler learned \
+    --train-spp 8 $d
   row "$s" "guided-nee tree" "$ref0" "$OUT/d-$s-gn" --method guided-nee $d $g
   row "$s" "guided-nee learned, photons" "$ref0" "$OUT/d-$s-gnp" --method guided-nee --light-sampler learned \
     --no-light-samples $d $g

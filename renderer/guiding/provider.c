@@ -138,21 +138,19 @@ static iris_status provider_build(const iris_guide_setup *setup, iris_direction_
   return IRIS_OK;
 }
 
-/* Training spp of the light-only passes for methods without a guide of their own. */
-#define LIGHTS_TRAIN_SPP 4
-
 /* For methods without a guide of their own: the caches (built whatever the
  * skip rules say, no file) for the learned light choice, and, unless
- * --no-light-samples, LIGHTS_TRAIN_SPP training passes of direct light alone
- * (camera ray, a light sample and a direction at the first surface: about
- * three rays a sample) whose light samples teach the tables what the camera
- * sees, as guided-nee's training does. */
+ * --no-light-samples, training passes of direct light alone (camera ray, a
+ * light sample and a direction at the first surface: about three rays a
+ * sample), as many samples as guided-nee's training would take
+ * (--train-spp; by default 5% of the render's), whose light samples teach the
+ * tables what the camera sees. */
 static iris_status provider_build_lights(const iris_guide_setup *setup, void **state, iris_error *err) {
   iris_guiding_params p = setup->options ? *(const iris_guiding_params *)setup->options
                                          : iris_guiding_params_default();
   p.use_nee = true;
   p.force = true;
-  p.train_spp = p.light_samples ? LIGHTS_TRAIN_SPP : 0;
+  if (!p.light_samples) p.train_spp = 0;
   p.pilot_paths = 0;
   p.sky_probes = 0;
   p.guide_in = p.guide_out = NULL;

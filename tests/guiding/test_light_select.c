@@ -325,13 +325,15 @@ int main(void) {
     }
     /* mis and nee train no guide: the tables built for them alone
      * (build_lights) run light-only training passes (guided-nee's first
-     * vertex) and learn from their light samples too; --no-light-samples not. */
+     * vertex; --train-spp, by default 5% of the render's spp) and learn from
+     * their light samples too; with --no-light-samples none run. */
     {
       iris_integrator it = iris_integrator_default(w.s, w.accel, &w.lights, &w.tex);
       it.method = IRIS_METHOD_MIS;
       for (int samples = 1; samples >= 0; samples--) {
         iris_guiding_params gp = iris_guiding_params_default();
         gp.light_samples = samples != 0;
+        gp.train_spp = 4; /* the render's 16 spp would give 5% of them: none */
         iris_guide_setup gs = {w.s, w.accel, &w.lights, &w.tex, &w.cam, &it, 7, 2, &gp, 16, 0.0,
                                IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true};
         iris_error err;
