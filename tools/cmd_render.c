@@ -33,6 +33,7 @@ typedef struct render_cli {
   double noise_threshold, target_error;
   int min_spp;
   int adaptive; /* iris_adaptive_rule; -1: unset */
+  bool time_total;
 } render_cli;
 
 static const iris_option OUTPUT_ROWS[] = {
@@ -56,6 +57,11 @@ static const iris_option PARTITION_ROWS[] = {
     {"pixel-bounds", 0, IRIS_OPT_STRING, "x0,y0,x1,y1", 0, 0, offsetof(render_cli, pixel_bounds),
      "render only this window of the frame\n(half-open; the output image is the window)", NULL},
 };
+static const iris_option BUDGET_ROWS[] = {
+    {"time-total", 0, IRIS_OPT_FLAG, NULL, 0, 0, offsetof(render_cli, time_total),
+     "--time also holds the setup (BVH, textures, lights, photons,\nthe guide's training, auto's race), "
+     "as iris bench's budgets\ndo; by default it holds the image passes", NULL},
+};
 /* In the order of iris_adaptive_rule. */
 static const char *const ADAPTIVE_CHOICES[] = {"off", "freeze", "relmse", NULL};
 static const iris_option ADAPTIVE_ROWS[] = {
@@ -77,6 +83,7 @@ static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (off unles
                                                    ADAPTIVE_ROWS, sizeof ADAPTIVE_ROWS / sizeof ADAPTIVE_ROWS[0]};
 static const iris_option_group OUTPUT_OPTIONS = {"Output and reporting", OUTPUT_ROWS,
                                                  sizeof OUTPUT_ROWS / sizeof OUTPUT_ROWS[0]};
+static const iris_option_group BUDGET_OPTIONS = {"Time budget", BUDGET_ROWS, sizeof BUDGET_ROWS / sizeof BUDGET_ROWS[0]};
 static const iris_option_group PARTITION_OPTIONS = {
     "Partitioned renders (merge the parts with iris merge; docs/distributed.md)", PARTITION_ROWS,
     sizeof PARTITION_ROWS / sizeof PARTITION_ROWS[0]};
@@ -264,7 +271,7 @@ int iris_cmd_render(int argc, char **argv) {
   iris_option_binding bind[] = {{&OUTPUT_OPTIONS, &rc_opts, 0, 0}, {&IRIS_RENDER_OPTIONS, &ro, 0, 0},
                                 {&PARTITION_OPTIONS, &rc_opts, 0, 0}, {&IRIS_GUIDING_OPTIONS, &gp, 0, 0},
                                 {&IRIS_ENV_OPTIONS, &eo, 0, 0}, {&IRIS_GLTF_INPUT_OPTIONS, &go, 0, 0},
-                                {&ADAPTIVE_OPTIONS, &rc_opts, 0, 0}};
+                                {&ADAPTIVE_OPTIONS, &rc_opts, 0, 0}, {&BUDGET_OPTIONS, &rc_opts, 0, 0}};
   const size_t nbind = sizeof bind / sizeof bind[0];
   const char *input = NULL;
   int operands = 0;
@@ -333,6 +340,9 @@ int iris_cmd_render(int argc, char **argv) {
   const bool guide_only = !out_exr && !out_png && gp.guide_out;
   if (!out_exr && !out_png && !guide_only)
     return iris_cli_usage_error(CMD, "no output: give -o OUT.exr and/or --png OUT.png");
+  if (rc_opts.time_total && !(p.time_budget > 0.0))
+    return iris_cli_usage_error(CMD, "--time-total needs --time");
+  p.budget_includes_setup = rc_opts.time_total;
   if (have_spp && p.time_budget > 0.0 && p.adaptive.rule == IRIS_ADAPTIVE_OFF)
     return iris_cli_usage_error(CMD, "--spp and --time exclude each other (both caps only with adaptive sampling)");
   if (out_exr && !ends_with(out_exr, ".exr"))

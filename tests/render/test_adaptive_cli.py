@@ -48,7 +48,8 @@ def main():
     for args, why in [(["--adaptive", "freeze", "--target-error", "0.01"], "--noise-threshold"),
                       (["--adaptive", "off", "--noise-threshold", "0.01"], "adaptive"),
                       (["--noise-threshold", "0.01", "--spp", "16", "--min-spp", "32"], "--min-spp"),
-                      (["--spp", "16", "--time", "1"], "--time")]:
+                      (["--spp", "16", "--time", "1"], "--time"),
+                      (["--spp", "16", "--time-total"], "--time")]:
         p = run(iris, "cornell-box", "--height", "16", "-o", out, *args)
         check(p.returncode == 2 and why in p.stderr, f"{args}: exit {p.returncode}, {p.stderr.strip()!r}")
         check(not os.path.exists(out), f"{args}: wrote {out}")
