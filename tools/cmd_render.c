@@ -526,10 +526,10 @@ int iris_cmd_render(int argc, char **argv) {
     } else {
       snprintf(spp, sizeof spp, "%d spp", res.spp);
     }
-    iris_infof("render: %s, %dx%d, %s%s (%s), %.2f s, %.2f Msamples/s, %.1f Mrays/s%s",
+    iris_infof("render: %s, %dx%d, %s%s (%s), %.2f s after %.2f s of setup, %.2f Msamples/s, %.1f Mrays/s%s",
                input, res.film.width, res.film.height, spp, train,
                res.method_reason[0] ? res.method_reason : iris_method_name(res.method),
-               res.seconds, res.seconds > 0 ? samples / res.seconds * 1e-6 : 0.0,
+               res.seconds, res.setup_seconds, res.seconds > 0 ? samples / res.seconds * 1e-6 : 0.0,
                res.seconds > 0 ? rays / res.seconds * 1e-6 : 0.0,
                res.interrupted ? " (interrupted)" : "");
     if (res.adaptive.rule != IRIS_ADAPTIVE_OFF) {
