@@ -486,11 +486,12 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
     int64_t n = p->caches * (int64_t)p->cache_k / 20;
     size_t lights = s->lights->group_count; /* emitting instances + punctual + sky, not triangles */
     n = (int64_t)((double)n * (1.0 + 0.05 * (double)(lights > 1 ? lights - 1 : 0)));
+    if (n < 50000) n = 50000;
     /* Environment photons leave a disk covering the whole scene, and many of
      * them hit nothing or only the outside of what the camera sees: in
      * proportion to the sky's share of the power, up to twice as many paths. */
     n = (int64_t)((double)n * (1.0 + environment_share(s->lights)));
-    p->photons = n < 100000 ? 100000 : (n > 4000000 ? 4000000 : n);
+    p->photons = n > 4000000 ? 4000000 : n;
   }
   /* Measured (docs/guiding.md, "Parameters around the defaults"): with light
    * sampling 0.5 is best; without it (`guided`) 0.7 is 6-23% more efficient

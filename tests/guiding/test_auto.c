@@ -112,8 +112,15 @@ static void test_decisions(void) {
       iris_check_record(strncmp(r.method_reason, "auto: ", 6) == 0 && strstr(r.method_reason, E[i].reason),
                         __FILE__, __LINE__, "%s: reason '%s' should name '%s'", E[i].name, r.method_reason,
                         E[i].reason);
-      /* the same build deciding on the full photon pass only */
-      if (CHECK(render(s, IRIS_METHOD_AUTO, 32, 24, 1, 1, 0, &full))) {
+      /* the same build deciding on the full photon pass only: the same
+       * choice, unless the 50% rule's share lies within the noise of its
+       * ~4096 sampled photons of the threshold (the rule then sees other
+       * photons than the pilot's and may go either way: stress-thin-walls) */
+      const double seen = pilot.seen_indirect_energy;
+      const bool borderline = seen >= 0.0 && fabs(seen - 0.5) < 0.03;
+      if (borderline) printf("%-16s the rule's share %.3f is within 0.03 of 50%%: pilot and full pass may differ\n",
+                             E[i].name, seen);
+      if (!borderline && CHECK(render(s, IRIS_METHOD_AUTO, 32, 24, 1, 1, 0, &full))) {
         CHECK_EQ_STR(iris_method_name(full.method), iris_method_name(r.method));
         CHECK_EQ_INT(g_stats.pilot_paths, 0);
         if (pilot.pilot_paths > 0) { /* a pilot ran: fewer paths than the full pass */
