@@ -126,8 +126,9 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);
     double paths = caches * 200.0 / 20.0 * (1.0 + 0.05 * (double)(light_groups > 1 ? light_groups - 1 : 0));
+    if (paths < 50000) paths = 50000;
     if (s->has_environment) paths *= 2.0; /* up to twice with a sky (its share of the power) */
-    paths = paths < 100000 ? 100000 : (paths > 4000000 ? 4000000 : paths);
+    if (paths > 4000000) paths = 4000000;
     /* learned light selection: with more than one light to choose from */
     if (emissive_tris + s->light_count > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
     out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;
