@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include "core/image.h"
+#include "renderer/guiding/guiding.h"
 #include "renderer/guiding/photons.h"
 
 /* Measured costs (docs/performance.md, "Memory estimate"; Embree 3.13 with
@@ -125,10 +126,8 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
   if (guided) { /* the default budget of renderer/guiding/guiding.c (choose_budget) */
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);
-    double paths = caches * 200.0 / 20.0 * (1.0 + 0.05 * (double)(light_groups > 1 ? light_groups - 1 : 0));
-    if (paths < 50000) paths = 50000;
-    if (s->has_environment) paths *= 2.0; /* up to twice with a sky (its share of the power) */
-    if (paths > 4000000) paths = 4000000;
+    /* the sky's share of the power at its largest: up to twice the paths */
+    double paths = iris_guiding_photon_paths(caches, 200, light_groups, s->has_environment ? 1.0 : 0.0);
     /* learned light selection: with more than one light to choose from */
     if (emissive_tris + s->light_count > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
     out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;

@@ -483,15 +483,9 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
      * photons per path on the benchmark scenes, so paths = caches * k / 20
      * gives every cache ~ 1/8 of its neighbourhood to itself; more lights
      * need more photons to cover each one. */
-    int64_t n = p->caches * (int64_t)p->cache_k / 20;
-    size_t lights = s->lights->group_count; /* emitting instances + punctual + sky, not triangles */
-    n = (int64_t)((double)n * (1.0 + 0.05 * (double)(lights > 1 ? lights - 1 : 0)));
-    if (n < 50000) n = 50000;
-    /* Environment photons leave a disk covering the whole scene, and many of
-     * them hit nothing or only the outside of what the camera sees: in
-     * proportion to the sky's share of the power, up to twice as many paths. */
-    n = (int64_t)((double)n * (1.0 + environment_share(s->lights)));
-    p->photons = n > 4000000 ? 4000000 : n;
+    /* light groups: emitting instances + punctual + sky, not triangles */
+    p->photons = (int64_t)iris_guiding_photon_paths((double)p->caches, p->cache_k, s->lights->group_count,
+                                                    environment_share(s->lights));
   }
   /* Measured (docs/guiding.md, "Parameters around the defaults"): with light
    * sampling 0.5 is best; without it (`guided`) 0.7 is 6-23% more efficient
@@ -621,6 +615,22 @@ static bool keeps_for_glints(const iris_guiding *g, const iris_guide_setup *s, c
     if (ph->glint) glint_energy += ph->energy, glinted++;
   }
   return glinted >= GLINT_PILOT_MIN && glint_energy >= IRIS_GLINT_SHARE_MIN * indirect;
+}
+
+double iris_guiding_photon_paths(double caches, int cache_k, size_t light_groups, double sky_share) {
+  /* Enough photons that each cache's k nearest stay local: about 2.5 stored
+   * photons per path on the benchmark scenes, so paths = caches * k / 20
+   * gives every cache ~ 1/8 of its neighbourhood to itself; more lights
+   * need more photons to cover each one. At least 50 000 (docs/guiding.md,
+   * "Budget": 100 000 until 2026-12-04, no better per sample). */
+  double n = floor(caches * (double)cache_k / 20.0);
+  n = floor(n * (1.0 + 0.05 * (double)(light_groups > 1 ? light_groups - 1 : 0)));
+  if (n < 50000.0) n = 50000.0;
+  /* Environment photons leave a disk covering the whole scene, and many of
+   * them hit nothing or only the outside of what the camera sees: in
+   * proportion to the sky's share of the power, up to twice as many paths. */
+  n = floor(n * (1.0 + sky_share));
+  return n > 4000000.0 ? 4000000.0 : n;
 }
 
 uint64_t iris_guiding_pilot_paths(uint64_t photons) {

@@ -244,6 +244,12 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp);
  * for iris_render; destroy frees it. */
 extern const iris_guide_provider iris_guiding_provider;
 
+/* The default photon paths of a guide (docs/guiding.md, "Budget") for this
+ * many caches of k photons, light groups (emitting instances, punctual
+ * lights, sky) and the sky's share of the power in [0, 1]; iris_memory's
+ * estimate asks it too, with the share an upper bound. */
+double iris_guiding_photon_paths(double caches, int cache_k, size_t light_groups, double sky_share);
+
 /* Photon paths of the pilot for a full pass of `photons` paths: max(16384,
  * photons / 16) rounded up to whole blocks of 4096, at most `photons`. */
 uint64_t iris_guiding_pilot_paths(uint64_t photons);
