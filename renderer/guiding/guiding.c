@@ -479,10 +479,6 @@ static void choose_budget(iris_guiding_params *p, const iris_guide_setup *s, int
   if (p->refine < 0) p->refine = 0;
   if (p->pdf_floor < 0.0f) p->pdf_floor = 2e-4f;
   if (p->photons <= 0) {
-    /* Enough photons that each cache's k nearest stay local: about 2.5 stored
-     * photons per path on the benchmark scenes, so paths = caches * k / 20
-     * gives every cache ~ 1/8 of its neighbourhood to itself; more lights
-     * need more photons to cover each one. */
     /* light groups: emitting instances + punctual + sky, not triangles */
     p->photons = (int64_t)iris_guiding_photon_paths((double)p->caches, p->cache_k, s->lights->group_count,
                                                     environment_share(s->lights));
