@@ -10,6 +10,7 @@
 #include "core/image.h"
 #include "renderer/guiding/guiding.h"
 #include "renderer/guiding/photons.h"
+#include "renderer/lights.h"
 
 /* Measured costs (docs/performance.md, "Memory estimate"; Embree 3.13 with
  * ROBUST and HIGH quality, from its memory monitor and peak RSS). */
@@ -62,7 +63,7 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
       if (s->instances[i].mesh < s->mesh_count && affine(&s->instances[i].transform))
         placements[s->instances[i].mesh]++;
   double accel = 0.0, flattened_peak = 0.0, emissive_tris = 0.0;
-  uint64_t light_groups = 0;
+  uint64_t light_groups = 0; /* emitting placements, then every light group */
   for (size_t k = 0; k < s->mesh_count; k++) {
     const iris_mesh *m = &s->meshes[k];
     out->scene += 12ull * m->vertex_count + 12ull * m->triangle_count;
@@ -119,10 +120,13 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
       out->textures += (uint64_t)(ENV_BYTES_PER_TEXEL * (double)w * (double)h);
     else /* OpenEXR: half or float RGB(A), so texels >= size / 16 */
       out->textures += (uint64_t)(ENV_BYTES_PER_TEXEL / 6.0 * (double)file_size(s->environment_map.path));
-    light_groups++;
   }
   out->lights = (uint64_t)(BYTES_PER_EMISSIVE_TRIANGLE * emissive_tris) + 16ull * s->instance_count;
-  light_groups += s->light_count;
+  /* as the lights build their groups (renderer/light_build.c): past
+   * IRIS_LIGHTS_MAX_GROUPS the emitting instances share one */
+  const uint64_t others = s->light_count + (s->has_environment ? 1 : 0); /* punctual lights, the sky */
+  if (light_groups + others > IRIS_LIGHTS_MAX_GROUPS && light_groups > 0) light_groups = 1;
+  light_groups += others;
   if (guided) { /* the default budget of renderer/guiding/guiding.c (choose_budget) */
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);

@@ -183,6 +183,39 @@ static void test_estimates(void) {
   check_estimate("150 flattened", flat, "IRIS_INSTANCE_MIN=1000000");
 }
 
+/* The guide's photon paths grow with the light groups (docs/guiding.md,
+ * "Budget"), but past IRIS_LIGHTS_MAX_GROUPS emitting instances the lights
+ * merge theirs into one (renderer/light_build.c): the estimate must follow,
+ * or a scene of thousands of lamps is estimated at the 4M-path cap (1.2 GB)
+ * and refused under a limit it fits. `count` placements of a small emitting
+ * sphere, 640 x 480 (9600 caches: 96 000 paths for one group). */
+static void test_light_groups(void) {
+  const int counts[4] = {1, 10, 100, 2000};
+  uint64_t guide[4];
+  for (int c = 0; c < 4; c++) {
+    iris_scene *s = iris_scene_create();
+    iris_material mat = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+    mat.name = iris_strdup("lamp");
+    mat.emission[0] = mat.emission[1] = mat.emission[2] = 5.0f;
+    iris_mesh m = lumpy(4);
+    m.material = iris_scene_add_material(s, &mat);
+    uint32_t mi = (uint32_t)iris_scene_add_mesh(s, &m);
+    for (int k = 0; k < counts[c]; k++) {
+      iris_instance in = {mi, iris_mat4_identity()};
+      in.transform.m[0][3] = 3.0f * (float)k;
+      iris_scene_add_instance(s, &in);
+    }
+    iris_memory_estimate est;
+    iris_memory_estimate_scene(s, 640, 480, true, &est);
+    guide[c] = est.guide;
+    printf("%5d emitting placements: guide %.1f MB\n", counts[c], (double)est.guide / 1e6);
+    iris_scene_destroy(s);
+  }
+  CHECK(guide[1] > guide[0]);  /* ten groups: more paths than one */
+  CHECK_EQ_INT(guide[2], guide[0]); /* more than 64: merged into one group */
+  CHECK_EQ_INT(guide[3], guide[0]);
+}
+
 static void test_refused(void) {
   char out[700], errf[700], exr[700], flat[700];
   snprintf(out, sizeof out, "%s/out.txt", dir);
@@ -265,6 +298,7 @@ int main(int argc, char **argv) {
   iris_bin = argv[1];
   assets = argv[2];
   if (iris_test_tmpdir(dir, sizeof dir, "memory") != 0) return TEST_SKIP("no temporary directory");
+  test_light_groups();
   test_embree_oom();
   test_refused();
   test_estimates();
