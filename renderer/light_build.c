@@ -29,9 +29,8 @@ static iris_status build_groups(iris_lights *L, iris_error *err) {
       prev = L->entries[i].group;
     }
   }
-  bool merge = tri_groups + others > IRIS_LIGHTS_MAX_GROUPS;
-  if (merge && tri_groups > 0) tri_groups = 1;
-  L->groups = calloc(tri_groups + others, sizeof *L->groups);
+  const bool merge = iris_lights_merge_groups(tri_groups, others);
+  L->groups = calloc(iris_lights_group_count(tri_groups, others), sizeof *L->groups);
   if (!L->groups) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for light groups");
   size_t g = 0;
   prev = UINT32_MAX;

@@ -59,6 +59,14 @@ typedef struct iris_light_entry {
  * directional lights and the environment), then an entry of the group in
  * proportion to power. docs/rendering.md, "Light selection". */
 #define IRIS_LIGHTS_MAX_GROUPS 64
+/* Past IRIS_LIGHTS_MAX_GROUPS groups the emitting instances' triangles share
+ * one group (the others keep theirs); the memory estimate counts them so. */
+static inline bool iris_lights_merge_groups(size_t tri_groups, size_t others) {
+  return tri_groups + others > IRIS_LIGHTS_MAX_GROUPS;
+}
+static inline size_t iris_lights_group_count(size_t tri_groups, size_t others) {
+  return (iris_lights_merge_groups(tri_groups, others) && tri_groups > 0 ? 1 : tri_groups) + others;
+}
 typedef struct iris_light_group {
   uint32_t first, count;  /* entries [first, first + count) */
   iris_light_kind kind;

@@ -122,11 +122,8 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
       out->textures += (uint64_t)(ENV_BYTES_PER_TEXEL / 6.0 * (double)file_size(s->environment_map.path));
   }
   out->lights = (uint64_t)(BYTES_PER_EMISSIVE_TRIANGLE * emissive_tris) + 16ull * s->instance_count;
-  /* as the lights build their groups (renderer/light_build.c): past
-   * IRIS_LIGHTS_MAX_GROUPS the emitting instances share one */
-  const uint64_t others = s->light_count + (s->has_environment ? 1 : 0); /* punctual lights, the sky */
-  if (light_groups + others > IRIS_LIGHTS_MAX_GROUPS && light_groups > 0) light_groups = 1;
-  light_groups += others;
+  /* as the lights build their groups: punctual lights and the sky one each */
+  light_groups = iris_lights_group_count(light_groups, s->light_count + (s->has_environment ? 1 : 0));
   if (guided) { /* the default budget of renderer/guiding/guiding.c (choose_budget) */
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);

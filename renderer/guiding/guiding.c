@@ -572,7 +572,6 @@ static double seen_indirect_energy(const iris_guide_setup *s, const iris_photon_
   return seen.energy > 0.0 ? seen.indirect_energy / seen.energy : -1.0;
 }
 
-#define AUTO_SEEN_INDIRECT_MIN 0.50 /* --method auto: guided-nee from this share on */
 
 static void skip(iris_guiding *g, const char *why) {
   g->stats.skipped = true;
@@ -585,10 +584,10 @@ static void skip(iris_guiding *g, const char *why) {
 static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons) {
   if (!s->deciding || g->params.force || g->stats.seen_indirect_energy >= 0.0) return false;
   g->stats.seen_indirect_energy = seen_indirect_energy(s, photons);
-  if (!(g->stats.seen_indirect_energy >= 0.0 && g->stats.seen_indirect_energy < AUTO_SEEN_INDIRECT_MIN)) return false;
+  if (!(g->stats.seen_indirect_energy >= 0.0 && g->stats.seen_indirect_energy < IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN)) return false;
   char why[160];
   snprintf(why, sizeof why, "what the camera sees is lit mostly directly: %.0f%% of its photon energy indirect (< %.0f%%)",
-           100.0 * g->stats.seen_indirect_energy, 100.0 * AUTO_SEEN_INDIRECT_MIN);
+           100.0 * g->stats.seen_indirect_energy, 100.0 * IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN);
   skip(g, why);
   return true;
 }

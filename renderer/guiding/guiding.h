@@ -244,6 +244,10 @@ float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp);
  * for iris_render; destroy frees it. */
 extern const iris_guide_provider iris_guiding_provider;
 
+/* --method auto: guided-nee (and the race) from this share of the photon
+ * energy on what the camera sees arriving after a bounce; mis below it. */
+#define IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN 0.50
+
 /* The default photon paths of a guide (docs/guiding.md, "Budget") for this
  * many caches of k photons, light groups (emitting instances, punctual
  * lights, sky) and the sky's share of the power in [0, 1]; iris_memory's
