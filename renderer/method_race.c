@@ -176,75 +176,28 @@ bool iris_race_scene_has_smooth_lobes(const iris_scene *s) {
   return false;
 }
 
-iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
-                             uint64_t seed, int threads, double time_cap, iris_race_outcome *out, char *why,
-                             size_t why_size, iris_error *err) {
-  memset(out, 0, sizeof *out);
-  if (threads < 1) threads = 1;
-  /* the grid covers the whole frame, whatever window is rendered: every part
-   * of a partitioned render runs the same race and makes the same choice */
-  int stride = (int)floor(sqrt((double)cam->width * (double)cam->height / IRIS_RACE_PIXELS));
-  if (stride < 1) stride = 1;
-  const int cols = (cam->width + stride - 1 - stride / 2) / stride, rows = (cam->height + stride - 1 - stride / 2) / stride;
-  const uint64_t n = (uint64_t)cols * (uint64_t)rows;
-  /* small frames: more paths per pixel, the same paths in all */
-  uint64_t spp = (IRIS_RACE_PATHS + n - 1) / n;
-  if (spp < IRIS_RACE_SPP) spp = IRIS_RACE_SPP;
-  if (spp > IRIS_RACE_SPP_MAX) spp = IRIS_RACE_SPP_MAX;
-  double *buf = calloc(12 * n, sizeof *buf);
-  race_thread *per = calloc((size_t)threads, sizeof *per);
-  if (!buf || !per) {
-    free(buf);
-    free(per);
-    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (the method race)");
-  }
-  counted_guide cg = {guided->guide};
-  iris_integrator counted = *guided;
-  counted.guide = counting(&cg);
-  /* an independent sampler: the race measures the variance of one path */
-  iris_integrator race_its[2] = {*mis, counted};
-  for (int m = 0; m < 2; m++) race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
-  /* rounds of IRIS_RACE_ROUND_SPP paths per pixel, the methods in turn, until
-   * spp; under a time cap also until the race has used it (after one round) */
-  const double t0 = iris_time_now();
-  uint64_t done = 0;
-  while (done < spp) {
-    const uint64_t r = spp - done < IRIS_RACE_ROUND_SPP ? spp - done : IRIS_RACE_ROUND_SPP;
-    for (int m = 0; m < 2; m++) {
-      memset(per, 0, (size_t)threads * sizeof *per);
-      race_ctx c = {&race_its[m], cam, iris_hash4(seed, 0x7ace, (uint64_t)m, 31), stride, cols, done, done + r,
-                    buf + 6 * n * (uint64_t)m, buf + 6 * n * (uint64_t)m + 3 * n, per};
-      double t = iris_time_now();
-      iris_parallel_for(n, 16, threads, race_pixels, &c);
-      out->seconds[m] += iris_time_now() - t;
-      for (int i = 0; i < threads; i++) {
-        out->rays[m] += per[i].stats.rays;
-        out->shadow_rays[m] += per[i].stats.shadow_rays;
-        out->prepares[m] += per[i].prepares;
-        out->guide_calls[m] += per[i].calls;
-      }
-      if (iris_cancel_requested()) {
-        free(buf);
-        free(per);
-        return iris_cancel_error(err);
-      }
-    }
-    done += r;
-    if (time_cap > 0.0 && iris_time_now() - t0 >= time_cap) break;
-  }
-  spp = done;
-  out->paths = n * spp;
-  /* Per pixel: each method's sample variance, relative to the two methods'
-   * mean over the pixel's grid neighbours, the pixel itself left out: a
-   * denominator from the pixel's own samples would grow with a rare bright
-   * sample and hide the very tail the race must see. Summed in pixel order. */
+/* A few pixels hold the variance and the scene has smooth lobes (below). */
+static bool race_unmeasurable(const iris_race_outcome *o, const iris_scene *scene) {
+  const double tail = o->tail_share[0] > o->tail_share[1] ? o->tail_share[0] : o->tail_share[1];
+  return tail > IRIS_RACE_TAIL_MAX && iris_race_scene_has_smooth_lobes(scene);
+}
+
+/* Group of a race pixel for the jackknife: 16 interleaved 4 x 4 lattices, each
+ * spread over the whole frame. */
+#define RACE_GROUPS 16
+static int race_group(uint64_t i, int cols) {
+  const int x = (int)(i % (uint64_t)cols), y = (int)(i / (uint64_t)cols);
+  return (x & 3) + 4 * (y & 3);
+}
+
+/* The race's statistics from the sums in `buf` (spp paths per pixel):
+ * relative variances, light, cost, speedup and the jackknife standard error of
+ * log(speedup) over RACE_GROUPS pixel groups (the cost taken as exact: it is a
+ * count over every path). `scratch` holds 6 n doubles. */
+static void race_measure(const double *buf, uint64_t n, int cols, int rows, uint64_t spp, double *scratch,
+                         iris_race_outcome *out) {
   const double k = (double)spp;
-  double *both = calloc(5 * n, sizeof *both), *terms = both + 3 * n; /* + each method's pixel terms */
-  if (!both) {
-    free(buf);
-    free(per);
-    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (the method race)");
-  }
+  double *both = scratch, *terms = both + 3 * n, *sorted = terms + 2 * n; /* sorted: n */
   for (uint64_t i = 0; i < 3 * n; i++) {
     const uint64_t px = i / 3, ch = i % 3;
     both[i] = 0.5 * (buf[3 * px + ch] + buf[6 * n + 3 * px + ch]) / k; /* sums of mis, of guided-nee */
@@ -266,25 +219,143 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
       dvar += luminance(var) / k; /* the luminance's variance, channels taken as independent: a bound */
     }
   }
-  /* as iris bench's relMSE, the 0.1% largest pixel terms left out */
-  for (int m = 0; m < 2; m++)
-    out->relvar[m] = iris_race_trimmed_mean(terms + (uint64_t)m * n, n, &out->tail_share[m]);
-  free(both);
+  /* as iris bench's relMSE, the 0.1% largest pixel terms left out; per group,
+   * the kept terms' sums and counts (the cut-off is the whole race's) */
+  double gsum[2][RACE_GROUPS] = {{0}}, gcount[2][RACE_GROUPS] = {{0}};
+  for (int m = 0; m < 2; m++) {
+    const double *t = terms + (uint64_t)m * n;
+    memcpy(sorted, t, n * sizeof *sorted);
+    out->relvar[m] = iris_race_trimmed_mean(sorted, n, &out->tail_share[m]);
+    const size_t keep = n - (size_t)(IRIS_RACE_TRIM * (double)n);
+    const double cut = keep > 0 ? sorted[keep - 1] : -1.0;
+    size_t kept = 0;
+    for (uint64_t i = 0; i < n && kept < keep; i++)
+      if (t[i] <= cut) {
+        const int g = race_group(i, cols);
+        gsum[m][g] += t[i];
+        gcount[m][g] += 1.0;
+        kept++;
+      }
+  }
+  const double paths = (double)n * k;
   for (int m = 0; m < 2; m++) {
     out->light[m] = light[m] / (double)n;
     out->cost[m] = ((double)out->rays[m] + IRIS_RACE_COST_SHADOW * (double)out->shadow_rays[m] +
                     IRIS_RACE_COST_PREPARE * (double)out->prepares[m] +
                     IRIS_RACE_COST_GUIDE_CALL * (double)out->guide_calls[m]) /
-                   (double)out->paths;
+                   paths;
   }
-  free(buf);
-  free(per);
   out->short_z = dvar > 0.0 ? (light[1] - light[0]) / sqrt(dvar) : 0.0;
   const double work[2] = {out->relvar[0] * out->cost[0], out->relvar[1] * out->cost[1]};
   out->speedup = work[1] > 0.0 ? work[0] / work[1] : (work[0] > 0.0 ? INFINITY : 1.0);
+  /* jackknife over the groups: log of the speedup without group g */
+  double all[2][2] = {{0}};
+  for (int m = 0; m < 2; m++)
+    for (int g = 0; g < RACE_GROUPS; g++) {
+      all[m][0] += gsum[m][g];
+      all[m][1] += gcount[m][g];
+    }
+  double l[RACE_GROUPS], lmean = 0.0;
+  int used = 0;
+  for (int g = 0; g < RACE_GROUPS; g++) {
+    double v[2];
+    bool ok = true;
+    for (int m = 0; m < 2; m++) {
+      const double c = all[m][1] - gcount[m][g], sm = all[m][0] - gsum[m][g];
+      v[m] = c > 0.0 ? sm / c : 0.0;
+      ok = ok && v[m] > 0.0;
+    }
+    if (!ok || gcount[0][g] + gcount[1][g] == 0.0) continue;
+    l[used] = log(v[0] * out->cost[0] / (v[1] * out->cost[1]));
+    lmean += l[used++];
+  }
+  double se = INFINITY;
+  if (used >= 2) {
+    lmean /= used;
+    double ss = 0.0;
+    for (int g = 0; g < used; g++) ss += (l[g] - lmean) * (l[g] - lmean);
+    se = sqrt((double)(used - 1) / used * ss);
+  }
+  out->log_speedup_se = se;
+}
+
+iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *guided, const iris_pinhole *cam,
+                             uint64_t seed, int threads, double time_cap, iris_race_outcome *out, char *why,
+                             size_t why_size, iris_error *err) {
+  memset(out, 0, sizeof *out);
+  if (threads < 1) threads = 1;
+  /* the grid covers the whole frame, whatever window is rendered: every part
+   * of a partitioned render runs the same race and makes the same choice */
+  int stride = (int)floor(sqrt((double)cam->width * (double)cam->height / IRIS_RACE_PIXELS));
+  if (stride < 1) stride = 1;
+  const int cols = (cam->width + stride - 1 - stride / 2) / stride, rows = (cam->height + stride - 1 - stride / 2) / stride;
+  const uint64_t n = (uint64_t)cols * (uint64_t)rows;
+  /* small frames: more paths per pixel, the same paths in all */
+  uint64_t spp = (IRIS_RACE_PATHS + n - 1) / n;
+  if (spp < IRIS_RACE_SPP) spp = IRIS_RACE_SPP;
+  if (spp > IRIS_RACE_SPP_MAX) spp = IRIS_RACE_SPP_MAX;
+  const uint64_t spp_max = IRIS_RACE_EXTEND * spp;
+  double *buf = calloc(12 * n, sizeof *buf), *scratch = calloc(6 * n, sizeof *scratch);
+  race_thread *per = calloc((size_t)threads, sizeof *per);
+  if (!buf || !per || !scratch) {
+    free(buf);
+    free(scratch);
+    free(per);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (the method race)");
+  }
+  counted_guide cg = {guided->guide};
+  iris_integrator counted = *guided;
+  counted.guide = counting(&cg);
+  /* an independent sampler: the race measures the variance of one path */
+  iris_integrator race_its[2] = {*mis, counted};
+  for (int m = 0; m < 2; m++) race_its[m].sampler = IRIS_SAMPLER_INDEPENDENT;
+  /* rounds of IRIS_RACE_ROUND_SPP paths per pixel, the methods in turn, until
+   * spp; then on, up to spp_max, while the speedup is within
+   * IRIS_RACE_DECISIVE_Z standard errors of 1 (a decision by the statistics
+   * alone: the same on any thread count); under a time cap also until the
+   * race has used it (after one round) */
+  const double t0 = iris_time_now();
+  uint64_t done = 0;
+  while (done < spp_max) {
+    const uint64_t r = done < spp && spp - done < IRIS_RACE_ROUND_SPP ? spp - done : IRIS_RACE_ROUND_SPP;
+    for (int m = 0; m < 2; m++) {
+      memset(per, 0, (size_t)threads * sizeof *per);
+      race_ctx c = {&race_its[m], cam, iris_hash4(seed, 0x7ace, (uint64_t)m, 31), stride, cols, done, done + r,
+                    buf + 6 * n * (uint64_t)m, buf + 6 * n * (uint64_t)m + 3 * n, per};
+      double t = iris_time_now();
+      iris_parallel_for(n, 16, threads, race_pixels, &c);
+      out->seconds[m] += iris_time_now() - t;
+      for (int i = 0; i < threads; i++) {
+        out->rays[m] += per[i].stats.rays;
+        out->shadow_rays[m] += per[i].stats.shadow_rays;
+        out->prepares[m] += per[i].prepares;
+        out->guide_calls[m] += per[i].calls;
+      }
+      if (iris_cancel_requested()) {
+        free(buf);
+        free(scratch);
+        free(per);
+        return iris_cancel_error(err);
+      }
+    }
+    done += r;
+    if (time_cap > 0.0 && iris_time_now() - t0 >= time_cap) break;
+    if (done < spp) continue;
+    race_measure(buf, n, cols, rows, done, scratch, out);
+    if (fabs(log(out->speedup)) >= IRIS_RACE_DECISIVE_Z * out->log_speedup_se ||
+        fabs(out->short_z) > IRIS_RACE_SHORT_Z || race_unmeasurable(out, mis->scene))
+      break;
+  }
+  race_measure(buf, n, cols, rows, done, scratch, out);
+  out->paths = n * done;
+  out->base_paths = n * (done < spp ? done : spp);
+  free(buf);
+  free(scratch);
+  free(per);
+  const double *light = out->light;
   const double shortfall = light[1] > 0.0 ? 1.0 - light[0] / light[1] : 0.0;
   const int tailed = out->tail_share[0] >= out->tail_share[1] ? 0 : 1;
-  if (out->tail_share[tailed] > IRIS_RACE_TAIL_MAX && iris_race_scene_has_smooth_lobes(mis->scene)) {
+  if (race_unmeasurable(out, mis->scene)) {
     /* a few pixels hold the variance, light arriving off smooth surfaces: the race
      * cannot measure it (sky-room-glazed: untrimmed ratios from 0.02x to 16x between
      * seeds); the rules' guided-nee stands. Without smooth lobes the trimmed
@@ -302,9 +373,14 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     snprintf(why, why_size, "the race: guided-nee found %.0f%% less light than mis (%.1f standard errors): paths too rare to measure",
              100.0 * (light[0] > 0.0 ? 1.0 - light[1] / light[0] : 0.0), -out->short_z);
   } else {
-    out->guided = out->speedup > 1.0;
-    snprintf(why, why_size, "the race: guided-nee %.2fx mis per unit of work (relative variance %.3g against %.3g, cost %.1f against %.1f rays per path)",
-             out->speedup, out->relvar[1], out->relvar[0], out->cost[1], out->cost[0]);
+    /* guided-nee must win by IRIS_RACE_MARGIN_Z standard errors: where the two
+     * are level within the race's noise, mis (stress-glossy-room's race
+     * measured 0.6-1.5x over seeds where long renders give 0.65-0.82x) */
+    const double z = log(out->speedup) / out->log_speedup_se;
+    out->guided = z > IRIS_RACE_MARGIN_Z;
+    snprintf(why, why_size, "the race: guided-nee %.2fx mis per unit of work, %.1f standard errors%s (relative variance %.3g against %.3g, cost %.1f against %.1f rays per path)",
+             out->speedup, z, out->speedup > 1.0 && !out->guided ? ": not enough to leave mis" : "",
+             out->relvar[1], out->relvar[0], out->cost[1], out->cost[0]);
   }
   return IRIS_OK;
 }

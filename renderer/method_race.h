@@ -34,6 +34,14 @@
  * alone gives a variance); a time cap ends it after the round that reaches
  * it. Under `--time` the cap is IRIS_RACE_BUDGET_SHARE of the budget. */
 #define IRIS_RACE_ROUND_SPP 2
+/* After those paths the race goes on, up to IRIS_RACE_EXTEND times as many,
+ * while guided-nee's speedup over mis is within IRIS_RACE_DECISIVE_Z jackknife
+ * standard errors of 1 (log scale, 16 interleaved pixel groups). */
+#define IRIS_RACE_EXTEND 4
+#define IRIS_RACE_DECISIVE_Z 2.0
+/* guided-nee renders only when its log speedup is above this many standard
+ * errors (mis, the method without a guide, when the race cannot separate them) */
+#define IRIS_RACE_MARGIN_Z 1.0
 #define IRIS_RACE_BUDGET_SHARE 0.05
 /* The share of the race's pixels with the largest terms left out of its
  * relative variance, as iris bench's relMSE leaves out the largest errors. */
@@ -57,8 +65,10 @@ typedef struct iris_race_outcome {
   double light[2];     /* mean luminance of the race pixels */
   double short_z;      /* (light[1] - light[0]) in standard errors: > 0 mis is short */
   uint64_t paths;      /* per method */
+  uint64_t base_paths; /* per method before the race went on for want of a decision */
   double tail_share[2]; /* the share of each method's variance in the IRIS_RACE_TRIM pixels left out */
   double speedup;      /* guided-nee's efficiency over mis's (relvar x cost), before the light check */
+  double log_speedup_se; /* jackknife standard error of log(speedup) */
   bool unmeasurable;   /* tail_share above IRIS_RACE_TAIL_MAX with smooth lobes: the rules' guided-nee stands */
   bool guided;         /* the winner */
 } iris_race_outcome;

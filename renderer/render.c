@@ -271,11 +271,13 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
         use = res->race.guided;
         const iris_race_outcome *o = &res->race;
         const double np = (double)o->paths;
-        iris_infof("auto: race of %llu paths each (per path: rays, shadow rays, guide prepares, guide calls; seconds): "
+        iris_infof("auto: race of %llu paths each (%llu before it went on for a decision; speedup %.3f, log standard "
+                   "error %.3f) (per path: rays, shadow rays, guide prepares, guide calls; seconds): "
                    "mis %.2f %.2f %.2f %.2f %.3f s, relative variance %.4g; guided-nee %.2f %.2f %.2f %.2f %.3f s, "
                    "relative variance %.4g; light guided-nee/mis %.3f (z %.1f); variance in the largest 0.1%%: "
                    "mis %.0f%%, guided-nee %.0f%%",
-                   (unsigned long long)o->paths, o->rays[0] / np, o->shadow_rays[0] / np, o->prepares[0] / np,
+                   (unsigned long long)o->paths, (unsigned long long)o->base_paths, o->speedup, o->log_speedup_se,
+                   o->rays[0] / np, o->shadow_rays[0] / np, o->prepares[0] / np,
                    o->guide_calls[0] / np, o->seconds[0], o->relvar[0], o->rays[1] / np, o->shadow_rays[1] / np,
                    o->prepares[1] / np, o->guide_calls[1] / np, o->seconds[1], o->relvar[1],
                    o->light[0] > 0.0 ? o->light[1] / o->light[0] : 1.0, o->short_z, 100.0 * o->tail_share[0],

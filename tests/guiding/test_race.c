@@ -10,6 +10,11 @@
  *    the variance: the race says it cannot tell and guided-nee stands; on
  *    door it measures, and on door-shielded (no smooth lobes) it measures
  *    even on seeds where the tail holds more than half of the variance;
+ *  - its standard error means what it says: equal racers (mis and mis, door,
+ *    four seeds) end level within 3 standard errors, the race goes on past
+ *    its first paths while they are level, and guided-nee (the second racer)
+ *    wins only by more than IRIS_RACE_MARGIN_Z standard errors; a decided
+ *    race (a racer short of light) stops at its first paths;
  *  - the cost model counts rays, shadow rays and the guide's work as
  *    documented, deterministic: the same outcome, bit for bit, on 1 and 2
  *    threads and for a window of the frame (auto on door). */
@@ -149,7 +154,29 @@ static void test_statistic_and_light(void) {
     CHECK(o.short_z < -IRIS_RACE_SHORT_Z);
     CHECK(!o.guided);
     CHECK(strstr(why, "less light") != NULL);
+    CHECK_EQ_INT(o.paths, o.base_paths); /* decided at the first look */
   }
+  /* equal racers: level within the race's standard error; it goes on while
+   * they are level; the second wins only beyond the margin */
+  int extended = 0;
+  double z2 = 0.0;
+  for (uint64_t seed = 1; seed <= 4; seed++)
+    if (race_seed(&w, &full, &full, 2, seed, &o, why, sizeof why)) {
+      const double z = log(o.speedup) / o.log_speedup_se;
+      printf("door mis vs mis, seed %llu: speedup %.3f, log se %.3f (z %.2f), %llu of at most %llu paths; %s\n",
+             (unsigned long long)seed, o.speedup, o.log_speedup_se, z, (unsigned long long)o.paths,
+             (unsigned long long)(IRIS_RACE_EXTEND * o.base_paths), why);
+      iris_check_record(isfinite(z) && fabs(z) < 3.0, __FILE__, __LINE__,
+                        "equal racers %.1f standard errors apart (log se %.3g): the error is too small", z,
+                        o.log_speedup_se);
+      CHECK(o.log_speedup_se < 0.5); /* ... and not uselessly large */
+      CHECK(o.guided == (z > IRIS_RACE_MARGIN_Z));
+      CHECK(o.paths <= IRIS_RACE_EXTEND * o.base_paths);
+      extended += o.paths > o.base_paths;
+      z2 += z * z;
+    }
+  iris_check_record(extended >= 2, __FILE__, __LINE__, "equal racers: the race went on past its first paths on %d of 4 seeds",
+                    extended);
   CHECK(!iris_race_scene_has_smooth_lobes(w.s));
   world_destroy(&w);
   /* without smooth lobes a heavy tail does not stop the race: door-shielded,
