@@ -215,8 +215,7 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
   }
   if (emissive >= UINT32_MAX)
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "more than 2^32 emissive triangles");
-  bool env = scene->has_environment && !scene->environment_map.path &&
-             (scene->environment[0] > 0 || scene->environment[1] > 0 || scene->environment[2] > 0);
+  bool env = iris_lights_constant_environment_emits(scene);
   iris_vec3 env_mean = iris_v3_load(scene->environment);
   if (scene->has_environment && scene->environment_map.path) {
     out->envmap = calloc(1, sizeof *out->envmap);
@@ -248,8 +247,8 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
   for (size_t i = 0; i < placements; i++) add_emissive_placement(out, i, &n, &slot);
   for (size_t i = 0; i < scene->light_count; i++) {
     const iris_light *l = &scene->lights[i];
+    if (!iris_lights_punctual_emits(l)) continue;
     iris_vec3 c = iris_scale(iris_v3_load(l->color), l->intensity);
-    if (!(luminance(c) > 0.0f)) continue;
     iris_light_entry *e = &out->entries[n];
     e->prim = (uint32_t)i;
     e->radiance = c;

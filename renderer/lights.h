@@ -67,6 +67,17 @@ static inline bool iris_lights_merge_groups(size_t tri_groups, size_t others) {
 static inline size_t iris_lights_group_count(size_t tri_groups, size_t others) {
   return (iris_lights_merge_groups(tri_groups, others) && tri_groups > 0 ? 1 : tri_groups) + others;
 }
+/* The punctual lights and constant environments the lights build an entry
+ * for: those that emit (a black one is left out). An environment map's mean
+ * is known only once it is loaded (a black map is left out then). */
+static inline bool iris_lights_punctual_emits(const iris_light *l) {
+  const float c[3] = {l->color[0] * l->intensity, l->color[1] * l->intensity, l->color[2] * l->intensity};
+  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2] > 0.0f;
+}
+static inline bool iris_lights_constant_environment_emits(const iris_scene *s) {
+  return s->has_environment && !s->environment_map.path &&
+         (s->environment[0] > 0 || s->environment[1] > 0 || s->environment[2] > 0);
+}
 typedef struct iris_light_group {
   uint32_t first, count;  /* entries [first, first + count) */
   iris_light_kind kind;

@@ -122,15 +122,19 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
       out->textures += (uint64_t)(ENV_BYTES_PER_TEXEL / 6.0 * (double)file_size(s->environment_map.path));
   }
   out->lights = (uint64_t)(BYTES_PER_EMISSIVE_TRIANGLE * emissive_tris) + 16ull * s->instance_count;
-  /* as the lights build their groups: punctual lights and the sky one each */
-  light_groups = iris_lights_group_count(light_groups, s->light_count + (s->has_environment ? 1 : 0));
+  /* as the lights build their groups: emitting punctual lights and the sky one
+   * each (a map counted whatever its mean: known only once loaded) */
+  const bool sky = iris_lights_constant_environment_emits(s) || (s->has_environment && s->environment_map.path);
+  size_t punctual = 0;
+  for (size_t i = 0; i < s->light_count; i++) punctual += iris_lights_punctual_emits(&s->lights[i]);
+  light_groups = iris_lights_group_count(light_groups, punctual + sky);
   if (guided) { /* the default budget of renderer/guiding/guiding.c (choose_budget) */
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);
     /* the sky's share of the power at its largest: up to twice the paths */
-    double paths = iris_guiding_photon_paths(caches, 200, light_groups, s->has_environment ? 1.0 : 0.0);
+    double paths = iris_guiding_photon_paths(caches, 200, light_groups, sky ? 1.0 : 0.0);
     /* learned light selection: with more than one light to choose from */
-    if (emissive_tris + s->light_count > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
+    if (emissive_tris + (double)punctual > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
     out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;
     for (size_t m = 0; m < s->material_count; m++)
       if (may_be_smooth(&s->materials[m])) { /* glints: at most one set of 65536 paths */

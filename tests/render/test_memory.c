@@ -190,10 +190,25 @@ static void test_estimates(void) {
  * and refused under a limit it fits. `count` placements of a small emitting
  * sphere, 640 x 480 (9600 caches: 96 000 paths for one group). */
 static void test_light_groups(void) {
-  const int counts[4] = {1, 10, 100, 2000};
-  uint64_t guide[4];
-  for (int c = 0; c < 4; c++) {
+  const int counts[6] = {1, 10, 100, 2000, 10, 10};
+  uint64_t guide[6];
+  for (int c = 0; c < 6; c++) {
     iris_scene *s = iris_scene_create();
+    /* 4: black lights and a black sky beside the 10 placements (the lights
+     * build no group for them); 5: a lit point light beside them */
+    if (c >= 4) {
+      iris_light l = {0};
+      l.type = IRIS_LIGHT_POINT;
+      l.color[0] = l.color[1] = l.color[2] = 1.0f;
+      l.intensity = c == 5 ? 100.0f : 0.0f;
+      iris_scene_add_light(s, &l);
+      l.type = IRIS_LIGHT_DIRECTIONAL;
+      l.intensity = 5.0f;
+      l.color[0] = l.color[1] = l.color[2] = 0.0f;
+      iris_scene_add_light(s, &l);
+      s->has_environment = c == 4;
+      s->environment[0] = s->environment[1] = s->environment[2] = 0.0f;
+    }
     iris_material mat = iris_material_default(IRIS_MATERIAL_DIFFUSE);
     mat.name = iris_strdup("lamp");
     mat.emission[0] = mat.emission[1] = mat.emission[2] = 5.0f;
@@ -214,6 +229,8 @@ static void test_light_groups(void) {
   CHECK(guide[1] > guide[0]);  /* ten groups: more paths than one */
   CHECK_EQ_INT(guide[2], guide[0]); /* more than 64: merged into one group */
   CHECK_EQ_INT(guide[3], guide[0]);
+  CHECK_EQ_INT(guide[4], guide[1]); /* black lights and sky: no group, no sky share */
+  CHECK(guide[5] > guide[1]);       /* a lit one: a group more */
 }
 
 static void test_refused(void) {
