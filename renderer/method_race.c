@@ -182,6 +182,14 @@ static bool race_unmeasurable(const iris_race_outcome *o, const iris_scene *scen
   return tail > IRIS_RACE_TAIL_MAX && iris_race_scene_has_smooth_lobes(scene);
 }
 
+/* log(speedup) in standard errors; +-infinity where a racer has no variance
+ * at all (the other wins), 0 where neither has. */
+static double race_z(const iris_race_outcome *o) {
+  const double ls = log(o->speedup), se = o->log_speedup_se;
+  if (!isfinite(ls) || ls == 0.0) return ls;
+  return se > 0.0 ? ls / se : (ls > 0.0 ? INFINITY : -INFINITY);
+}
+
 /* Group of a race pixel for the jackknife: 16 interleaved 4 x 4 lattices, each
  * spread over the whole frame. */
 #define RACE_GROUPS 16
@@ -342,7 +350,7 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     if (time_cap > 0.0 && iris_time_now() - t0 >= time_cap) break;
     if (done < spp) continue;
     race_measure(buf, n, cols, rows, done, scratch, out);
-    if (fabs(log(out->speedup)) >= IRIS_RACE_DECISIVE_Z * out->log_speedup_se ||
+    if (fabs(race_z(out)) >= IRIS_RACE_DECISIVE_Z ||
         fabs(out->short_z) > IRIS_RACE_SHORT_Z || race_unmeasurable(out, mis->scene))
       break;
   }
@@ -376,7 +384,7 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     /* guided-nee must win by IRIS_RACE_MARGIN_Z standard errors: where the two
      * are level within the race's noise, mis (stress-glossy-room's race
      * measured 0.6-1.5x over seeds where long renders give 0.65-0.82x) */
-    const double z = log(out->speedup) / out->log_speedup_se;
+    const double z = race_z(out);
     out->guided = z > IRIS_RACE_MARGIN_Z;
     snprintf(why, why_size, "the race: guided-nee %.2fx mis per unit of work, %.1f standard errors%s (relative variance %.3g against %.3g, cost %.1f against %.1f rays per path)",
              out->speedup, z, out->speedup > 1.0 && !out->guided ? ": not enough to leave mis" : "",

@@ -14,5 +14,5 @@ for sc in "$@"; do
       --seed 777 --threads 2 -o "$R/ref_$sc.exr" > /dev/null 2>&1
   fi
   /usr/bin/python3 "$(dirname "$0")/variants.py" "$B" "$R/ref_$sc.exr" "$sc" --spp 64 --seeds 1,2,3 \
-    'refine=--force' 'norefine=--force --refine 0'
+    'refine=--force --refine 8' 'norefine=--force --refine 0'
 done
