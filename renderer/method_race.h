@@ -1,13 +1,15 @@
 /* `--method auto` by measurement (docs/guiding.md, "--method auto"): a short,
  * deterministic race of mis against guided-nee on a fixed grid of pixels of
  * the whole frame, after the guide is built. Each method traces the same
- * number of camera paths with its own seed (none of them enters the image);
+ * number of camera paths with its own seed (none of them enters the image),
+ * more while the two are level within the race's standard error;
  * the race measures each method's relative variance per sample and its cost
  * per sample in a deterministic model (rays and guide look-ups, weighted by
  * per-operation times measured once: no clock decides), and whether one
  * method found significantly less light than the other (an estimator that is
  * short of light has paths too rare for the race to see, so its variance is
- * underestimated). Private to renderer/. */
+ * underestimated). guided-nee wins only by more than one standard error.
+ * Private to renderer/. */
 #ifndef IRIS_RENDERER_METHOD_RACE_H
 #define IRIS_RENDERER_METHOD_RACE_H
 
