@@ -42,6 +42,8 @@ static inline iris_vec3 iris_add(iris_vec3 a, iris_vec3 b) { return iris_v3(a.x 
 static inline iris_vec3 iris_sub(iris_vec3 a, iris_vec3 b) { return iris_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
 static inline iris_vec3 iris_mul(iris_vec3 a, iris_vec3 b) { return iris_v3(a.x * b.x, a.y * b.y, a.z * b.z); }
 static inline iris_vec3 iris_scale(iris_vec3 a, float s) { return iris_v3(a.x * s, a.y * s, a.z * s); }
+/* Rec. 709 luminance of linear RGB. */
+static inline float iris_luminance(iris_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 static inline iris_vec3 iris_neg(iris_vec3 a) { return iris_v3(-a.x, -a.y, -a.z); }
 static inline iris_vec3 iris_madd(iris_vec3 a, iris_vec3 b, float s) {
   return iris_v3(a.x + b.x * s, a.y + b.y * s, a.z + b.z * s);

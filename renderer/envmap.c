@@ -10,7 +10,7 @@
 #include "core/image.h"
 #include "core/log.h"
 
-static float luminance3(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+static float luminance3(const float *c) { return iris_luminance(iris_v3_load(c)); }
 
 /* EXR by its magic number (0x762f3101), else Radiance HDR (stb checks its header). */
 static bool is_exr(const char *path) {

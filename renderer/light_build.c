@@ -10,7 +10,6 @@
 
 #include "renderer/lights_private.h"
 
-static float luminance(iris_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 static float triangle_area(const iris_vec3 v[3]) {
   return 0.5f * iris_length(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));
@@ -74,14 +73,14 @@ static iris_status build_groups(iris_lights *L, iris_error *err) {
       case IRIS_LIGHT_KIND_SPOT:
         gr->center = iris_v3_load(L->scene->lights[e0->prim].position);
         gr->radius = 0.0f;
-        gr->phi = 4.0f * IRIS_PI * luminance(e0->radiance);
+        gr->phi = 4.0f * IRIS_PI * iris_luminance(e0->radiance);
         break;
       case IRIS_LIGHT_KIND_DIRECTIONAL:
-        gr->irradiance = luminance(e0->radiance);
+        gr->irradiance = iris_luminance(e0->radiance);
         break;
       case IRIS_LIGHT_KIND_ENVIRONMENT:
       default:
-        gr->irradiance = IRIS_PI * luminance(e0->radiance);
+        gr->irradiance = IRIS_PI * iris_luminance(e0->radiance);
         break;
     }
     if (gr->count > 1) {
@@ -174,7 +173,7 @@ static void add_emissive_placement(iris_lights *out, size_t instance, size_t *n,
     e->area = area;
     e->two_sided = m->emission_two_sided;
     e->radiance = iris_v3_load(m->emission);
-    e->power = luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
+    e->power = iris_luminance(e->radiance) * IRIS_PI * area * (e->two_sided ? 2.0f : 1.0f);
     e->v0 = v[0];
     e->e1 = iris_sub(v[1], v[0]);
     e->e2 = iris_sub(v[2], v[0]);
@@ -255,17 +254,17 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     switch (l->type) {
       case IRIS_LIGHT_POINT:
         e->kind = IRIS_LIGHT_KIND_POINT;
-        e->power = luminance(c) * 4.0f * IRIS_PI;
+        e->power = iris_luminance(c) * 4.0f * IRIS_PI;
         break;
       case IRIS_LIGHT_SPOT:
         e->kind = IRIS_LIGHT_KIND_SPOT;
-        e->power = luminance(c) * 2.0f * IRIS_PI *
+        e->power = iris_luminance(c) * 2.0f * IRIS_PI *
                    (1.0f - cosf(0.5f * (l->inner_cone + l->outer_cone)));
         break;
       case IRIS_LIGHT_DIRECTIONAL:
       default:
         e->kind = IRIS_LIGHT_KIND_DIRECTIONAL;
-        e->power = luminance(c) * IRIS_PI * out->radius * out->radius;
+        e->power = iris_luminance(c) * IRIS_PI * out->radius * out->radius;
         break;
     }
     n++;
@@ -275,7 +274,7 @@ iris_status iris_lights_build(const iris_scene *scene, const iris_accel *accel,
     e->kind = IRIS_LIGHT_KIND_ENVIRONMENT;
     e->radiance = env_mean; /* a map's mean over the sphere */
     /* Power of a sky of this mean radiance through the scene's bounding sphere (pbrt-v4). */
-    e->power = luminance(e->radiance) * 4.0f * IRIS_PI * IRIS_PI * out->radius * out->radius;
+    e->power = iris_luminance(e->radiance) * 4.0f * IRIS_PI * IRIS_PI * out->radius * out->radius;
     out->environment = (int32_t)n;
     n++;
   }
@@ -406,7 +405,7 @@ iris_light_bounds iris_lights_bounds(const iris_lights *L, uint32_t i) {
     case IRIS_LIGHT_KIND_SPOT: {
       const iris_light *l = &L->scene->lights[e->prim];
       b.lo = b.hi = iris_v3_load(l->position);
-      b.phi = 4.0f * IRIS_PI * luminance(e->radiance);
+      b.phi = 4.0f * IRIS_PI * iris_luminance(e->radiance);
       if (e->kind == IRIS_LIGHT_KIND_SPOT) {
         b.w = iris_normalize(iris_v3_load(l->direction));
         b.cos_e = cosf(fminf(l->outer_cone, IRIS_PI));
@@ -418,12 +417,12 @@ iris_light_bounds iris_lights_bounds(const iris_lights *L, uint32_t i) {
     }
     case IRIS_LIGHT_KIND_DIRECTIONAL:
       b.infinite = true;
-      b.phi = IRIS_PI * luminance(e->radiance);
+      b.phi = IRIS_PI * iris_luminance(e->radiance);
       break;
     case IRIS_LIGHT_KIND_ENVIRONMENT:
     default:
       b.infinite = true;
-      b.phi = IRIS_PI * IRIS_PI * luminance(e->radiance);
+      b.phi = IRIS_PI * IRIS_PI * iris_luminance(e->radiance);
       break;
   }
   return b;

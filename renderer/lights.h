@@ -71,8 +71,7 @@ static inline size_t iris_lights_group_count(size_t tri_groups, size_t others) {
  * for: those that emit (a black one is left out). An environment map's mean
  * is known only once it is loaded (a black map is left out then). */
 static inline bool iris_lights_punctual_emits(const iris_light *l) {
-  const float c[3] = {l->color[0] * l->intensity, l->color[1] * l->intensity, l->color[2] * l->intensity};
-  return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2] > 0.0f;
+  return iris_luminance(iris_scale(iris_v3_load(l->color), l->intensity)) > 0.0f;
 }
 static inline bool iris_lights_constant_environment_emits(const iris_scene *s) {
   return s->has_environment && !s->environment_map.path &&

@@ -323,7 +323,7 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
    * alone: the same on any thread count); under a time cap also until the
    * race has used it (after one round) */
   const double t0 = iris_time_now();
-  uint64_t done = 0;
+  uint64_t done = 0, measured = 0; /* the paths per pixel `out` was measured at */
   while (done < spp_max) {
     const uint64_t r = done < spp && spp - done < IRIS_RACE_ROUND_SPP ? spp - done : IRIS_RACE_ROUND_SPP;
     for (int m = 0; m < 2; m++) {
@@ -350,11 +350,12 @@ iris_status iris_method_race(const iris_integrator *mis, const iris_integrator *
     if (time_cap > 0.0 && iris_time_now() - t0 >= time_cap) break;
     if (done < spp) continue;
     race_measure(buf, n, cols, rows, done, scratch, out);
+    measured = done;
     if (fabs(race_z(out)) >= IRIS_RACE_DECISIVE_Z ||
         fabs(out->short_z) > IRIS_RACE_SHORT_Z || race_unmeasurable(out, mis->scene))
       break;
   }
-  race_measure(buf, n, cols, rows, done, scratch, out);
+  if (measured != done) race_measure(buf, n, cols, rows, done, scratch, out);
   out->paths = n * done;
   out->base_paths = n * (done < spp ? done : spp);
   free(buf);
