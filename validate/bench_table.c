@@ -71,6 +71,18 @@ double iris_bench_default_target(const iris_bench_point *pts, int count) {
   return sqrt(a * b);
 }
 
+int iris_bench_net_curve(const iris_bench_point *pts, int count, double own, iris_bench_point *out) {
+  int n = 0;
+  for (int i = 0; i < count; i++) {
+    iris_bench_point q = pts[i];
+    q.relmse -= own;
+    q.relmse_min -= own;
+    q.relmse_max -= own;
+    if (q.relmse > 0.0) out[n++] = q;
+  }
+  return n;
+}
+
 /* ---- writing --------------------------------------------------------------- */
 
 typedef struct method_curve {
@@ -186,6 +198,52 @@ static void cell_relmse(char *buf, size_t size, const method_curve *m, const met
     snprintf(buf, size, "%.4g%s%s", pt->relmse, speed, at);
 }
 
+/* One scene's table: relMSE per budget (speed-up against `base` at equal
+ * time) and the time to `target` with its speed-up. */
+static void write_scene_table(FILE *m, FILE *h, const iris_bench_params *p, const iris_bench_result *res,
+                              const char *scene, const double *budgets, method_curve *mc, int n,
+                              const method_curve *base, double target, const char *caption) {
+  for (int k = 0; k < n; k++) mc[k].ttt = iris_bench_time_to_target(mc[k].pts, mc[k].count, target, &mc[k].extrapolated);
+  fprintf(m, "### %s\n\n| method |", caption);
+  fprintf(h, "<table><caption>%s</caption>\n<tr><th>method</th>", caption);
+  for (int t = 0; t < p->time_count; t++) {
+    fprintf(m, " %g s |", budgets[t]);
+    fprintf(h, "<th>%g s</th>", budgets[t]);
+  }
+  fprintf(m, " time to relMSE %.3g | speed-up |\n|---|", target);
+  fprintf(h, "<th>time to relMSE %.3g</th><th>speed-up</th></tr>\n", target);
+  for (int t = 0; t < p->time_count + 2; t++) fprintf(m, "---:|");
+  fprintf(m, "\n");
+  for (int k = 0; k < n; k++) {
+    char shown[96];
+    display_name(res, scene, mc[k].name, shown, sizeof shown);
+    fprintf(m, "| %s |", shown);
+    fprintf(h, "<tr><td>%s</td>", shown);
+    for (int t = 0; t < p->time_count; t++) {
+      char c[400];
+      cell_relmse(c, sizeof c, &mc[k], base, budgets[t], false);
+      fprintf(m, " %s |", c);
+      cell_relmse(c, sizeof c, &mc[k], base, budgets[t], true);
+      fprintf(h, "<td>%s</td>", c);
+    }
+    char ts[48] = "-", sp[48] = "-";
+    if (mc[k].ttt > 0) {
+      char s2[32];
+      fmt_seconds(s2, sizeof s2, mc[k].ttt);
+      snprintf(ts, sizeof ts, "%s%s", mc[k].extrapolated ? "~" : "", s2);
+      if (base && base->ttt > 0) {
+        char x[32];
+        fmt_factor(x, sizeof x, base->ttt / mc[k].ttt);
+        snprintf(sp, sizeof sp, "%s%s", (mc[k].extrapolated || base->extrapolated) ? "~" : "", x);
+      }
+    }
+    fprintf(m, " %s | %s |\n", ts, sp);
+    fprintf(h, "<td>%s</td><td>%s</td></tr>\n", ts, sp);
+  }
+  fprintf(m, "\n");
+  fprintf(h, "</table>\n");
+}
+
 iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
                                     iris_bench_result *res, iris_error *err) {
   double budgets[IRIS_BENCH_MAX_TIMES];
@@ -221,14 +279,16 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
              "budgets around the target (~: extrapolated with relMSE ~ 1/t). [took T]: the run needed T\n"
              "seconds, more than its budget (setup alone exceeded it; at least one pass always runs).\n"
              "Every relMSE also holds the reference's own error (\"its own relMSE\" in the captions, from\n"
-             "its variance), which pulls the speed-ups towards 1 unless it is far below the values.\n\n");
+             "its variance), which pulls the speed-ups towards 1 unless it is far below the values; where it\n"
+             "is known, a second table gives every relMSE net of it, an estimate of the error against the truth.\n\n");
   fprintf(h, "<p>relMSE (&epsilon; = 0.01, top 0.1%% of pixels dropped), mean over the seeds (hover for the "
              "spread); in brackets the speed-up against mis at equal time, relMSE(mis) / relMSE(method). "
              "Budgets are wall-clock seconds with setup included. Time to target is interpolated in log-log "
              "between the budgets around the target (~: extrapolated with relMSE &prop; 1/t). [took T]: the run "
              "needed T seconds, more than its budget (setup alone exceeded it; at least one pass always runs). "
              "Every relMSE also holds the reference's own error (&ldquo;its own relMSE&rdquo; in the captions, "
-             "from its variance), which pulls the speed-ups towards 1 unless it is far below the values.</p>\n");
+             "from its variance), which pulls the speed-ups towards 1 unless it is far below the values; where it is "
+             "known, a second table gives every relMSE net of it, an estimate of the error against the truth.</p>\n");
   for (int s = 0; s < res->scene_count; s++) {
     iris_bench_scene *sc = &res->scenes[s];
     method_curve mc[IRIS_BENCH_MAX_METHODS + 1];
@@ -241,47 +301,28 @@ iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *p,
                     : base ? iris_bench_default_target(base->pts, base->count)
                            : -1.0;
     sc->target_relmse = target;
-    for (int k = 0; k < n; k++) mc[k].ttt = iris_bench_time_to_target(mc[k].pts, mc[k].count, target, &mc[k].extrapolated);
-    fprintf(m, "### %s (%dx%d; reference: %s)\n\n| method |", sc->name, sc->width, sc->height,
-            sc->reference_description);
-    fprintf(h, "<table><caption>%s (%dx%d; reference: %s)</caption>\n<tr><th>method</th>", sc->name,
-            sc->width, sc->height, sc->reference_description);
-    for (int t = 0; t < p->time_count; t++) {
-      fprintf(m, " %g s |", budgets[t]);
-      fprintf(h, "<th>%g s</th>", budgets[t]);
-    }
-    fprintf(m, " time to relMSE %.3g | speed-up |\n|---|", target);
-    fprintf(h, "<th>time to relMSE %.3g</th><th>speed-up</th></tr>\n", target);
-    for (int t = 0; t < p->time_count + 2; t++) fprintf(m, "---:|");
-    fprintf(m, "\n");
+    char caption[sizeof sc->reference_description + 200];
+    snprintf(caption, sizeof caption, "%s (%dx%d; reference: %s)", sc->name, sc->width, sc->height,
+             sc->reference_description);
+    write_scene_table(m, h, p, res, sc->name, budgets, mc, n, base, target, caption);
+    /* The same net of the reference's own error (iris_bench_net_curve): the
+     * target moves with it, so that it is the same error against the truth. */
+    const double own = sc->reference_relmse;
+    if (!(own > 0.0) || !base) continue;
+    method_curve net[IRIS_BENCH_MAX_METHODS + 1];
+    const method_curve *net_base = NULL;
     for (int k = 0; k < n; k++) {
-      char shown[96];
-      display_name(res, sc->name, mc[k].name, shown, sizeof shown);
-      fprintf(m, "| %s |", shown);
-      fprintf(h, "<tr><td>%s</td>", shown);
-      for (int t = 0; t < p->time_count; t++) {
-        char c[400];
-        cell_relmse(c, sizeof c, &mc[k], base, budgets[t], false);
-        fprintf(m, " %s |", c);
-        cell_relmse(c, sizeof c, &mc[k], base, budgets[t], true);
-        fprintf(h, "<td>%s</td>", c);
-      }
-      char ts[48] = "-", sp[48] = "-";
-      if (mc[k].ttt > 0) {
-        char s2[32];
-        fmt_seconds(s2, sizeof s2, mc[k].ttt);
-        snprintf(ts, sizeof ts, "%s%s", mc[k].extrapolated ? "~" : "", s2);
-        if (base && base->ttt > 0) {
-          char x[32];
-          fmt_factor(x, sizeof x, base->ttt / mc[k].ttt);
-          snprintf(sp, sizeof sp, "%s%s", (mc[k].extrapolated || base->extrapolated) ? "~" : "", x);
-        }
-      }
-      fprintf(m, " %s | %s |\n", ts, sp);
-      fprintf(h, "<td>%s</td><td>%s</td></tr>\n", ts, sp);
+      net[k] = mc[k];
+      net[k].count = iris_bench_net_curve(mc[k].pts, mc[k].count, own, net[k].pts);
+      if (&mc[k] == base) net_base = &net[k];
     }
-    fprintf(m, "\n");
-    fprintf(h, "</table>\n");
+    double net_target = target - own;
+    if (!(net_target > 0.0)) net_target = iris_bench_default_target(net_base->pts, net_base->count);
+    snprintf(caption, sizeof caption,
+             "%s net of the reference's own relMSE %.3g (each relMSE minus it; an error within it cannot be "
+             "measured: -)",
+             sc->name, own);
+    write_scene_table(m, h, p, res, sc->name, budgets, net, n, net_base, net_target, caption);
   }
   fprintf(h, "<!-- /iris-bench-tables -->\n</body></html>\n");
   if (ferror(m) || ferror(h)) {

@@ -43,8 +43,18 @@ double iris_bench_time_to_target(const iris_bench_point *pts, int count, double 
  * of the reference method's curve, so that it is reached mid-range. */
 double iris_bench_default_target(const iris_bench_point *pts, int count);
 
+/* The curve net of the reference's own relMSE `own` (its variance channels'
+ * expected error, iris_metric_own_relmse): every relMSE measured against a
+ * noisy reference r estimates E[(t - r)^2] = E[(t - T)^2] + Var(r) for the
+ * truth T and r independent of t, so relMSE - own estimates the error against
+ * the truth (docs/benchmarks.md, "Net of the reference's noise"). Points
+ * whose mean falls to <= 0 (an error within the reference's own) are dropped:
+ * the reference cannot measure them. Returns the number of points written. */
+int iris_bench_net_curve(const iris_bench_point *pts, int count, double own, iris_bench_point *out);
+
 /* Sets each scene's target_relmse (params->target_relmse, else the default
  * from mis, else the first method) and writes DIR/table.md and DIR/table.html
+ * and, where the reference's own relMSE is known, a second table net of it
  * (the tables sit between <!-- iris-bench-tables --> markers so that `iris
  * report` can embed them). */
 iris_status iris_bench_write_tables(const char *dir, const iris_bench_params *params,
