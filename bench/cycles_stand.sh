@@ -10,8 +10,11 @@
 #   TIMES e.g. "4,16"; METHODS e.g. mis,auto; REF: auto (a cached iris mis
 #   reference of 4096 spp), auto:N (of N spp) or a directory holding ref_SCENE.exr.
 # Runs that already have results in OUT are kept (delete them to rerun).
+# SEEDS=N in the environment: N seeds per row (default 1), iris's and Cycles'
+# alike; the times to target are then those of the seeds' mean relMSE.
 set -eu
 B=$1; O=$2; T=$3; H=$4; M=$5; R=$6
+S=${SEEDS:-1}
 shift 6
 mkdir -p "$O"
 for sc in "$@"; do
@@ -24,7 +27,7 @@ for sc in "$@"; do
     d="$O/$sc-$mode"
     [ -f "$d/results.csv" ] && continue
     # shellcheck disable=SC2086
-    "$B/tools/iris" bench "$sc" --methods "$M" --times "$T" --seeds 1 --height "$H" $ref --threads 2 \
+    "$B/tools/iris" bench "$sc" --methods "$M" --times "$T" --seeds "$S" --height "$H" $ref --threads 2 \
       "--$mode" --no-charts --out "$d" > "$O/$sc-$mode.log" 2>&1 ||
       { echo "$sc ($mode): iris bench failed (see $O/$sc-$mode.log)"; continue; }
   done
