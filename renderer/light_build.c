@@ -10,7 +10,6 @@
 
 #include "renderer/lights_private.h"
 
-
 static float triangle_area(const iris_vec3 v[3]) {
   return 0.5f * iris_length(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));
 }

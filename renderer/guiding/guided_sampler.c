@@ -94,8 +94,9 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
      * vertex's nearest ones left (glints.h), if they agree on one. */
     if (glint > 0.0f && iris_glints_spot(&g->glints, v->p, sp->frame.n, &v->spot))
       v->glint = fmaxf(0.0f, fminf(glint / (float)v->m, 1.0f - v->sky - v->lamp));
+    const float rough = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
     const float a_free = learned == v->m ? a / (float)v->m : g->params.alpha_max;
-    if (learned == v->m) v->alpha = fminf(iris_bsdf_guiding_roughness(&sp->bsdf), a_free);
+    if (learned == v->m) v->alpha = fminf(rough, a_free);
     /* Behind glass, the lobe's roughness caps only the caches' part: their
      * texels cannot follow a glossy lobe, but the map through glass and a
      * lamp's cone are exact directions that stand in for light sampling,
@@ -105,8 +106,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
      * far lower there). Glints keep the cap: light sampling still reaches
      * their light. docs/guiding.md, "Glass seen from glossy vertices". */
     const float exact = v->sky + v->lamp;
-    const float a_exact =
-        isfinite(iris_bsdf_guiding_roughness(&sp->bsdf)) ? fmaxf(a_free, g->params.alpha_max) : a_free;
+    const float a_exact = isfinite(rough) ? fmaxf(a_free, g->params.alpha_max) : a_free;
     if (exact > 0.0f && a_exact > v->alpha) {
       const float total = v->alpha * (1.0f - exact) + a_exact * exact;
       v->sky *= a_exact / total;
