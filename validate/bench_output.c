@@ -18,16 +18,34 @@ static int cmp_double(const void *a, const void *b) {
   return x < y ? -1 : x > y;
 }
 
+/* The reference's own relMSE of a scene (from its variance), < 0 if unknown. */
+static double own_relmse(const iris_bench_result *res, const char *scene) {
+  for (int i = 0; i < res->scene_count; i++)
+    if (strcmp(res->scenes[i].name, scene) == 0) return res->scenes[i].reference_relmse;
+  return -1.0;
+}
+
+/* A row's relMSE net of the reference's own (docs/benchmarks.md, "Net of the
+ * reference's noise"): NaN where that is unknown. One seed's value may be
+ * negative: it is a difference of two noisy numbers. */
+static double relmse_net(const iris_bench_result *res, const iris_bench_row *r) {
+  const double own = own_relmse(res, r->scene);
+  return own >= 0.0 && isfinite(r->relmse) ? r->relmse - own : NAN;
+}
+
 iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res, iris_error *err) {
   iris_atomic_file f;
   iris_status st = iris_atomic_open(&f, path, err);
   if (st != IRIS_OK) return st;
-  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved\n");
+  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net\n");
   for (size_t i = 0; i < res->row_count; i++) {
     const iris_bench_row *r = &res->rows[i];
-    fprintf(f.fp, "%s,%s,%llu,%g,%.4f,%d,%.6g,%.6g,%.6g,%s\n", r->scene, r->method,
+    fprintf(f.fp, "%s,%s,%llu,%g,%.4f,%d,%.6g,%.6g,%.6g,%s,", r->scene, r->method,
             (unsigned long long)r->seed, r->budget_s, r->seconds, r->spp, r->relmse, r->mape,
             r->energy_ratio, r->resolved[0] ? r->resolved : r->method);
+    const double net = relmse_net(res, r);
+    if (isfinite(net)) fprintf(f.fp, "%.6g", net); /* empty where the reference's own is unknown */
+    fputc('\n', f.fp);
   }
   if (ferror(f.fp)) {
     iris_atomic_abort(&f);
@@ -129,6 +147,7 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     iris_json_add_number(j, "setup_seconds", r->setup_seconds);
     cJSON_AddNumberToObject(j, "spp", r->spp);
     iris_json_add_number(j, "relmse", r->relmse);
+    iris_json_add_number(j, "relmse_net", relmse_net(res, r));
     iris_json_add_number(j, "mape", r->mape);
     iris_json_add_number(j, "energy_ratio", r->energy_ratio);
     cJSON_AddNumberToObject(j, "nonfinite", (double)r->nonfinite);

@@ -60,7 +60,7 @@ def main(argv):
     # results.csv
     with open(os.path.join(out, "results.csv"), newline="") as f:
         lines = f.read().splitlines()
-    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved",
+    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net",
           "CSV header: " + lines[0])
     rows = list(csv.DictReader(lines))
     check(len(rows) == 4, f"4 rows (2 methods x 2 budgets x 1 seed), got {len(rows)}")
@@ -119,6 +119,13 @@ def main(argv):
             q = float(r["relmse"]) / predicted
             check(0.2 < q < 2.0, f"mis at {b} s: relMSE {r['relmse']} vs predicted {predicted:.4g} from "
                   f"the reference's own {own:.4g} ({r['spp']} spp)")
+        # every row also net of it, in the CSV and the JSON
+        for jr, cr in zip(js["rows"], rows):
+            want = float(cr["relmse"]) - own
+            check(cr["relmse_net"] != "" and abs(float(cr["relmse_net"]) - want) <= 1e-5 * abs(want) + 1e-9,
+                  f"CSV relmse_net {cr['relmse_net']} = relmse {cr['relmse']} - own {own:.6g}")
+            check(isinstance(jr.get("relmse_net"), float) and abs(jr["relmse_net"] - want) <= 1e-5 * abs(want) + 1e-9,
+                  f"JSON relmse_net {jr.get('relmse_net')} = relmse - own")
     check(js["outputs"]["charts"] is True, "charts drawn")
 
     # tables
