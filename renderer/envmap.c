@@ -484,11 +484,11 @@ bool iris_envmap_sample_region(const iris_envmap *env, const iris_envmap_regions
   const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
   float lo = cdf[c0], hi = cdf[c1];
   if (!(hi > lo)) return false;
-  /* u1 scaled into the region's part of the row's CDF: the row's guide
-   * entries find it as they do for the whole map */
+  /* u1 scaled into the region's part of the row's CDF, searched within the
+   * region's columns: cdf[c0] <= target, so this is the cell the whole row's
+   * search finds, clamped to the region (target may round up to cdf[c1]) */
   float target = lo + u1 * (hi - lo);
-  int x = search_guided(cdf, &env->guide[(size_t)y * (size_t)env->blocks], env->blocks, env->width, target);
-  x = x < c0 ? c0 : x >= c1 ? c1 - 1 : x;
+  int x = search_cdf(cdf, c0, c1, target);
   float x0 = cdf[x], x1 = cdf[x + 1];
   if (!(x1 > x0)) return false;
   float uc = iris_clampf((target - x0) / (x1 - x0), 0.0f, 0x1.fffffep-1f);
