@@ -138,6 +138,9 @@ static const iris_option GUIDING_ROWS[] = {
     OPT("no-glints", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, glints,
         "do not aim guided directions at the spots where a mirror,\n"
         "glass or near-mirror metal reflects a light (glints)"),
+    OPT("no-portals", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, portals,
+        "do not draw guided directions through the openings (doors)\n"
+        "the caches' indirect light came through (portals)"),
     OPT("no-light-samples", 0, IRIS_OPT_FLAG, NULL, -1, 0, iris_guiding_params, light_samples,
         "with --light-sampler learned: learn the caches' light tables\n"
         "from the photons alone, not also from training's light samples"),

@@ -15,7 +15,7 @@
 static const unsigned char MAGIC[8] = {'I', 'R', 'I', 'S', 'G', 'D', 'E', '\n'};
 #define HEADER_BYTES 48u     /* magic 8, version 4, flags 4, scene 8, settings 8, payload size 8, checksum 8 */
 #define CHECKSUM_AT 40u      /* the checksum covers bytes [0, 40) and the payload */
-#define CACHE_BYTES (98u + 5u * IRIS_CACHE_LAMPS) /* one cache record */
+#define CACHE_BYTES (138u + 5u * IRIS_CACHE_LAMPS) /* one cache record (v7: + the portal, 40 bytes) */
 #define GLINT_BYTES 40u      /* one glint photon: p, n, y (9 f32), energy f32 */
 #define REFINE_CACHE_BYTES (4u * IRIS_REFINE_MAX * IRIS_REFINE_SUB) /* refinement sub-tables per cache */
 #define TEXEL_BYTES 12u      /* pdf f32 + alias q f32 + alias index u32 */
@@ -218,6 +218,10 @@ iris_status iris_guiding_save(const iris_guiding *g, const char *path, uint64_t 
     put_f32(&w, c->pane_share);
     for (int k = 0; k < 4; ++k) put_f32(&w, c->pane[k]);
     put_f32(&w, c->glint_share);
+    put_vec3(&w, c->portal.o);
+    put_vec3(&w, c->portal.u);
+    put_vec3(&w, c->portal.v);
+    put_f32(&w, c->portal_weight);
     at += texels_of(g, c);
   }
   for (size_t i = 0; i < count; ++i) {
@@ -507,6 +511,18 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
     through += c->pane_share;
     c->glint_share = get_f32(r);
     through += c->glint_share;
+    c->portal.o = get_vec3(r);
+    c->portal.u = get_vec3(r);
+    c->portal.v = get_vec3(r);
+    c->portal_weight = get_f32(r);
+    /* a weight names a rectangle (orthogonal half-axes); none: all zero */
+    const bool portal_ok =
+        finite3(c->portal.o) && finite3(c->portal.u) && finite3(c->portal.v) &&
+        (c->portal_weight == 0.0f ? !iris_portal_present(&c->portal)
+                                  : c->portal_weight > 0.0f && c->portal_weight <= 1.0f &&
+                                        iris_portal_present(&c->portal) &&
+                                        fabsf(iris_dot(c->portal.u, c->portal.v)) <=
+                                            1e-4f * iris_length(c->portal.u) * iris_length(c->portal.v));
     /* a share asks the vertex for a spot among glint photons: there must be some */
     const bool glint_ok = c->glint_share == 0.0f || (c->glint_share > 0.0f && c->glint_share <= 1.0f && glints > 0);
     const float pn2 = c->pane[0] * c->pane[0] + c->pane[1] * c->pane[1] + c->pane[2] * c->pane[2];
@@ -524,6 +540,9 @@ static iris_status read_payload(reader *r, const char *path, iris_guiding *g, ui
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid pane (corrupted)", i);
     if (!glint_ok)
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid glint share (corrupted)", i);
+    if (!portal_ok)
+      return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid portal (corrupted)", i);
+    g->stats.portal_caches += c->portal_weight > 0.0f;
     if (!lamps_ok || !(through <= 1.001f)) /* the shares are of the same photons' energy */
       return iris_error_set(err, IRIS_ERR_PARSE, path, 0, NULL, "cache %zu: invalid lamp shares (corrupted)", i);
     /* Tables are stored back to back in cache order: exactly one offset is right. */
@@ -759,6 +778,7 @@ uint64_t iris_guiding_settings_hash(const iris_guide_setup *s, const iris_guidin
   /* lamps behind glass: keeps the hash of guides without lamp light through glass */
   if (!p->lamp_glass) h = mix_u64(h, 0x1a3b91a55ULL);
   if (!p->glints) h = mix_u64(h, 0x611e75ULL);
+  if (!p->portals) h = mix_u64(h, 0x9027a15ULL);
   h = mix_f32(h, p->light_min);
   return h;
 }

@@ -17,7 +17,7 @@
 extern "C" {
 #endif
 
-#define IRIS_GUIDE_FILE_VERSION 6u
+#define IRIS_GUIDE_FILE_VERSION 7u
 
 /* Writes g atomically (a temporary next to path, renamed on success: a
  * failed write leaves no file). Errors: IRIS_ERR_IO naming path. */

@@ -62,6 +62,8 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->pane = 0xff;
   v->glint = 0.0f;
   v->spot = (iris_guide_lamp){{0.0f, 0.0f, 0.0f}, 0.0f};
+  v->portal = 0.0f;
+  v->portal_of = 0xff;
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
@@ -114,6 +116,17 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
       v->glint *= v->alpha / total; /* its probability alpha * glint unchanged */
       v->alpha = total;
     }
+    /* Portals: at a diffuse vertex that sees the front of one of its tied
+     * caches' openings, the heaviest such one, drawn before the rest. */
+    if (v->alpha > 0.0f && (sp->lobes & IRIS_LOBE_DIFFUSE)) { /* weights only where the build found portals */
+      float best = 0.0f;
+      for (int i = 0; i < v->m; ++i) {
+        const iris_cache *c = &g->caches[v->ids[i]];
+        if (c->portal_weight > best && iris_portal_faces(&c->portal, c->p, v->p, sp->frame.n))
+          best = c->portal_weight, v->portal_of = (uint8_t)i;
+      }
+      if (v->portal_of != 0xff) v->portal = IRIS_PORTAL_SHARE;
+    }
   }
   /* The pdf tables of the tied caches are needed after this vertex's shadow
    * ray (the light sample's mixture pdf): start loading them now so the ray
@@ -138,13 +151,22 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   }
 }
 
+/* The portal's part of the density: the rest of the mixture (pdf) has 1 - portal of it. */
+static inline float with_portal(const iris_guiding *g, const iris_guide_vertex_state *v, float pdf, iris_vec3 wi) {
+  if (!(v->portal > 0.0f)) return pdf;
+  const iris_portal *p = &g->caches[v->ids[v->portal_of]].portal;
+  return (1.0f - v->portal) * pdf + v->portal * iris_portal_pdf(p, v->p, wi);
+}
+
 /* A direction drawn by the guide's strategy: the BSDF's value and the mixture's density. */
 static bool guided_finish(const iris_guiding *g, const iris_shading_point *sp, const iris_guide_vertex_state *v,
                           float alpha, iris_vec3 wi, iris_direction_sample *out) {
   iris_vec3 wi_local = iris_frame_to_local(&sp->frame, wi);
   out->wi = wi;
   out->f = iris_integrator_bsdf_eval(sp, wi);
-  out->pdf = (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_guide_pdf(g, v, wi);
+  out->pdf = with_portal(g, v,
+                         (1.0f - alpha) * iris_integrator_bsdf_pdf(sp, wi) + alpha * iris_guide_vertex_guide_pdf(g, v, wi),
+                         wi);
   out->delta = false;
   bool reflect = wi_local.z * sp->wo_local.z > 0.0f;
   out->lobe = (reflect ? IRIS_LOBE_REFLECTION : IRIS_LOBE_TRANSMISSION) |
@@ -160,13 +182,23 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
   /* Delta BSDF, no cache, bad cosine: BSDF sampling with weight 1. */
   if (!(alpha > 0.0f)) return iris_integrator_sample_bsdf(sp, rng, out);
   float u = iris_sampler_slot(rng, IRIS_SLOT_GUIDE_SELECT);
+  if (v->portal > 0.0f) { /* a point on the portal, or u rescaled for the rest */
+    if (u < v->portal) {
+      float u1, u2;
+      iris_sampler_slot2(rng, IRIS_SLOT_DIRECTION, &u1, &u2);
+      return guided_finish(g, sp, v, alpha, iris_portal_sample(&g->caches[v->ids[v->portal_of]].portal, v->p, u1, u2),
+                           out);
+    }
+    u = fminf((u - v->portal) / (1.0f - v->portal), 0x1.fffffep-1f);
+  }
   if (u >= alpha) {
     if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;
     if (out->delta) { /* only the BSDF strategy reaches a delta lobe */
-      out->pdf *= 1.0f - alpha;
+      out->pdf *= (1.0f - alpha) * (1.0f - v->portal);
       return true;
     }
-    out->pdf = (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_guide_pdf(g, v, out->wi);
+    out->pdf = with_portal(g, v, (1.0f - alpha) * out->pdf + alpha * iris_guide_vertex_guide_pdf(g, v, out->wi),
+                           out->wi);
     return out->pdf > 0.0f;
   }
   /* Sky behind glass: the guide's share alpha split between the map (sky) and the caches. */
@@ -216,7 +248,7 @@ static float guided_pdf(void *ctx, const iris_shading_point *sp, iris_vec3 wi) {
   const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   float pb = iris_integrator_bsdf_pdf(sp, wi);
   if (!(v->alpha > 0.0f)) return pb;
-  return (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_guide_pdf(g, v, wi);
+  return with_portal(g, v, (1.0f - v->alpha) * pb + v->alpha * iris_guide_vertex_guide_pdf(g, v, wi), wi);
 }
 
 /* Radiance still to come at a prepared vertex, per unit throughput: the tied

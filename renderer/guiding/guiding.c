@@ -43,6 +43,7 @@ iris_guiding_params iris_guiding_params_default(void) {
   p.refine = -1;
   p.lamp_glass = true;
   p.glints = true;
+  p.portals = true;
   p.light_samples = true;
   p.light_min = IRIS_GUIDING_LIGHT_MIN;
   return p;
@@ -247,6 +248,8 @@ typedef struct fill_ctx {
   uint32_t **ids;   /* per thread, 2 * k: ids, then tree slots */
   float **d2;       /* per thread, k */
   float **fine;     /* per thread, sphere-map sized: fine histogram (refine.h), squares, probabilities (double) */
+  float *cluster;   /* per cache, PORTAL_CLUSTER_FLOATS: the indirect light's cone (indirect_cluster) */
+  struct cluster_photon **cph; /* per thread, k: the cache's indirect photons for it */
 } fill_ctx;
 
 /* The photons a cache can use: on a surface facing like the cache's (not the
@@ -312,6 +315,68 @@ static void lamp_shares(const lamp_sums *l, double power, iris_cache *cache) {
   }
 }
 
+/* ---- the indirect light's cone (portals) ----------------------------------- */
+
+#define PORTAL_CLUSTER_FLOATS 5 /* axis x, y, z, cos of the cone, share of the indirect energy */
+#define PORTAL_CLUSTER_COS 0.82f /* photons within ~35 degrees of the axis make the cluster */
+#define PORTAL_CLUSTER_Q 0.9f    /* the cone holds this much of the cluster's energy */
+#define PORTAL_MIN_WEIGHT 0.3f   /* a cluster with less of the indirect energy looks for no portal */
+#define PORTAL_MIN_PHOTONS 16    /* ... nor one of fewer indirect photons */
+
+typedef struct cluster_photon {
+  iris_vec3 wi;
+  float energy;
+} cluster_photon;
+
+/* The dominant direction of a cache's indirect photons (those a light
+ * sample cannot stand in for): the energy-weighted mean of those within
+ * PORTAL_CLUSTER_COS of the previous mean, three times from the mean of all;
+ * the cone around it holding PORTAL_CLUSTER_Q of their energy (bisection on
+ * the cosine); out = {axis, cos, share of all indirect energy}, share 0 when
+ * there is no such cluster. */
+static void indirect_cluster(const cluster_photon *ph, uint32_t n, float out[PORTAL_CLUSTER_FLOATS]) {
+  memset(out, 0, sizeof(float) * PORTAL_CLUSTER_FLOATS);
+  if (n < PORTAL_MIN_PHOTONS) return;
+  double ax = 0.0, ay = 0.0, az = 0.0, total = 0.0;
+  for (uint32_t j = 0; j < n; ++j) {
+    ax += ph[j].energy * ph[j].wi.x, ay += ph[j].energy * ph[j].wi.y, az += ph[j].energy * ph[j].wi.z;
+    total += ph[j].energy;
+  }
+  if (!(total > 0.0)) return;
+  iris_vec3 axis = iris_v3((float)ax, (float)ay, (float)az);
+  double in = 0.0;
+  for (int it = 0; it < 3; ++it) {
+    if (!(iris_dot(axis, axis) > 0.0f)) return;
+    axis = iris_normalize(axis);
+    ax = ay = az = in = 0.0;
+    for (uint32_t j = 0; j < n; ++j)
+      if (iris_dot(ph[j].wi, axis) >= PORTAL_CLUSTER_COS) {
+        ax += ph[j].energy * ph[j].wi.x, ay += ph[j].energy * ph[j].wi.y, az += ph[j].energy * ph[j].wi.z;
+        in += ph[j].energy;
+      }
+    if (!(in > 0.0)) return;
+    axis = iris_v3((float)ax, (float)ay, (float)az);
+  }
+  if (!(iris_dot(axis, axis) > 0.0f)) return;
+  axis = iris_normalize(axis);
+  double cluster = 0.0;
+  for (uint32_t j = 0; j < n; ++j)
+    if (iris_dot(ph[j].wi, axis) >= PORTAL_CLUSTER_COS) cluster += ph[j].energy;
+  if (!(cluster > 0.0)) return;
+  float lo = PORTAL_CLUSTER_COS, hi = 1.0f; /* the largest cosine whose cone holds Q */
+  for (int it = 0; it < 20; ++it) {
+    const float mid = 0.5f * (lo + hi);
+    double e = 0.0;
+    for (uint32_t j = 0; j < n; ++j)
+      if (iris_dot(ph[j].wi, axis) >= mid) e += ph[j].energy;
+    if (e >= PORTAL_CLUSTER_Q * cluster) lo = mid;
+    else hi = mid;
+  }
+  out[0] = axis.x, out[1] = axis.y, out[2] = axis.z;
+  out[3] = lo;
+  out[4] = (float)(cluster / total);
+}
+
 static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   fill_ctx *c = ctx;
   iris_guiding *g = c->g;
@@ -335,7 +400,8 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
     uint32_t ng = select_groups(c->cones, cache->frame.n, groups);
     uint32_t n = iris_kdtree_knn_groups_payload_if(c->photon_tree, cache->p, c->k, INFINITY, groups, ng,
                                                    photon_usable, &f, ids, d2, slots);
-    uint32_t used = 0;
+    uint32_t used = 0, clustered = 0;
+    cluster_photon *cph = c->cluster ? c->cph[thread_index] : NULL;
     double power = 0.0, through = 0.0, paned = 0.0, pane[4] = {0, 0, 0, 0}, indirect = 0.0, glinted = 0.0;
     for (uint32_t j = 0; j < n; ++j) {
       photon_dirs ph;
@@ -351,12 +417,16 @@ static void fill_caches(void *ctx, uint64_t begin, uint64_t end, int thread_inde
         paned += ph.energy;
         for (int k = 0; k < 4; ++k) pane[k] += ph.energy * c->photons->photons[ids[j]].pane[k];
       }
-      if (u && c->photons->photons[ids[j]].bounce > 0) indirect += ph.energy;
+      if (u && c->photons->photons[ids[j]].bounce > 0) {
+        indirect += ph.energy;
+        if (cph) cph[clustered++] = (cluster_photon){ph.wi, ph.energy};
+      }
       if (u && c->photons->photons[ids[j]].glint) glinted += ph.energy;
       if (u && lamps.on && c->photons->photons[ids[j]].lamp_through)
         lamp_add(&lamps, g, c->lights->entries[c->photons->photons[ids[j]].light].group, ph.energy);
     }
     cache->photons = used;
+    if (cph) indirect_cluster(cph, cache->sphere ? 0 : clustered, c->cluster + i * PORTAL_CLUSTER_FLOATS);
     cache->sky_through = g->env && power > 0.0 ? (float)(through / power) : 0.0f;
     cache->pane_share = 0.0f;
     /* the glints' share of the light the guide must find (light sampling finds
@@ -450,6 +520,54 @@ static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, cons
                          : 0.0f;
   }
   return IRIS_OK;
+}
+
+/* ---- portals ---------------------------------------------------------------- */
+
+#define PORTAL_STREAM 0x706f7274616cULL /* "portal": the probes' hash stream */
+
+typedef struct portal_ctx {
+  iris_guiding *g;
+  const iris_accel *accel;
+  const float *cluster;
+  uint64_t seed;
+} portal_ctx;
+
+/* The light leaving a surface point, by the caches Algorithm 1 picks there:
+ * their radiance estimate (the indirect part where light sampling takes the
+ * direct, which the comparison of two sides of an opening tolerates); 0 where
+ * none serves. */
+static float brightness(void *ctx, iris_vec3 p, iris_vec3 n) {
+  const iris_guiding *g = ctx;
+  uint32_t ids[IRIS_GUIDING_PICK_K];
+  int m = iris_guiding_pick(g, p, n, ids);
+  float r = 0.0f;
+  for (int i = 0; i < m; ++i) r += g->caches[ids[i]].radiance;
+  return m > 0 ? r / (float)m : 0.0f;
+}
+
+static void find_portals(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  const portal_ctx *c = ctx;
+  for (uint64_t i = begin; i < end; ++i) {
+    if (iris_cancel_requested()) return;
+    iris_cache *cache = &c->g->caches[i];
+    const float *k = c->cluster + i * PORTAL_CLUSTER_FLOATS;
+    if (!(k[4] >= PORTAL_MIN_WEIGHT)) continue;
+    if (iris_portal_find(c->accel, cache->p, cache->frame.n, iris_v3(k[0], k[1], k[2]), k[3],
+                         iris_hash4(c->seed, PORTAL_STREAM, i, 0), brightness, c->g, &cache->portal))
+      cache->portal_weight = k[4];
+  }
+}
+
+/* Each cache whose indirect light mostly came from one cone looks into it
+ * for an opening (portal.h); deterministic: probes hashed from (seed, cache). */
+static void build_portals(iris_guiding *g, const iris_guide_setup *s, const float *cluster) {
+  portal_ctx c = {g, s->accel, cluster, s->seed};
+  int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
+  iris_parallel_for(g->cache_count, 16, threads, find_portals, &c);
+  g->stats.portal_caches = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) g->stats.portal_caches += g->caches[i].portal_weight > 0.0f;
 }
 
 /* ---- budget ---------------------------------------------------------------- */
@@ -821,17 +939,20 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
                                  err);
   /* Fill in parallel with per-thread scratch. */
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
-  fill_ctx fc = {g, s->lights, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL, NULL};
+  fill_ctx fc = {g, s->lights, &photons, &ptree, cones, (uint32_t)p->cache_k, NULL, NULL, NULL, NULL, NULL, NULL};
   if (st == IRIS_OK) {
     fc.hist = calloc((size_t)threads, sizeof(float *));
     fc.ids = calloc((size_t)threads, sizeof(uint32_t *));
     fc.d2 = calloc((size_t)threads, sizeof(float *));
     fc.fine = calloc((size_t)threads, sizeof(float *));
-    bool ok = fc.hist && fc.ids && fc.d2 && fc.fine;
+    fc.cph = calloc((size_t)threads, sizeof(cluster_photon *));
+    if (p->portals && s->accel) fc.cluster = calloc(total * PORTAL_CLUSTER_FLOATS, sizeof(float));
+    bool ok = fc.hist && fc.ids && fc.d2 && fc.fine && fc.cph && (fc.cluster || !p->portals || !s->accel);
     for (int t = 0; ok && t < threads; ++t) {
       fc.hist[t] = malloc(sizeof(float) * g->sphere.texel_count);
       fc.ids[t] = malloc(sizeof(uint32_t) * 2 * (size_t)p->cache_k);
       fc.d2[t] = malloc(sizeof(float) * (size_t)p->cache_k);
+      if (fc.cluster) fc.cph[t] = malloc(sizeof(cluster_photon) * (size_t)p->cache_k);
       if (g->refine_sub)
         fc.fine[t] = malloc((sizeof(float) * (IRIS_REFINE_SUB + 1) + sizeof(double)) * g->sphere.texel_count);
       ok = fc.hist[t] && fc.ids[t] && fc.d2[t] && (!g->refine_sub || fc.fine[t]);
@@ -848,11 +969,13 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
       if (fc.ids) free(fc.ids[t]);
       if (fc.d2) free(fc.d2[t]);
       if (fc.fine) free(fc.fine[t]);
+      if (fc.cph) free(fc.cph[t]);
     }
     free(fc.hist);
     free(fc.ids);
     free(fc.d2);
     free(fc.fine);
+    free(fc.cph);
   }
   if (st == IRIS_OK) {
     /* Keep the caches that received photons; their tables stay where they are. */
@@ -860,8 +983,16 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
     for (size_t i = 0; i < total; ++i) {
       g->caches[i].alpha = -1.0f; /* until training learns it */
       g->caches[i].light = 1.0f;  /* ... and where light sampling brings nothing */
-      if (g->caches[i].photons) g->caches[kept++] = g->caches[i];
-      else g->stats.empty_caches++;
+      memset(&g->caches[i].portal, 0, sizeof g->caches[i].portal);
+      g->caches[i].portal_weight = 0.0f;
+      if (g->caches[i].photons) {
+        if (fc.cluster) /* the clusters move with their caches */
+          memmove(fc.cluster + kept * PORTAL_CLUSTER_FLOATS, fc.cluster + i * PORTAL_CLUSTER_FLOATS,
+                  sizeof(float) * PORTAL_CLUSTER_FLOATS);
+        g->caches[kept++] = g->caches[i];
+      } else {
+        g->stats.empty_caches++;
+      }
     }
     g->cache_count = kept;
     for (size_t i = 0; i < kept; ++i) g->stats.camera_caches += g->caches[i].from_camera;
@@ -877,6 +1008,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
         st = iris_pick_grid_build(&g->grid, &g->tree, IRIS_GUIDING_PICK_K, g->pick_radius2, spacing,
                                   s->threads, err);
       if (st == IRIS_OK) st = build_glints(g, s, &photons, spacing, err);
+      if (st == IRIS_OK && fc.cluster) build_portals(g, s, fc.cluster);
       g->stats.memory_bytes = sizeof(iris_cache) * kept + (sizeof(float) + sizeof(iris_cache_alias)) * floats +
                               (sizeof(float) * 3 + sizeof(uint32_t) + 1) * kept +
                               sizeof(double) * (g->hemi.texel_count + g->sphere.texel_count) +
@@ -895,6 +1027,7 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   /* Inspection outputs need the photons (counts in the dumps): before freeing them. */
   if (st == IRIS_OK && !g->stats.skipped && p->inspect && (p->dump_dir || p->marks))
     st = p->inspect(g, s, p, &photons, &ptree, err);
+  free(fc.cluster);
   iris_kdtree_destroy(&ptree);
   iris_photons_destroy(&photons); /* thesis 4.2.4: photons are not needed any more */
   return st;

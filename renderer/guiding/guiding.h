@@ -21,6 +21,7 @@
 #include "renderer/guiding/refine.h"
 #include "renderer/guiding/photons.h"
 #include "renderer/guiding/pickgrid.h"
+#include "renderer/guiding/portal.h"
 #include "renderer/integrator.h"
 #include "renderer/render.h"
 #include "renderer/guiding/skyvis.h"
@@ -89,6 +90,9 @@ typedef struct iris_guiding_params {
                            metal) mark where their reflections of the lights land, and the guide
                            draws directions in the cone of the spot a vertex's nearest ones left
                            (default on; --no-glints; glints.h, docs/guiding.md "Glints") */
+  bool portals;         /* portals: where a cache's indirect light came through an opening in a
+                           wall (a door), the guide also draws points on a rectangle spanning it
+                           (default on; --no-portals; portal.h, docs/guiding.md "Portals") */
   bool light_samples;   /* --light-sampler learned: training's light samples teach the caches' light
                            tables too (default on; --no-light-samples: the photons alone;
                            light_select.h, docs/guiding.md "Learned light selection") */
@@ -150,6 +154,9 @@ typedef struct iris_cache {
                         energy that a smooth surface reflected last (photons.h, glint), within
                         [IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX]; else 0 ("Glints"); with
                         the shares above <= 1 */
+  iris_portal portal;  /* the opening its indirect light came through (portal.h); none: u = v = 0 */
+  float portal_weight; /* the share of its indirect photon energy in the cone the portal was
+                          looked for in (a vertex takes its tied caches' heaviest portal) */
   uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
@@ -159,6 +166,7 @@ typedef struct iris_guiding_stats {
   uint64_t photon_paths, photons_stored, photons_indirect;
   uint64_t caches, camera_caches, empty_caches;
   uint64_t refined_texels, refined_caches; /* texels split into sub-cells, caches with any (refine.h) */
+  uint64_t portal_caches;                  /* caches with a portal (portal.h) */
   int cache_res, cache_k, camera_stride;
   float pdf_floor;
   double photon_seconds, cache_seconds, total_seconds;

@@ -58,6 +58,10 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
   append_shares(sky, sizeof sky, g, "sky through a pane", share_pane); /* "Sky through a pane" */
   append_shares(sky, sizeof sky, g, "lamps behind glass", share_lamps); /* "Lamps behind glass" */
   append_shares(sky, sizeof sky, g, "glints", share_glints);             /* "Glints" */
+  if (s->portal_caches) { /* "Portals" */
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; portals: %llu caches", (unsigned long long)s->portal_caches);
+  }
   /* caches where light sampling became optional ("Light sampling where no light arrives") */
   size_t dark = 0;
   for (size_t i = 0; i < g->cache_count; ++i) dark += g->caches[i].light < 1.0f;

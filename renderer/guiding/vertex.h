@@ -28,6 +28,8 @@ typedef struct iris_guide_vertex_state {
                                            map's directions pass ("Sky through a pane"); 0xff: none */
   float glint;                          /* ... and the glint spot's cone's ("Glints"); 0: no spot */
   iris_guide_lamp spot;                 /* the glint spot seen from p (glints.h) */
+  float portal;                         /* probability of a portal sample, before the rest (portal.h) */
+  uint8_t portal_of;                    /* the tied cache (index into ids) whose portal; 0xff: none */
 } iris_guide_vertex_state;
 _Static_assert(sizeof(iris_guide_vertex_state) <= IRIS_GUIDE_VERTEX_BYTES, "guide vertex state too large");
 

@@ -27,7 +27,7 @@
 
 #define SCENE_HASH 0x1234567890abcdefULL
 #define SETTINGS_HASH 0xfedcba0987654321ULL
-#define CB (98 + 5 * IRIS_CACHE_LAMPS) /* bytes of one cache record */
+#define CB (138 + 5 * IRIS_CACHE_LAMPS) /* bytes of one cache record */
 
 static iris_guiding *build(const char *name, iris_method method, int64_t photons, bool force) {
   iris_scene *s = NULL;
@@ -274,6 +274,9 @@ static void refusals(const char *dir, iris_guiding *g) {
       {caches_at + CB * 6 + 94, 4, 0x3fc00000u, "invalid pane"},        /* a pane share 1.5 */
       {caches_at + CB * 7 + 114, 4, 0x3e800000u, "invalid glint share"}, /* a glint share 0.25 with no glint photons */
       {caches_at + CB * 7 + 114, 4, 0x7fc00000u, "invalid glint share"}, /* a NaN glint share */
+      {caches_at + CB * 8 + 154, 4, 0x3fc00000u, "invalid portal"},    /* a portal weight 1.5 */
+      {caches_at + CB * 8 + 118, 4, 0x7fc00000u, "invalid portal"},    /* a NaN portal centre */
+      {caches_at + CB * 9 + 130, 4, 0x7f800000u, "invalid portal"},    /* an inf half-axis */
       {pdf_at + 4 * 17, 4, 0x7fc00000u, "not finite"},                 /* NaN pdf */
       {pdf_at + 4 * 18, 4, 0xbf800000u, "negative"},                   /* pdf -1 */
       {pdf_at + 4 * 19, 4, 0x7f800000u, "not finite"},                 /* inf pdf */

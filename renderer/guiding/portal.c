@@ -1,0 +1,228 @@
+/* Portals: see portal.h and docs/guiding.md, "Portals". */
+#include "renderer/guiding/portal.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "core/rng.h"
+#include "renderer/accel.h"
+
+/* Slack of the inside test in the density: a direction drawn at the
+ * rectangle's edge must not get density 0 from rounding; the rim this adds
+ * (1e-4 of each half-axis) is never drawn. */
+#define PORTAL_RIM 1e-4f
+
+float iris_portal_pdf(const iris_portal *p, iris_vec3 x, iris_vec3 wi) {
+  const iris_vec3 nrm = iris_cross(p->u, p->v);
+  const float nl = iris_length(nrm), uu = iris_dot(p->u, p->u), vv = iris_dot(p->v, p->v);
+  if (!(nl > 0.0f)) return 0.0f;
+  const iris_vec3 nn = iris_scale(nrm, 1.0f / nl);
+  const float dn = iris_dot(wi, nn);
+  if (!(fabsf(dn) > 1e-7f)) return 0.0f;
+  const float t = iris_dot(iris_sub(p->o, x), nn) / dn;
+  if (!(t > 0.0f)) return 0.0f;
+  const iris_vec3 d = iris_sub(iris_madd(x, wi, t), p->o);
+  const float a = iris_dot(d, p->u) / uu, b = iris_dot(d, p->v) / vv;
+  if (!(fabsf(a) <= 1.0f + PORTAL_RIM && fabsf(b) <= 1.0f + PORTAL_RIM)) return 0.0f;
+  const float area = 4.0f * sqrtf(uu) * sqrtf(vv);
+  return t * t / (area * fabsf(dn));
+}
+
+iris_vec3 iris_portal_sample(const iris_portal *p, iris_vec3 x, float u1, float u2) {
+  iris_vec3 q = iris_add(p->o, iris_add(iris_scale(p->u, 2.0f * u1 - 1.0f), iris_scale(p->v, 2.0f * u2 - 1.0f)));
+  return iris_normalize(iris_sub(q, x));
+}
+
+bool iris_portal_faces(const iris_portal *p, iris_vec3 side, iris_vec3 x, iris_vec3 n) {
+  const iris_vec3 nrm = iris_cross(p->u, p->v);
+  const float sx = iris_dot(iris_sub(x, p->o), nrm), ss = iris_dot(iris_sub(side, p->o), nrm);
+  if (!(sx * ss > 0.0f)) return false;
+  return iris_dot(iris_sub(p->o, x), n) > 0.0f;
+}
+
+typedef struct probe {
+  iris_vec3 d, h, ng; /* direction, hit point and its normal turned towards the probe */
+  float t;            /* hit distance; INFINITY: escaped */
+} probe;
+
+/* a unit vector perpendicular to n, from the world axis least aligned with it */
+static iris_vec3 perpendicular(iris_vec3 n) {
+  float ax = fabsf(n.x), ay = fabsf(n.y), az = fabsf(n.z);
+  iris_vec3 w = ax <= ay && ax <= az ? iris_v3(1, 0, 0) : ay <= az ? iris_v3(0, 1, 0) : iris_v3(0, 0, 1);
+  return iris_normalize(iris_cross(n, w));
+}
+
+bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, iris_vec3 axis, float cos_max,
+                      uint64_t seed, iris_portal_brightness bright, void *bright_ctx, iris_portal *out) {
+  memset(out, 0, sizeof *out);
+  if (!(cos_max > -1.0f && cos_max < 1.0f)) return false;
+  const float omc_max = 1.0f - cos_max;
+  const iris_frame f = iris_frame_from_normal(axis);
+  probe pr[IRIS_PORTAL_PROBES];
+  int count = 0;
+  uint64_t h = seed;
+  for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
+    h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
+    const float j1 = iris_u64_to_unit(h), j2 = iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL));
+    const float u1 = ((float)(i % 8) + j1) / 8.0f, u2 = ((float)(i / 8) + j2) / 8.0f;
+    const float omc = u1 * omc_max, cosv = 1.0f - omc, sinv = sqrtf(fmaxf(0.0f, omc * (2.0f - omc)));
+    const float phi = 2.0f * (float)IRIS_PI * u2;
+    const iris_vec3 d = iris_normalize(iris_frame_to_world(&f, iris_v3(sinv * cosf(phi), sinv * sinf(phi), cosv)));
+    if (!(iris_dot(d, n) > 0.05f)) continue;
+    iris_ray ray;
+    ray.o = iris_offset_origin(c, n, d);
+    ray.d = d;
+    ray.tmin = 0.0f;
+    ray.tmax = INFINITY;
+    iris_hit hit;
+    probe *q = &pr[count++];
+    q->d = d;
+    q->t = INFINITY;
+    if (iris_accel_intersect(accel, &ray, &hit)) {
+      iris_interaction si;
+      iris_accel_interaction(accel, d, &hit, &si);
+      q->t = hit.t;
+      q->h = si.p;
+      q->ng = iris_dot(si.ng, d) > 0.0f ? iris_neg(si.ng) : si.ng;
+    }
+  }
+  /* The wall: of the planes at least 4 hits lie on, the one the most probes
+   * pass (cross in front of it, land beyond it); the first found of equals. */
+  int best_count = 0, best_pass = 0, best_j = -1;
+  iris_vec3 po = iris_v3(0, 0, 0), pn = iris_v3(0, 0, 0);
+  bool taken[IRIS_PORTAL_PROBES] = {false};
+  for (int j = 0; j < count; ++j) {
+    if (!isfinite(pr[j].t) || taken[j]) continue;
+    int on = 0;
+    iris_vec3 o = iris_v3(0, 0, 0), nsum = iris_v3(0, 0, 0);
+    for (int k = 0; k < count; ++k)
+      if (isfinite(pr[k].t) && iris_dot(pr[k].ng, pr[j].ng) > 0.95f &&
+          fabsf(iris_dot(iris_sub(pr[k].h, pr[j].h), pr[j].ng)) < 0.01f * pr[j].t + 1e-3f)
+        taken[k] = true, on++, o = iris_add(o, pr[k].h), nsum = iris_add(nsum, pr[k].ng);
+    if (on < 4) continue;
+    o = iris_scale(o, 1.0f / (float)on);
+    nsum = iris_normalize(nsum);
+    int passing_here = 0;
+    for (int k = 0; k < count; ++k) {
+      const float dn = iris_dot(pr[k].d, nsum);
+      const float tc = dn < -1e-6f ? iris_dot(iris_sub(o, c), nsum) / dn : -1.0f;
+      passing_here += tc > 0.0f && (!isfinite(pr[k].t) || pr[k].t > 1.02f * tc + 1e-3f);
+    }
+    if (passing_here > best_pass) best_pass = passing_here, best_count = on, po = o, pn = nsum, best_j = j;
+  }
+  if (best_count < 4 || best_pass < 4) return false;
+  bool on_wall[IRIS_PORTAL_PROBES]; /* the hits on the chosen wall */
+  for (int k = 0; k < count; ++k)
+    on_wall[k] = isfinite(pr[k].t) && iris_dot(pr[k].ng, pr[best_j].ng) > 0.95f &&
+                 fabsf(iris_dot(iris_sub(pr[k].h, pr[best_j].h), pr[best_j].ng)) < 0.01f * pr[best_j].t + 1e-3f;
+  /* Where the probes cross that plane, and which pass it to land beyond. */
+  const iris_vec3 e1 = perpendicular(pn), e2 = iris_cross(pn, e1);
+  float a[IRIS_PORTAL_PROBES], b[IRIS_PORTAL_PROBES];
+  bool pass[IRIS_PORTAL_PROBES], crosses[IRIS_PORTAL_PROBES];
+  float a0 = INFINITY, a1 = -INFINITY, b0 = INFINITY, b1 = -INFINITY, dist = 0.0f;
+  int passing = 0;
+  for (int k = 0; k < count; ++k) {
+    const float dn = iris_dot(pr[k].d, pn);
+    const float tc = dn < -1e-6f ? iris_dot(iris_sub(po, c), pn) / dn : -1.0f;
+    crosses[k] = tc > 0.0f;
+    pass[k] = false;
+    if (!crosses[k]) continue;
+    const iris_vec3 q = iris_sub(iris_madd(c, pr[k].d, tc), po);
+    a[k] = iris_dot(q, e1);
+    b[k] = iris_dot(q, e2);
+    pass[k] = !isfinite(pr[k].t) || pr[k].t > 1.02f * tc + 1e-3f;
+    if (!pass[k]) continue;
+    passing++;
+    dist += tc;
+    a0 = fminf(a0, a[k]), a1 = fmaxf(a1, a[k]), b0 = fminf(b0, b[k]), b1 = fmaxf(b1, b[k]);
+  }
+  if (passing < 4) return false;
+  /* widened by half the probes' spacing where they cross */
+  const float margin = 0.5f * sqrtf(2.0f * (float)IRIS_PI * omc_max / (float)IRIS_PORTAL_PROBES) * dist / (float)passing;
+  a0 -= margin, a1 += margin, b0 -= margin, b1 += margin;
+  int inside = 0, inside_pass = 0;
+  for (int k = 0; k < count; ++k)
+    if (crosses[k] && a[k] >= a0 && a[k] <= a1 && b[k] >= b0 && b[k] <= b1) inside++, inside_pass += pass[k];
+  if (2 * inside_pass < inside) return false;
+  /* An opening in the wall: the wall's hits lie on at least two of its four
+   * sides (the probes may see only a corner of the wall around a door), and
+   * the cone's axis passes through it or near it, within half its size (not a
+   * gap beside an object the light only grazes). */
+  {
+    bool side[4] = {false, false, false, false};
+    float w0 = INFINITY, w1 = -INFINITY, v0 = INFINITY, v1 = -INFINITY; /* the wall's hits' extent */
+    for (int k = 0; k < count; ++k) {
+      if (!crosses[k] || pass[k] || !on_wall[k]) continue;
+      w0 = fminf(w0, a[k]), w1 = fmaxf(w1, a[k]), v0 = fminf(v0, b[k]), v1 = fmaxf(v1, b[k]);
+      const bool in_a = a[k] >= a0 && a[k] <= a1, in_b = b[k] >= b0 && b[k] <= b1;
+      if (in_b && a[k] < a0) side[0] = true;
+      if (in_b && a[k] > a1) side[1] = true;
+      if (in_a && b[k] < b0) side[2] = true;
+      if (in_a && b[k] > b1) side[3] = true;
+    }
+    if (side[0] + side[1] + side[2] + side[3] < 2) return false;
+    /* a hole in a wall is smaller than the wall the probes saw around it */
+    if (!((a1 - a0) * (b1 - b0) <= (w1 - w0) * (v1 - v0))) return false;
+    const float dn = iris_dot(axis, pn);
+    if (!(dn < -1e-6f)) return false;
+    const iris_vec3 q = iris_sub(iris_madd(c, axis, iris_dot(iris_sub(po, c), pn) / dn), po);
+    const float qa = iris_dot(q, e1), qb = iris_dot(q, e2);
+    const float ha = 0.5f * (a1 - a0), hb = 0.5f * (b1 - b0);
+    if (!(qa >= a0 - ha && qa <= a1 + ha && qb >= b0 - hb && qb <= b1 + hb)) return false;
+  }
+  /* Again with as many probes through points stratified over that rectangle:
+   * its edges to a cell of an 8 x 8 grid over it, then half a cell wider. */
+  {
+    const float da = (a1 - a0) / 8.0f, db = (b1 - b0) / 8.0f;
+    float c0 = INFINITY, c1 = -INFINITY, d0 = INFINITY, d1 = -INFINITY;
+    int through = 0, lit_n = 0, wall_n = 0;
+    double lit = 0.0, wall = 0.0;
+    for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
+      h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
+      const float qa = a0 + da * ((float)(i % 8) + iris_u64_to_unit(h));
+      const float qb = b0 + db * ((float)(i / 8) + iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL)));
+      const iris_vec3 target = iris_add(po, iris_add(iris_scale(e1, qa), iris_scale(e2, qb)));
+      const iris_vec3 d = iris_normalize(iris_sub(target, c));
+      if (!(iris_dot(d, n) > 0.0f)) continue;
+      const float dn = iris_dot(d, pn);
+      if (!(dn < -1e-6f)) continue;
+      const float tc = iris_dot(iris_sub(po, c), pn) / dn;
+      if (!(tc > 0.0f)) continue;
+      iris_ray ray;
+      ray.o = iris_offset_origin(c, n, d);
+      ray.d = d;
+      ray.tmin = 0.0f;
+      ray.tmax = INFINITY;
+      iris_hit hit;
+      const bool hits = iris_accel_intersect(accel, &ray, &hit);
+      if (hits && bright) {
+        iris_interaction si;
+        iris_accel_interaction(accel, d, &hit, &si);
+        const float b = bright(bright_ctx, si.p, iris_dot(si.ng, d) > 0.0f ? iris_neg(si.ng) : si.ng);
+        if (hit.t > 1.02f * tc + 1e-3f) lit += b, lit_n++;
+        else wall += b, wall_n++;
+      }
+      if (hits && !(hit.t > 1.02f * tc + 1e-3f)) continue;
+      through++;
+      c0 = fminf(c0, qa), c1 = fmaxf(c1, qa), d0 = fminf(d0, qb), d1 = fmaxf(d1, qb);
+    }
+    if (through < 4) return false;
+    /* the light came through it: what lies beyond outshines the wall */
+    if (bright && (lit_n < 4 || !(lit / lit_n >= IRIS_PORTAL_CONTRAST * (wall_n ? wall / wall_n : 0.0)) ||
+                   !(lit > 0.0)))
+      return false;
+    a0 = fmaxf(a0, c0 - 0.5f * da), a1 = fminf(a1, c1 + 0.5f * da);
+    b0 = fmaxf(b0, d0 - 0.5f * db), b1 = fminf(b1, d1 + 0.5f * db);
+  }
+  iris_portal p;
+  p.o = iris_add(po, iris_add(iris_scale(e1, 0.5f * (a0 + a1)), iris_scale(e2, 0.5f * (b0 + b1))));
+  p.u = iris_scale(e1, 0.5f * (a1 - a0));
+  p.v = iris_scale(e2, 0.5f * (b1 - b0));
+  /* narrower than the cone, or the cone's own map does as well */
+  const iris_vec3 to = iris_sub(p.o, c);
+  const float d2 = iris_dot(to, to);
+  const float omega = 4.0f * (0.5f * (a1 - a0)) * (0.5f * (b1 - b0)) * fabsf(iris_dot(to, pn)) / (d2 * sqrtf(d2));
+  if (!(d2 > 0.0f) || !(omega <= 0.7f * 2.0f * (float)IRIS_PI * omc_max)) return false;
+  *out = p;
+  return true;
+}

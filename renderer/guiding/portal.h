@@ -1,0 +1,71 @@
+/* Portals (docs/guiding.md, "Portals"): indirect light that reaches a cache
+ * through an opening in a wall, a door into a lit room. A cache's directional
+ * map smears the opening over texels that mostly hold the wall around it, so
+ * the guide also draws, with a small fixed probability, points uniformly on a
+ * rectangle spanning the opening, found once per cache by probe rays into the
+ * cone its indirect photons came from. Exact density for any vertex: the
+ * rectangle is a fixed piece of a plane in space, seen from wherever the
+ * vertex is. */
+#ifndef IRIS_RENDERER_GUIDING_PORTAL_H
+#define IRIS_RENDERER_GUIDING_PORTAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct iris_accel;
+
+/* Probability of a portal sample at a diffuse vertex one of whose tied caches
+ * has a portal (measured on the door, docs/guiding.md: 0.1-0.2 best). */
+#define IRIS_PORTAL_SHARE 0.15f
+
+/* A rectangle: centre o, orthogonal half-axes u and v (its normal
+ * u x v); u = v = 0: none. */
+typedef struct iris_portal {
+  iris_vec3 o, u, v;
+} iris_portal;
+
+static inline bool iris_portal_present(const iris_portal *p) {
+  return iris_dot(p->u, p->u) > 0.0f && iris_dot(p->v, p->v) > 0.0f;
+}
+
+/* Solid-angle density at x of iris_portal_sample's directions: distance^2 /
+ * (area |cos|) where the ray (x, wi) crosses the rectangle, else 0. */
+float iris_portal_pdf(const iris_portal *p, iris_vec3 x, iris_vec3 wi);
+
+/* The direction from x to a point uniform on the rectangle (u1, u2 in [0, 1)). */
+iris_vec3 iris_portal_sample(const iris_portal *p, iris_vec3 x, float u1, float u2);
+
+/* Whether x sees the rectangle's front at all (off its plane, on the side
+ * the cache that found it lies on) and, for a one-sided vertex with normal n,
+ * whether its centre is above the surface. */
+bool iris_portal_faces(const iris_portal *p, iris_vec3 side, iris_vec3 x, iris_vec3 n);
+
+/* Looks for an opening from a cache at c (normal n) into the cone (axis,
+ * cos_max) its indirect light came from: IRIS_PORTAL_PROBES probe rays
+ * (stratified, jittered by seed) find the wall most of the blocked ones hit
+ * and the probes that pass its plane to land beyond it; the rectangle (in the
+ * wall's plane) bounding where they pass, widened by half the probes'
+ * spacing. None (false) when fewer than 4 probes are blocked by that wall or
+ * pass it, when fewer than half of the probes inside the rectangle pass, or
+ * when the rectangle is not at most 0.7 of the cone's solid angle seen from c. */
+#define IRIS_PORTAL_PROBES 64
+/* The light leaving a surface point (p, n facing the probe): the guide's
+ * estimate, to tell an opening the light came through from one it leaves by. */
+typedef float (*iris_portal_brightness)(void *ctx, iris_vec3 p, iris_vec3 n);
+/* ... and the opening must be one the light came through: where the second
+ * pass's probes land beyond it, `bright` must average at least
+ * IRIS_PORTAL_CONTRAST times what it gives on the wall around it. */
+#define IRIS_PORTAL_CONTRAST 2.0f
+bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, iris_vec3 axis, float cos_max,
+                      uint64_t seed, iris_portal_brightness bright, void *bright_ctx, iris_portal *out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,210 @@
+/* Portals (renderer/guiding/portal.h, docs/guiding.md "Portals"):
+ *  - a rectangle's sampler against its density: chi-square over the sphere,
+ *    the density integrates to 1, every drawn direction has density > 0;
+ *  - on the door scene the caches whose indirect light came through the door
+ *    find it: every portal lies in the door's plane within the door (plus the
+ *    probes' margin), seen from room A, and enough of room A's caches have
+ *    one; none with portals off; the same for 1 and 2 threads;
+ *  - the whole guided sampler at a room-A floor point with a portal passes
+ *    chi-square over the sphere against its own pdf (which integrates to 1):
+ *    the sampler and the MIS density agree with the portal in the mixture;
+ *  - the portals survive the guide file bit for bit. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "check.h"
+#include "chi2.h"
+#include "guide_fixture.h"
+#include "renderer/guiding/guide_file.h"
+#include "renderer/guiding/portal.h"
+#include "renderer/guiding/vertex.h"
+#include "scenes/builtin.h"
+
+#define N_TESTS 2
+
+typedef struct rect_ctx {
+  iris_portal p;
+  iris_vec3 x;
+} rect_ctx;
+
+static bool rect_sample(void *vc, const double u[3], double dir[3]) {
+  const rect_ctx *c = vc;
+  iris_vec3 d = iris_portal_sample(&c->p, c->x, (float)u[0], (float)u[1]);
+  dir[0] = d.x, dir[1] = d.y, dir[2] = d.z;
+  return true;
+}
+static double rect_pdf(void *vc, const double dir[3]) {
+  const rect_ctx *c = vc;
+  return iris_portal_pdf(&c->p, c->x, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+static void test_rectangle(void) {
+  /* a door-like rectangle seen obliquely from 2.3 m */
+  rect_ctx c = {{{0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 0.3f}, {0.0f, 1.0f, 0.0f}}, {-2.0f, 0.4f, 1.1f}};
+  chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
+  chi2_result r = chi2_run(&dom, rect_sample, rect_pdf, &c, 400000, 0.01, N_TESTS);
+  iris_check_record(r.passed, __FILE__, __LINE__, "portal rectangle: %s", r.message);
+  CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
+  printf("rectangle: p = %.3g, pdf integral %.5f\n", r.p_value, r.pdf_integral);
+  /* every drawn direction (corners included) has density, and the faces test */
+  int zero = 0;
+  for (int i = 0; i <= 64; ++i)
+    for (int j = 0; j <= 64; ++j) {
+      float u1 = fminf((float)i / 64.0f, 0x1.fffffep-1f), u2 = fminf((float)j / 64.0f, 0x1.fffffep-1f);
+      zero += !(iris_portal_pdf(&c.p, c.x, iris_portal_sample(&c.p, c.x, u1, u2)) > 0.0f);
+    }
+  iris_check_record(zero == 0, __FILE__, __LINE__, "%d drawn directions with density 0", zero);
+  CHECK(iris_portal_faces(&c.p, iris_v3(-1, 1, 0), c.x, iris_v3(1, 0, 0)));
+  CHECK(!iris_portal_faces(&c.p, iris_v3(1, 1, 0), c.x, iris_v3(1, 0, 0)));  /* the other side's */
+  CHECK(!iris_portal_faces(&c.p, iris_v3(-1, 1, 0), c.x, iris_v3(-1, 0, 0))); /* behind the surface */
+}
+
+static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool portals, int threads) {
+  iris_guiding_params gp = iris_guiding_params_default();
+  gp.portals = portals;
+  return test_guide_build_in(sc, t, gp, 7, threads, 16);
+}
+
+/* Every portal in the door's plane (x = 0) within the door (z in [-0.3,
+ * 0.3], y in [0, 2]) widened by 0.15 m, found from room A; returns how many
+ * room-A caches have one. */
+static int check_portals(const iris_guiding *g) {
+  int bad = 0, room_a = 0, found = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    const iris_cache *c = &g->caches[i];
+    if (!(c->portal_weight > 0.0f)) continue;
+    found++;
+    const iris_portal *p = &c->portal;
+    const float zext = fabsf(p->u.z) + fabsf(p->v.z), yext = fabsf(p->u.y) + fabsf(p->v.y);
+    const bool ok = fabsf(p->o.x) < 0.05f && fabsf(p->u.x) < 1e-3f && fabsf(p->v.x) < 1e-3f &&
+                    p->o.z - zext >= -0.45f && p->o.z + zext <= 0.45f && p->o.y - yext >= -0.15f &&
+                    p->o.y + yext <= 2.15f && c->p.x < 0.0f;
+    if (!ok && bad++ < 5)
+      printf("  portal of the cache at (%.2f, %.2f, %.2f): centre (%.2f, %.2f, %.2f), half-axes (%.2f, %.2f, %.2f), "
+             "(%.2f, %.2f, %.2f)\n",
+             (double)c->p.x, (double)c->p.y, (double)c->p.z, (double)p->o.x, (double)p->o.y, (double)p->o.z,
+             (double)p->u.x, (double)p->u.y, (double)p->u.z, (double)p->v.x, (double)p->v.y, (double)p->v.z);
+    room_a += c->p.x < 0.0f;
+  }
+  iris_check_record(bad == 0, __FILE__, __LINE__, "%d of %d portals not the door seen from room A", bad, found);
+  return room_a;
+}
+
+typedef struct sampler_ctx {
+  iris_direction_sampler s;
+  const iris_shading_point *sp;
+  uint64_t calls;
+} sampler_ctx;
+
+static bool full_sample(void *vc, const double u[3], double dir[3]) {
+  (void)u;
+  sampler_ctx *c = vc;
+  iris_sampler rng = iris_sampler_start(0x706f7274ULL, c->calls++, 0);
+  iris_direction_sample ds;
+  memset(&ds, 0, sizeof ds);
+  if (!c->s.sample(c->s.ctx, c->sp, &rng, &ds)) return false;
+  dir[0] = ds.wi.x, dir[1] = ds.wi.y, dir[2] = ds.wi.z;
+  return true;
+}
+static double full_pdf(void *vc, const double dir[3]) {
+  sampler_ctx *c = vc;
+  return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+/* A shading point on room A's floor at (x, 0, z), seen from above. */
+static bool floor_point(const test_guide_scene *t, float x, float z, iris_shading_point *sp) {
+  iris_ray ray = {iris_v3(x, 0.05f, z), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
+  iris_hit hit;
+  if (!iris_accel_intersect(t->acc, &ray, &hit)) return false;
+  iris_interaction si;
+  iris_accel_interaction(t->acc, ray.d, &hit, &si);
+  iris_integrator_shade(&t->it, &si, iris_v3(0.0f, 1.0f, 0.0f), 0, sp);
+  return fabsf(si.p.y) < 1e-3f;
+}
+
+static void test_door(void) {
+  iris_scene *sc = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("door", &sc, &err) == IRIS_OK)) return;
+  test_guide_scene t;
+  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
+    iris_scene_destroy(sc);
+    return;
+  }
+  iris_guiding *g = build(sc, &t, true, 1);
+  if (!CHECK(g != NULL)) {
+    test_guide_scene_close(&t);
+    iris_scene_destroy(sc);
+    return;
+  }
+  size_t room_a_caches = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) room_a_caches += g->caches[i].p.x < -0.05f;
+  const int room_a = check_portals(g);
+  printf("door: %llu caches with a portal, %d of room A's %zu\n", (unsigned long long)g->stats.portal_caches, room_a,
+         room_a_caches);
+  iris_check_record(room_a >= 30 && (double)room_a >= 0.3 * (double)room_a_caches, __FILE__, __LINE__,
+                    "only %d of room A's %zu caches found the door", room_a, room_a_caches);
+  /* the same with 2 threads */
+  {
+    iris_guiding *g2 = build(sc, &t, true, 2);
+    int differ = !g2 || g2->cache_count != g->cache_count;
+    for (size_t i = 0; !differ && i < g->cache_count; ++i)
+      differ += memcmp(&g->caches[i].portal, &g2->caches[i].portal, sizeof g->caches[i].portal) != 0 ||
+                g->caches[i].portal_weight != g2->caches[i].portal_weight;
+    iris_check_record(!differ, __FILE__, __LINE__, "portals differ between 1 and 2 threads");
+    iris_guiding_destroy(g2);
+  }
+  /* none with portals off */
+  {
+    iris_guiding *g3 = build(sc, &t, false, 1);
+    if (CHECK(g3 != NULL)) CHECK_EQ_INT((int)g3->stats.portal_caches, 0);
+    iris_guiding_destroy(g3);
+  }
+  /* the whole sampler at a room-A floor point whose vertex takes a portal */
+  iris_direction_sampler s = iris_guiding_sampler(g);
+  bool tested = false;
+  for (int i = 0; i < 40 && !tested && CHECK(s.sample != NULL); ++i) {
+    iris_shading_point sp;
+    if (!floor_point(&t, -3.6f + 0.08f * (float)i, -1.7f + 0.085f * (float)i, &sp)) continue;
+    s.prepare(s.ctx, &sp);
+    const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
+    if (!(v->portal > 0.0f && v->alpha > 0.0f)) continue;
+    tested = true;
+    sampler_ctx c = {s, &sp, 0};
+    chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
+    chi2_result r = chi2_run(&dom, full_sample, full_pdf, &c, 400000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "guided sampler with a portal: %s", r.message);
+    CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
+    printf("  sampler at (%.2f, 0, %.2f): alpha %.2f, portal %.2f: p = %.3g, pdf integral %.5f\n",
+           (double)sp.si.p.x, (double)sp.si.p.z, (double)v->alpha, (double)v->portal, r.p_value, r.pdf_integral);
+  }
+  iris_check_record(tested, __FILE__, __LINE__, "no room-A floor point with a portal");
+  /* the guide file keeps them bit for bit */
+  char path[256];
+  const char *tmp = getenv("TMPDIR");
+  snprintf(path, sizeof path, "%s/iris_test_portal_%ld.guide", tmp ? tmp : "/tmp", (long)getpid());
+  iris_guiding *l = NULL;
+  if (CHECK(iris_guiding_save(g, path, 1, 2, &err) == IRIS_OK) &&
+      CHECK(iris_guiding_load(path, 1, 2, 1, &l, &err) == IRIS_OK)) {
+    int differ = l->cache_count != g->cache_count;
+    for (size_t i = 0; !differ && i < g->cache_count; ++i)
+      differ += memcmp(&g->caches[i].portal, &l->caches[i].portal, sizeof g->caches[i].portal) != 0 ||
+                g->caches[i].portal_weight != l->caches[i].portal_weight;
+    iris_check_record(!differ, __FILE__, __LINE__, "portals differ after the guide file");
+    CHECK(l->stats.portal_caches == g->stats.portal_caches);
+  }
+  iris_guiding_destroy(l);
+  remove(path);
+  iris_guiding_destroy(g);
+  test_guide_scene_close(&t);
+  iris_scene_destroy(sc);
+}
+
+int main(void) {
+  test_rectangle();
+  test_door();
+  return iris_check_summary("guiding.portal");
+}
