@@ -21,7 +21,7 @@
 #define BYTES_PER_EMISSIVE_TRIANGLE 280.0 /* tables and tree; +100 for the descent's wide nodes (384 B, ~1 per 2 leaves) */
 #define BASE_BYTES 14e6                 /* iris + libraries + Embree's threads */
 #define PATH_BYTES 304.0                /* one photon path: ~4 stored photons (64 B) and their kd-tree */
-#define CACHE_BYTES 1428.0              /* one 8x8 cache with its tables */
+#define CACHE_BYTES 1468.0              /* one 8x8 cache with its tables (and its portal, 40 B) */
 #define GLINT_BYTES 3.8e6               /* glint photons and their tree (guiding/glints.h), with a smooth material */
 #define LIGHT_SELECT_BYTES 129.0        /* one cache's learned light table (guiding/light_select.h) */
 #define FILM_BYTES_PER_PIXEL 62.0       /* sums, counts and the EXR image */
