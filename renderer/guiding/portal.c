@@ -35,8 +35,12 @@ iris_vec3 iris_portal_sample(const iris_portal *p, iris_vec3 x, float u1, float 
 
 bool iris_portal_faces(const iris_portal *p, iris_vec3 side, iris_vec3 x, iris_vec3 n) {
   const iris_vec3 nrm = iris_cross(p->u, p->v);
-  const float sx = iris_dot(iris_sub(x, p->o), nrm), ss = iris_dot(iris_sub(side, p->o), nrm);
-  if (!(sx * ss > 0.0f)) return false;
+  const float nl = iris_length(nrm);
+  if (!(nl > 0.0f)) return false;
+  const float sx = iris_dot(iris_sub(x, p->o), nrm) / nl, ss = iris_dot(iris_sub(side, p->o), nrm) / nl;
+  /* a millimetre off the plane at least: from the plane itself every direction
+   * to the rectangle grazes it */
+  if (!(sx * ss > 0.0f) || !(fabsf(sx) > 1e-3f)) return false;
   return iris_dot(iris_sub(p->o, x), n) > 0.0f;
 }
 

@@ -41,9 +41,9 @@ float iris_portal_pdf(const iris_portal *p, iris_vec3 x, iris_vec3 wi);
 /* The direction from x to a point uniform on the rectangle (u1, u2 in [0, 1)). */
 iris_vec3 iris_portal_sample(const iris_portal *p, iris_vec3 x, float u1, float u2);
 
-/* Whether x sees the rectangle's front at all (off its plane, on the side
- * the cache that found it lies on) and, for a one-sided vertex with normal n,
- * whether its centre is above the surface. */
+/* Whether x sees the rectangle's front at all (at least 1 mm off its plane,
+ * on the side the cache that found it lies on, `side`) and its centre is
+ * above x's surface (normal n). */
 bool iris_portal_faces(const iris_portal *p, iris_vec3 side, iris_vec3 x, iris_vec3 n);
 
 /* Looks for an opening from a cache at c (normal n) into the cone (axis,

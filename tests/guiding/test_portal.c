@@ -60,6 +60,7 @@ static void test_rectangle(void) {
   CHECK(iris_portal_faces(&c.p, iris_v3(-1, 1, 0), c.x, iris_v3(1, 0, 0)));
   CHECK(!iris_portal_faces(&c.p, iris_v3(1, 1, 0), c.x, iris_v3(1, 0, 0)));  /* the other side's */
   CHECK(!iris_portal_faces(&c.p, iris_v3(-1, 1, 0), c.x, iris_v3(-1, 0, 0))); /* behind the surface */
+  CHECK(!iris_portal_faces(&c.p, iris_v3(-1, 1, 0), iris_v3(-0.0005f, 0.5f, 1.0f), iris_v3(0, 1, 0))); /* in its plane */
 }
 
 static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool portals, int threads) {
