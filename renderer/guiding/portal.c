@@ -49,6 +49,16 @@ typedef struct probe {
   float t;            /* hit distance; INFINITY: escaped */
 } probe;
 
+/* The first hit of a probe from the cache at c (normal n) along d. */
+static bool probe_hit(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, iris_vec3 d, iris_hit *hit) {
+  iris_ray ray;
+  ray.o = iris_offset_origin(c, n, d);
+  ray.d = d;
+  ray.tmin = 0.0f;
+  ray.tmax = INFINITY;
+  return iris_accel_intersect(accel, &ray, hit);
+}
+
 /* a unit vector perpendicular to n, from the world axis least aligned with it */
 static iris_vec3 perpendicular(iris_vec3 n) {
   float ax = fabsf(n.x), ay = fabsf(n.y), az = fabsf(n.z);
@@ -73,16 +83,11 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
     const float phi = 2.0f * (float)IRIS_PI * u2;
     const iris_vec3 d = iris_normalize(iris_frame_to_world(&f, iris_v3(sinv * cosf(phi), sinv * sinf(phi), cosv)));
     if (!(iris_dot(d, n) > 0.05f)) continue;
-    iris_ray ray;
-    ray.o = iris_offset_origin(c, n, d);
-    ray.d = d;
-    ray.tmin = 0.0f;
-    ray.tmax = INFINITY;
     iris_hit hit;
     probe *q = &pr[count++];
     q->d = d;
     q->t = INFINITY;
-    if (iris_accel_intersect(accel, &ray, &hit)) {
+    if (probe_hit(accel, c, n, d, &hit)) {
       iris_interaction si;
       iris_accel_interaction(accel, d, &hit, &si);
       q->t = hit.t;
@@ -192,13 +197,8 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
       if (!(dn < -1e-6f)) continue;
       const float tc = iris_dot(iris_sub(po, c), pn) / dn;
       if (!(tc > 0.0f)) continue;
-      iris_ray ray;
-      ray.o = iris_offset_origin(c, n, d);
-      ray.d = d;
-      ray.tmin = 0.0f;
-      ray.tmax = INFINITY;
       iris_hit hit;
-      const bool hits = iris_accel_intersect(accel, &ray, &hit);
+      const bool hits = probe_hit(accel, c, n, d, &hit);
       if (hits && bright) {
         iris_interaction si;
         iris_accel_interaction(accel, d, &hit, &si);

@@ -80,4 +80,30 @@ static inline bool test_envmap_open(const char *path, float rotation, iris_envma
   return false;
 }
 
+/* The whole guided direction sampler at one prepared shading point, for
+ * chi2_run: it draws its own numbers (chi2_run's are not the sampler's
+ * slots), an independent stream per call from `key`; the pdf is the
+ * sampler's MIS density. */
+typedef struct test_sampler_ctx {
+  iris_direction_sampler s;
+  const iris_shading_point *sp;
+  uint64_t key, calls;
+} test_sampler_ctx;
+
+static inline bool test_full_sample(void *vc, const double u[3], double dir[3]) {
+  (void)u;
+  test_sampler_ctx *c = vc;
+  iris_sampler rng = iris_sampler_start(c->key, c->calls++, 0);
+  iris_direction_sample ds;
+  memset(&ds, 0, sizeof ds);
+  if (!c->s.sample(c->s.ctx, c->sp, &rng, &ds)) return false;
+  dir[0] = ds.wi.x, dir[1] = ds.wi.y, dir[2] = ds.wi.z;
+  return true;
+}
+
+static inline double test_full_pdf(void *vc, const double dir[3]) {
+  test_sampler_ctx *c = vc;
+  return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
 #endif

@@ -81,29 +81,6 @@ static bool ground_point(const test_guide_scene *t, iris_vec3 x, iris_shading_po
   return fabsf(si.p.y) < 1e-3f;
 }
 
-typedef struct sampler_ctx {
-  iris_direction_sampler s;
-  const iris_shading_point *sp;
-  uint64_t calls;
-} sampler_ctx;
-
-/* The sampler draws its own numbers (chi2_run's are not the sampler's slots):
- * independent streams, one per call. */
-static bool full_sample(void *vc, const double u[3], double dir[3]) {
-  (void)u;
-  sampler_ctx *c = vc;
-  iris_sampler rng = iris_sampler_start(0x61696e74ULL, c->calls++, 0);
-  iris_direction_sample ds;
-  memset(&ds, 0, sizeof ds);
-  if (!c->s.sample(c->s.ctx, c->sp, &rng, &ds)) return false;
-  dir[0] = ds.wi.x, dir[1] = ds.wi.y, dir[2] = ds.wi.z;
-  return true;
-}
-static double full_pdf(void *vc, const double dir[3]) {
-  sampler_ctx *c = vc;
-  return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
-}
-
 static void check_round_trip(const iris_guiding *g, const iris_vec3 *xs, int nx) {
   char path[256];
   const char *tmp = getenv("TMPDIR");
@@ -220,9 +197,9 @@ static void test_env_spheres(void) {
     const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
     if (!(v->glint > 0.0f && v->alpha > 0.0f)) continue;
     tested = true;
-    sampler_ctx c = {s, &sp, 0};
+    test_sampler_ctx c = {s, &sp, 0x61696e74ULL, 0};
     chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
-    chi2_result r = chi2_run(&dom, full_sample, full_pdf, &c, 400000, 0.01, N_TESTS);
+    chi2_result r = chi2_run(&dom, test_full_sample, test_full_pdf, &c, 400000, 0.01, N_TESTS);
     iris_check_record(r.passed, __FILE__, __LINE__, "guided sampler with a glint: %s", r.message);
     CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
     printf("  sampler at (%.2f, 0, %.2f): alpha %.2f, glint share %.2f, spot radius %.3f m at %.2f m: p = %.3g, pdf "

@@ -94,27 +94,6 @@ static int check_portals(const iris_guiding *g) {
   return room_a;
 }
 
-typedef struct sampler_ctx {
-  iris_direction_sampler s;
-  const iris_shading_point *sp;
-  uint64_t calls;
-} sampler_ctx;
-
-static bool full_sample(void *vc, const double u[3], double dir[3]) {
-  (void)u;
-  sampler_ctx *c = vc;
-  iris_sampler rng = iris_sampler_start(0x706f7274ULL, c->calls++, 0);
-  iris_direction_sample ds;
-  memset(&ds, 0, sizeof ds);
-  if (!c->s.sample(c->s.ctx, c->sp, &rng, &ds)) return false;
-  dir[0] = ds.wi.x, dir[1] = ds.wi.y, dir[2] = ds.wi.z;
-  return true;
-}
-static double full_pdf(void *vc, const double dir[3]) {
-  sampler_ctx *c = vc;
-  return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
-}
-
 /* A shading point on room A's floor at (x, 0, z), seen from above. */
 static bool floor_point(const test_guide_scene *t, float x, float z, iris_shading_point *sp) {
   iris_ray ray = {iris_v3(x, 0.05f, z), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
@@ -174,9 +153,9 @@ static void test_door(void) {
     const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
     if (!(v->portal > 0.0f && v->alpha > 0.0f)) continue;
     tested = true;
-    sampler_ctx c = {s, &sp, 0};
+    test_sampler_ctx c = {s, &sp, 0x706f7274ULL, 0};
     chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
-    chi2_result r = chi2_run(&dom, full_sample, full_pdf, &c, 400000, 0.01, N_TESTS);
+    chi2_result r = chi2_run(&dom, test_full_sample, test_full_pdf, &c, 400000, 0.01, N_TESTS);
     iris_check_record(r.passed, __FILE__, __LINE__, "guided sampler with a portal: %s", r.message);
     CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
     printf("  sampler at (%.2f, 0, %.2f): alpha %.2f, portal %.2f: p = %.3g, pdf integral %.5f\n",
