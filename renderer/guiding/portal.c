@@ -59,6 +59,12 @@ static bool probe_hit(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
   return iris_accel_intersect(accel, &ray, hit);
 }
 
+/* Probe k's hit lies on the plane of probe j's (facing alike, within 1% of j's distance). */
+static bool coplanar(const probe *pr, int j, int k) {
+  return isfinite(pr[k].t) && iris_dot(pr[k].ng, pr[j].ng) > 0.95f &&
+         fabsf(iris_dot(iris_sub(pr[k].h, pr[j].h), pr[j].ng)) < 0.01f * pr[j].t + 1e-3f;
+}
+
 /* a unit vector perpendicular to n, from the world axis least aligned with it */
 static iris_vec3 perpendicular(iris_vec3 n) {
   float ax = fabsf(n.x), ay = fabsf(n.y), az = fabsf(n.z);
@@ -97,7 +103,7 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
   }
   /* The wall: of the planes at least 4 hits lie on, the one the most probes
    * pass (cross in front of it, land beyond it); the first found of equals. */
-  int best_count = 0, best_pass = 0, best_j = -1;
+  int best_pass = 0, best_j = -1;
   iris_vec3 po = iris_v3(0, 0, 0), pn = iris_v3(0, 0, 0);
   bool taken[IRIS_PORTAL_PROBES] = {false};
   for (int j = 0; j < count; ++j) {
@@ -105,8 +111,7 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
     int on = 0;
     iris_vec3 o = iris_v3(0, 0, 0), nsum = iris_v3(0, 0, 0);
     for (int k = 0; k < count; ++k)
-      if (isfinite(pr[k].t) && iris_dot(pr[k].ng, pr[j].ng) > 0.95f &&
-          fabsf(iris_dot(iris_sub(pr[k].h, pr[j].h), pr[j].ng)) < 0.01f * pr[j].t + 1e-3f)
+      if (coplanar(pr, j, k))
         taken[k] = true, on++, o = iris_add(o, pr[k].h), nsum = iris_add(nsum, pr[k].ng);
     if (on < 4) continue;
     o = iris_scale(o, 1.0f / (float)on);
@@ -117,13 +122,12 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
       const float tc = dn < -1e-6f ? iris_dot(iris_sub(o, c), nsum) / dn : -1.0f;
       passing_here += tc > 0.0f && (!isfinite(pr[k].t) || pr[k].t > 1.02f * tc + 1e-3f);
     }
-    if (passing_here > best_pass) best_pass = passing_here, best_count = on, po = o, pn = nsum, best_j = j;
+    if (passing_here > best_pass) best_pass = passing_here, po = o, pn = nsum, best_j = j;
   }
-  if (best_count < 4 || best_pass < 4) return false;
+  if (best_pass < 4) return false; /* (a plane is a candidate only with >= 4 hits) */
   bool on_wall[IRIS_PORTAL_PROBES]; /* the hits on the chosen wall */
   for (int k = 0; k < count; ++k)
-    on_wall[k] = isfinite(pr[k].t) && iris_dot(pr[k].ng, pr[best_j].ng) > 0.95f &&
-                 fabsf(iris_dot(iris_sub(pr[k].h, pr[best_j].h), pr[best_j].ng)) < 0.01f * pr[best_j].t + 1e-3f;
+    on_wall[k] = coplanar(pr, best_j, k);
   /* Where the probes cross that plane, and which pass it to land beyond. */
   const iris_vec3 e1 = perpendicular(pn), e2 = iris_cross(pn, e1);
   float a[IRIS_PORTAL_PROBES], b[IRIS_PORTAL_PROBES];

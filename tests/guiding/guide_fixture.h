@@ -80,6 +80,19 @@ static inline bool test_envmap_open(const char *path, float rotation, iris_envma
   return false;
 }
 
+/* The shading point where a ray straight down from 5 cm above x meets the
+ * scene, seen from above; false when it misses or the hit is not at x's
+ * height (within 1 mm). */
+static inline bool test_shade_below(const test_guide_scene *t, iris_vec3 x, iris_shading_point *sp) {
+  iris_ray ray = {iris_add(x, iris_v3(0.0f, 0.05f, 0.0f)), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
+  iris_hit hit;
+  if (!iris_accel_intersect(t->acc, &ray, &hit)) return false;
+  iris_interaction si;
+  iris_accel_interaction(t->acc, ray.d, &hit, &si);
+  iris_integrator_shade(&t->it, &si, iris_v3(0.0f, 1.0f, 0.0f), 0, sp);
+  return fabsf(si.p.y - x.y) < 1e-3f;
+}
+
 /* The whole guided direction sampler at one prepared shading point, for
  * chi2_run: it draws its own numbers (chi2_run's are not the sampler's
  * slots), an independent stream per call from `key`; the pdf is the

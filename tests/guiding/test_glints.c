@@ -70,17 +70,6 @@ static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool glint
   return test_guide_build_in(sc, t, gp, 7, threads, 16);
 }
 
-/* A shading point on the ground (y = 0) at x, seen from above. */
-static bool ground_point(const test_guide_scene *t, iris_vec3 x, iris_shading_point *sp) {
-  iris_ray ray = {iris_add(x, iris_v3(0.0f, 0.05f, 0.0f)), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
-  iris_hit hit;
-  if (!iris_accel_intersect(t->acc, &ray, &hit)) return false;
-  iris_interaction si;
-  iris_accel_interaction(t->acc, ray.d, &hit, &si);
-  iris_integrator_shade(&t->it, &si, iris_v3(0.0f, 1.0f, 0.0f), 0, sp);
-  return fabsf(si.p.y) < 1e-3f;
-}
-
 static void check_round_trip(const iris_guiding *g, const iris_vec3 *xs, int nx) {
   char path[256];
   const char *tmp = getenv("TMPDIR");
@@ -192,7 +181,7 @@ static void test_env_spheres(void) {
   iris_direction_sampler s = iris_guiding_sampler(g);
   for (int i = 0; i < nx && !tested && CHECK(s.sample != NULL); ++i) {
     iris_shading_point sp;
-    if (!ground_point(&t, xs[i], &sp)) continue;
+    if (!test_shade_below(&t, xs[i], &sp)) continue; /* on the ground, y = 0 */
     s.prepare(s.ctx, &sp);
     const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
     if (!(v->glint > 0.0f && v->alpha > 0.0f)) continue;

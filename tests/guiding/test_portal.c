@@ -94,17 +94,6 @@ static int check_portals(const iris_guiding *g) {
   return room_a;
 }
 
-/* A shading point on room A's floor at (x, 0, z), seen from above. */
-static bool floor_point(const test_guide_scene *t, float x, float z, iris_shading_point *sp) {
-  iris_ray ray = {iris_v3(x, 0.05f, z), 0.0f, iris_v3(0.0f, -1.0f, 0.0f), 1.0f};
-  iris_hit hit;
-  if (!iris_accel_intersect(t->acc, &ray, &hit)) return false;
-  iris_interaction si;
-  iris_accel_interaction(t->acc, ray.d, &hit, &si);
-  iris_integrator_shade(&t->it, &si, iris_v3(0.0f, 1.0f, 0.0f), 0, sp);
-  return fabsf(si.p.y) < 1e-3f;
-}
-
 static void test_door(void) {
   iris_scene *sc = NULL;
   iris_error err;
@@ -148,7 +137,7 @@ static void test_door(void) {
   bool tested = false;
   for (int i = 0; i < 40 && !tested && CHECK(s.sample != NULL); ++i) {
     iris_shading_point sp;
-    if (!floor_point(&t, -3.6f + 0.08f * (float)i, -1.7f + 0.085f * (float)i, &sp)) continue;
+    if (!test_shade_below(&t, iris_v3(-3.6f + 0.08f * (float)i, 0.0f, -1.7f + 0.085f * (float)i), &sp)) continue;
     s.prepare(s.ctx, &sp);
     const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
     if (!(v->portal > 0.0f && v->alpha > 0.0f)) continue;
