@@ -560,12 +560,123 @@ static void find_portals(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   }
 }
 
+/* At most this many joined openings (each cache's rectangle is compared
+ * with each: the work stays linear in the caches). */
+#define PORTAL_JOINED_MAX 64
+#define PORTAL_VIEWERS 4 /* finders that tighten a joined rectangle */
+#define PORTAL_MIN_SHARE 0.05f /* a cache without a portal takes a joined one that brings this much of its light */
+
+typedef struct joined_portal {
+  iris_portal p;
+  iris_vec3 side; /* the first finder's position: the side it is seen from */
+} joined_portal;
+
+typedef struct extend_ctx {
+  iris_guiding *g;
+  const iris_accel *accel;
+  uint64_t seed;
+  const joined_portal *joined;
+  int count;
+} extend_ctx;
+
+typedef struct share_ctx {
+  const iris_guiding *g;
+  uint32_t id;
+} share_ctx;
+
+static float cache_density(void *ctx, iris_vec3 wi) {
+  const share_ctx *c = ctx;
+  return iris_guiding_cache_pdf(c->g, &c->id, 1, wi);
+}
+
+/* A cache that found no portal of its own takes the joined one through
+ * which the most of its incident light came (its map's share through it,
+ * iris_portal_share), if that is at least PORTAL_MIN_SHARE and at least half
+ * the probes reach the opening. The portal's samples are worth more than
+ * that share: the light through an opening is the part whose paths vary
+ * most (the door: 98% of the second moment, docs/guiding.md). */
+static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  const extend_ctx *c = ctx;
+  for (uint64_t i = begin; i < end; ++i) {
+    if (iris_cancel_requested()) return;
+    iris_cache *cache = &c->g->caches[i];
+    if (cache->portal_weight > 0.0f) continue;
+    share_ctx sc = {c->g, (uint32_t)i};
+    float best = 0.0f;
+    int best_j = -1;
+    for (int j = 0; j < c->count; ++j) {
+      const joined_portal *jp = &c->joined[j];
+      if (!iris_portal_present(&jp->p) || !iris_portal_faces(&jp->p, jp->side, cache->p, cache->frame.n)) continue;
+      float reach;
+      const float share = iris_portal_share(c->accel, &jp->p, cache->p, cache->frame.n,
+                                            iris_hash4(c->seed, PORTAL_STREAM, i, 1 + (uint64_t)j), cache_density, &sc,
+                                            &reach);
+      if (reach >= 0.5f && share >= PORTAL_MIN_SHARE && share > best) best = share, best_j = j;
+    }
+    if (best_j >= 0) cache->portal = c->joined[best_j].p, cache->portal_weight = fminf(best, 1.0f);
+  }
+}
+
+/* The finders' rectangles that lie in one plane and overlap, joined
+ * (serially, in cache order: deterministic); every finder takes its whole,
+ * and so does every cache that found none but gets enough of its light
+ * through a whole one (extend_portals). */
+static void join_portals(iris_guiding *g, const iris_guide_setup *s, int threads) {
+  joined_portal joined[PORTAL_JOINED_MAX];
+  int count = 0;
+  uint8_t *group = malloc(g->cache_count ? g->cache_count : 1); /* whole of each cache; 0xff: none */
+  if (!group) return; /* the finders' own rectangles stay */
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    iris_cache *cache = &g->caches[i];
+    group[i] = 0xff;
+    if (!(cache->portal_weight > 0.0f)) continue;
+    int j = 0;
+    while (j < count && !iris_portal_join(&joined[j].p, joined[j].side, &cache->portal, cache->p)) ++j;
+    if (j == count && count < PORTAL_JOINED_MAX) joined[count++] = (joined_portal){cache->portal, cache->p};
+    if (j < count) group[i] = (uint8_t)j;
+  }
+  /* wholes that grew into each other since are one */
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (int j = 0; j < count && !merged; ++j)
+      for (int k = j + 1; k < count && !merged; ++k) {
+        if (!iris_portal_join(&joined[j].p, joined[j].side, &joined[k].p, joined[k].side)) continue;
+        merged = true;
+        joined[k] = joined[--count];
+        for (size_t i = 0; i < g->cache_count; ++i)
+          if (group[i] == k) group[i] = (uint8_t)j;
+          else if (group[i] == count) group[i] = (uint8_t)k;
+      }
+  }
+  /* each whole tightened to what up to PORTAL_VIEWERS of its finders (spread
+   * over the cache order) see through it; one that none sees through is dropped */
+  for (int j = 0; j < count; ++j) {
+    size_t members = 0, seen = 0;
+    for (size_t i = 0; i < g->cache_count; ++i) members += group[i] == j;
+    iris_vec3 at[PORTAL_VIEWERS], nrm[PORTAL_VIEWERS];
+    int viewers = 0;
+    for (size_t i = 0; i < g->cache_count && viewers < PORTAL_VIEWERS; ++i)
+      if (group[i] == j && seen++ * PORTAL_VIEWERS >= (size_t)viewers * members)
+        at[viewers] = g->caches[i].p, nrm[viewers++] = g->caches[i].frame.n;
+    if (!iris_portal_tighten(s->accel, &joined[j].p, at, nrm, viewers)) memset(&joined[j].p, 0, sizeof joined[j].p);
+  }
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (group[i] != 0xff && iris_portal_present(&joined[group[i]].p)) g->caches[i].portal = joined[group[i]].p;
+  free(group);
+  extend_ctx e = {g, s->accel, s->seed, joined, count};
+  if (count > 0) iris_parallel_for(g->cache_count, 16, threads, extend_portals, &e);
+}
+
 /* Each cache whose indirect light mostly came from one cone looks into it
- * for an opening (portal.h); deterministic: probes hashed from (seed, cache). */
+ * for an opening (portal.h), then the parts of one opening different caches
+ * found are joined (join_portals). Deterministic: probes hashed from (seed,
+ * cache). */
 static void build_portals(iris_guiding *g, const iris_guide_setup *s, const float *cluster) {
   portal_ctx c = {g, s->accel, cluster, s->seed};
   int threads = s->threads > 0 ? s->threads : iris_parallel_default_threads();
   iris_parallel_for(g->cache_count, 16, threads, find_portals, &c);
+  if (!iris_cancel_requested()) join_portals(g, s, threads);
   g->stats.portal_caches = 0;
   for (size_t i = 0; i < g->cache_count; ++i) g->stats.portal_caches += g->caches[i].portal_weight > 0.0f;
 }

@@ -234,3 +234,101 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
   *out = p;
   return true;
 }
+
+/* ---- joining the caches' rectangles ---------------------------------------- */
+
+/* The unit normal of p's plane turned towards `side`. */
+static iris_vec3 facing_normal(const iris_portal *p, iris_vec3 side) {
+  iris_vec3 nrm = iris_normalize(iris_cross(p->u, p->v));
+  return iris_dot(iris_sub(side, p->o), nrm) < 0.0f ? iris_neg(nrm) : nrm;
+}
+
+/* p's extent along the unit axes e1, e2 of a plane through o. */
+static void extent(const iris_portal *p, iris_vec3 o, iris_vec3 e1, iris_vec3 e2, float box[4]) {
+  const iris_vec3 d = iris_sub(p->o, o);
+  const float ca = iris_dot(d, e1), cb = iris_dot(d, e2);
+  const float ra = fabsf(iris_dot(p->u, e1)) + fabsf(iris_dot(p->v, e1));
+  const float rb = fabsf(iris_dot(p->u, e2)) + fabsf(iris_dot(p->v, e2));
+  box[0] = ca - ra, box[1] = ca + ra, box[2] = cb - rb, box[3] = cb + rb;
+}
+
+bool iris_portal_join(iris_portal *a, iris_vec3 side_a, const iris_portal *b, iris_vec3 side_b) {
+  if (!iris_portal_present(a) || !iris_portal_present(b)) return false;
+  const iris_vec3 na = facing_normal(a, side_a), nb = facing_normal(b, side_b);
+  if (!(iris_dot(na, nb) > 0.995f)) return false; /* within ~6 degrees, facing the same side */
+  const float size = sqrtf(fmaxf(iris_dot(a->u, a->u), iris_dot(a->v, a->v)));
+  if (!(fabsf(iris_dot(iris_sub(b->o, a->o), na)) < 1e-3f + 0.02f * size)) return false; /* in a's plane */
+  const iris_vec3 e1 = iris_normalize(a->u), e2 = iris_normalize(a->v);
+  float ba[4], bb[4];
+  extent(a, a->o, e1, e2, ba);
+  extent(b, a->o, e1, e2, bb);
+  /* they overlap, or come within a tenth of the larger one's size of each other */
+  const float gap = 0.1f * fmaxf(fmaxf(ba[1] - ba[0], ba[3] - ba[2]), fmaxf(bb[1] - bb[0], bb[3] - bb[2]));
+  if (bb[0] > ba[1] + gap || bb[1] < ba[0] - gap || bb[2] > ba[3] + gap || bb[3] < ba[2] - gap) return false;
+  const float a0 = fminf(ba[0], bb[0]), a1 = fmaxf(ba[1], bb[1]), b0 = fminf(ba[2], bb[2]), b1 = fmaxf(ba[3], bb[3]);
+  a->o = iris_add(a->o, iris_add(iris_scale(e1, 0.5f * (a0 + a1)), iris_scale(e2, 0.5f * (b0 + b1))));
+  a->u = iris_scale(e1, 0.5f * (a1 - a0));
+  a->v = iris_scale(e2, 0.5f * (b1 - b0));
+  return true;
+}
+
+float iris_portal_share(const struct iris_accel *accel, const iris_portal *p, iris_vec3 c, iris_vec3 n, uint64_t seed,
+                        iris_portal_density pdf, void *pdf_ctx, float *reach) {
+  const float area = 4.0f * iris_length(p->u) * iris_length(p->v);
+  const iris_vec3 nrm = iris_normalize(iris_cross(p->u, p->v));
+  double share = 0.0;
+  int through = 0;
+  uint64_t h = seed;
+  for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
+    h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
+    const float u1 = ((float)(i % 8) + iris_u64_to_unit(h)) / 8.0f;
+    const float u2 = ((float)(i / 8) + iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL))) / 8.0f;
+    const iris_vec3 target = iris_add(p->o, iris_add(iris_scale(p->u, 2.0f * u1 - 1.0f), iris_scale(p->v, 2.0f * u2 - 1.0f)));
+    const iris_vec3 to = iris_sub(target, c);
+    const float tc = iris_length(to);
+    if (!(tc > 0.0f)) continue;
+    const iris_vec3 d = iris_scale(to, 1.0f / tc);
+    const float cosp = fabsf(iris_dot(d, nrm));
+    if (!(iris_dot(d, n) > 0.0f) || !(cosp > 1e-4f)) continue;
+    iris_hit hit;
+    if (probe_hit(accel, c, n, d, &hit) && !(hit.t > 1.02f * tc + 1e-3f)) continue;
+    through++;
+    /* the map's density over the portal's: tc^2 / (area cos) per direction */
+    share += (double)pdf(pdf_ctx, d) * (double)area * (double)cosp / ((double)tc * (double)tc);
+  }
+  *reach = (float)through / (float)IRIS_PORTAL_PROBES;
+  return (float)(share / IRIS_PORTAL_PROBES);
+}
+
+bool iris_portal_tighten(const struct iris_accel *accel, iris_portal *p, const iris_vec3 *viewer,
+                         const iris_vec3 *viewer_n, int viewers) {
+  const iris_vec3 nrm = iris_normalize(iris_cross(p->u, p->v));
+  float lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+  for (int i = 0; i < IRIS_PORTAL_TIGHTEN_GRID * IRIS_PORTAL_TIGHTEN_GRID; ++i) {
+    const float s = 2.0f * ((float)(i % IRIS_PORTAL_TIGHTEN_GRID) + 0.5f) / IRIS_PORTAL_TIGHTEN_GRID - 1.0f;
+    const float t = 2.0f * ((float)(i / IRIS_PORTAL_TIGHTEN_GRID) + 0.5f) / IRIS_PORTAL_TIGHTEN_GRID - 1.0f;
+    if (s >= lo[0] && s <= hi[0] && t >= lo[1] && t <= hi[1]) continue; /* cannot widen the box */
+    const iris_vec3 q = iris_add(p->o, iris_add(iris_scale(p->u, s), iris_scale(p->v, t)));
+    for (int k = 0; k < viewers; ++k) {
+      const iris_vec3 to = iris_sub(q, viewer[k]);
+      const float tc = iris_length(to);
+      if (!(tc > 0.0f)) continue;
+      const iris_vec3 d = iris_scale(to, 1.0f / tc);
+      if (!(iris_dot(d, viewer_n[k]) > 0.0f) || !(fabsf(iris_dot(d, nrm)) > 1e-3f)) continue;
+      iris_hit hit;
+      if (probe_hit(accel, viewer[k], viewer_n[k], d, &hit) && !(hit.t > 1.02f * tc + 1e-3f)) continue;
+      lo[0] = fminf(lo[0], s), hi[0] = fmaxf(hi[0], s), lo[1] = fminf(lo[1], t), hi[1] = fmaxf(hi[1], t);
+      break;
+    }
+  }
+  if (!(lo[0] <= hi[0] && lo[1] <= hi[1])) return false;
+  /* a single open point still spans one grid cell */
+  const float half = 1.0f / IRIS_PORTAL_TIGHTEN_GRID;
+  if (hi[0] - lo[0] < 2.0f * half) lo[0] -= half, hi[0] += half;
+  if (hi[1] - lo[1] < 2.0f * half) lo[1] -= half, hi[1] += half;
+  const iris_vec3 o = iris_add(p->o, iris_add(iris_scale(p->u, 0.5f * (lo[0] + hi[0])), iris_scale(p->v, 0.5f * (lo[1] + hi[1]))));
+  p->u = iris_scale(p->u, 0.5f * (hi[0] - lo[0]));
+  p->v = iris_scale(p->v, 0.5f * (hi[1] - lo[1]));
+  p->o = o;
+  return true;
+}

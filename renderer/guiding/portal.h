@@ -65,6 +65,32 @@ typedef float (*iris_portal_brightness)(void *ctx, iris_vec3 p, iris_vec3 n);
 bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, iris_vec3 axis, float cos_max,
                       uint64_t seed, iris_portal_brightness bright, void *bright_ctx, iris_portal *out);
 
+/* Joining: caches see parts of one opening, each from its own cone. If b
+ * lies in a's plane (normals within ~6 degrees, both turned towards their
+ * finders' sides side_a, side_b; offset within 1 mm + 2% of a's size) and
+ * overlaps a or comes within a tenth of its size, a becomes the rectangle in
+ * a's plane bounding both (true); else a is unchanged (false). */
+bool iris_portal_join(iris_portal *a, iris_vec3 side_a, const iris_portal *b, iris_vec3 side_b);
+
+/* Shrinks a joined rectangle to the box of the points, on a regular
+ * IRIS_PORTAL_TIGHTEN_GRID^2 grid over it, that some viewer (its finders: a
+ * position above its surface, normal viewer_n) reaches in a straight line:
+ * the bounds of joined parts are each a probe spacing wide and would reach
+ * into the floor or the wall around the opening. False (p unchanged) when
+ * no viewer reaches any grid point. */
+#define IRIS_PORTAL_TIGHTEN_GRID 24
+bool iris_portal_tighten(const struct iris_accel *accel, iris_portal *p, const iris_vec3 *viewer,
+                         const iris_vec3 *viewer_n, int viewers);
+
+/* A cache's density of incident light over world directions. */
+typedef float (*iris_portal_density)(void *ctx, iris_vec3 wi);
+/* The share of a cache's incident light (density `pdf`) that reaches a cache
+ * at c (normal n) through p, by IRIS_PORTAL_PROBES probes to points
+ * stratified over p (jittered by seed) that reach its plane unblocked and
+ * above the surface; *reach: the fraction of the probes that do. */
+float iris_portal_share(const struct iris_accel *accel, const iris_portal *p, iris_vec3 c, iris_vec3 n, uint64_t seed,
+                        iris_portal_density pdf, void *pdf_ctx, float *reach);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,10 +1,13 @@
 /* Portals (renderer/guiding/portal.h, docs/guiding.md "Portals"):
  *  - a rectangle's sampler against its density: chi-square over the sphere,
  *    the density integrates to 1, every drawn direction has density > 0;
+ *  - joining: rectangles in one plane that overlap join into the box of both,
+ *    not across planes, sides or gaps;
  *  - on the door scene the caches whose indirect light came through the door
- *    find it: every portal lies in the door's plane within the door (plus the
- *    probes' margin), seen from room A, and enough of room A's caches have
- *    one; none with portals off; the same for 1 and 2 threads;
+ *    find it: every portal lies in the door's plane within the door (plus 5
+ *    cm), seen from room A, most of room A's caches have one, and their
+ *    rectangles, joined, cover most of the door (each cache alone sees a
+ *    part); none with portals off; the same for 1 and 2 threads;
  *  - the whole guided sampler at a room-A floor point with a portal passes
  *    chi-square over the sphere against its own pdf (which integrates to 1):
  *    the sampler and the MIS density agree with the portal in the mixture;
@@ -63,6 +66,33 @@ static void test_rectangle(void) {
   CHECK(!iris_portal_faces(&c.p, iris_v3(-1, 1, 0), iris_v3(-0.0005f, 0.5f, 1.0f), iris_v3(0, 1, 0))); /* in its plane */
 }
 
+static bool near3(iris_vec3 a, iris_vec3 b) { return iris_length(iris_sub(a, b)) < 1e-5f; }
+
+static void test_join(void) {
+  /* the door's plane x = 0, seen from x < 0 */
+  const iris_vec3 side = iris_v3(-1.0f, 1.0f, 0.0f);
+  const iris_portal low = {{0.0f, 0.5f, -0.1f}, {0.0f, 0.0f, 0.2f}, {0.0f, 0.5f, 0.0f}};  /* z [-0.3, 0.1], y [0, 1] */
+  const iris_portal high = {{0.0f, 1.4f, 0.1f}, {0.0f, 0.6f, 0.0f}, {0.0f, 0.0f, -0.2f}}; /* z [-0.1, 0.3], y [0.8, 2] */
+  iris_portal a = low;
+  CHECK(iris_portal_join(&a, side, &high, iris_v3(-2.0f, 0.0f, 1.0f)));
+  CHECK(near3(a.o, iris_v3(0.0f, 1.0f, 0.0f))); /* the box z [-0.3, 0.3], y [0, 2] */
+  CHECK(fabsf(fabsf(iris_dot(a.u, iris_v3(0, 0, 1))) + fabsf(iris_dot(a.v, iris_v3(0, 0, 1))) - 0.3f) < 1e-5f);
+  CHECK(fabsf(fabsf(iris_dot(a.u, iris_v3(0, 1, 0))) + fabsf(iris_dot(a.v, iris_v3(0, 1, 0))) - 1.0f) < 1e-5f);
+  CHECK(fabsf(iris_dot(a.u, a.v)) < 1e-6f);
+  /* not: seen from the other side, in a plane 10 cm behind, tilted 10 degrees, 1 m away */
+  iris_portal b = low, other = high;
+  CHECK(!iris_portal_join(&b, side, &high, iris_v3(1.0f, 1.0f, 0.0f)));
+  other.o.x = 0.1f;
+  CHECK(!iris_portal_join(&b, side, &other, side));
+  other = high;
+  other.u = iris_v3(0.6f * sinf(0.1745f), 0.6f * cosf(0.1745f), 0.0f);
+  CHECK(!iris_portal_join(&b, side, &other, side));
+  other = high;
+  other.o.z += 1.0f;
+  CHECK(!iris_portal_join(&b, side, &other, side));
+  CHECK(memcmp(&b, &low, sizeof b) == 0); /* unchanged when refused */
+}
+
 static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool portals, int threads) {
   iris_guiding_params gp = iris_guiding_params_default();
   gp.portals = portals;
@@ -70,10 +100,12 @@ static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool porta
 }
 
 /* Every portal in the door's plane (x = 0) within the door (z in [-0.3,
- * 0.3], y in [0, 2]) widened by 0.15 m, found from room A; returns how many
- * room-A caches have one. */
-static int check_portals(const iris_guiding *g) {
+ * 0.3], y in [0, 2]) widened by 5 cm, found from room A; returns how many
+ * room-A caches have one, *cover the mean share of the door's area their
+ * rectangles cover. */
+static int check_portals(const iris_guiding *g, double *cover) {
   int bad = 0, room_a = 0, found = 0;
+  *cover = 0.0;
   for (size_t i = 0; i < g->cache_count; ++i) {
     const iris_cache *c = &g->caches[i];
     if (!(c->portal_weight > 0.0f)) continue;
@@ -81,8 +113,11 @@ static int check_portals(const iris_guiding *g) {
     const iris_portal *p = &c->portal;
     const float zext = fabsf(p->u.z) + fabsf(p->v.z), yext = fabsf(p->u.y) + fabsf(p->v.y);
     const bool ok = fabsf(p->o.x) < 0.05f && fabsf(p->u.x) < 1e-3f && fabsf(p->v.x) < 1e-3f &&
-                    p->o.z - zext >= -0.45f && p->o.z + zext <= 0.45f && p->o.y - yext >= -0.15f &&
-                    p->o.y + yext <= 2.15f && c->p.x < 0.0f;
+                    p->o.z - zext >= -0.35f && p->o.z + zext <= 0.35f && p->o.y - yext >= -0.05f &&
+                    p->o.y + yext <= 2.05f && c->p.x < 0.0f;
+    const double z0 = fmax(p->o.z - zext, -0.3), z1 = fmin(p->o.z + zext, 0.3);
+    const double y0 = fmax(p->o.y - yext, 0.0), y1 = fmin(p->o.y + yext, 2.0);
+    if (c->p.x < 0.0f) *cover += fmax(z1 - z0, 0.0) * fmax(y1 - y0, 0.0) / 1.2;
     if (!ok && bad++ < 5)
       printf("  portal of the cache at (%.2f, %.2f, %.2f): centre (%.2f, %.2f, %.2f), half-axes (%.2f, %.2f, %.2f), "
              "(%.2f, %.2f, %.2f)\n",
@@ -91,6 +126,7 @@ static int check_portals(const iris_guiding *g) {
     room_a += c->p.x < 0.0f;
   }
   iris_check_record(bad == 0, __FILE__, __LINE__, "%d of %d portals not the door seen from room A", bad, found);
+  if (room_a > 0) *cover /= room_a;
   return room_a;
 }
 
@@ -111,11 +147,14 @@ static void test_door(void) {
   }
   size_t room_a_caches = 0;
   for (size_t i = 0; i < g->cache_count; ++i) room_a_caches += g->caches[i].p.x < -0.05f;
-  const int room_a = check_portals(g);
-  printf("door: %llu caches with a portal, %d of room A's %zu\n", (unsigned long long)g->stats.portal_caches, room_a,
-         room_a_caches);
-  iris_check_record(room_a >= 30 && (double)room_a >= 0.3 * (double)room_a_caches, __FILE__, __LINE__,
+  double cover;
+  const int room_a = check_portals(g, &cover);
+  printf("door: %llu caches with a portal, %d of room A's %zu, covering %.0f%% of the door on average\n",
+         (unsigned long long)g->stats.portal_caches, room_a, room_a_caches, 100.0 * cover);
+  iris_check_record(room_a >= 30 && (double)room_a >= 0.6 * (double)room_a_caches, __FILE__, __LINE__,
                     "only %d of room A's %zu caches found the door", room_a, room_a_caches);
+  iris_check_record(cover >= 0.88, __FILE__, __LINE__, "room A's portals cover %.0f%% of the door on average",
+                    100.0 * cover);
   /* the same with 2 threads */
   {
     iris_guiding *g2 = build(sc, &t, true, 2);
@@ -174,6 +213,7 @@ static void test_door(void) {
 
 int main(void) {
   test_rectangle();
+  test_join();
   test_door();
   return iris_check_summary("guiding.portal");
 }

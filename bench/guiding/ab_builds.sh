@@ -1,0 +1,48 @@
+#!/bin/sh
+# Two builds at equal wall time: NEW against BASE (another checkout's build
+# directory), each an `iris render --time T --time-total` (setup counted) per
+# seed and budget, alternating, relMSE (bench/render/relmse, the benchmarks'
+# trimmed metric) against REFDIR/ref_SCENE.exr (made as bench/guiding/portal_ab.sh
+# makes it when missing), 72 rows (door scenes 96 wide, the rest 108), 2
+# threads. Prints per scene and budget each build's relMSE per seed, their
+# geometric mean net of the reference's own relMSE, and the ratio BASE / NEW.
+# usage: bench/guiding/ab_builds.sh NEW BASE REFDIR "TIMES" "SEEDS" [METHOD [SCENE...]]
+#   e.g. git worktree add /tmp/base HEAD~1 && cmake -S /tmp/base -B /tmp/base/build -DCMAKE_BUILD_TYPE=Release &&
+#        cmake --build /tmp/base/build --target iris relmse &&
+#        bench/guiding/ab_builds.sh build /tmp/base/build refs "4 16" "1 2 3 4" auto door
+set -eu
+N=$1; B=$2; R=$3; TIMES=$4; SEEDS=$5
+METHOD=${6:-auto}
+[ $# -ge 6 ] && shift 6 || shift $#
+SCENES=${*:-door}
+mkdir -p "$R"
+OUT=$(mktemp -d)
+trap 'rm -rf "$OUT"' EXIT
+for sc in $SCENES; do
+  case $sc in door*) W=96 ;; *) W=108 ;; esac
+  ref="$R/ref_$sc.exr"
+  if [ ! -f "$ref" ]; then
+    "$N/tools/iris" render "$sc" --method mis --sampler independent --spp "${REFSPP:-32768}" --width "$W" --height 72 \
+      --seed 999 --threads 2 --variance --quiet -o "$ref"
+  fi
+  own=$("$N/bench/render/relmse" --own "$ref")
+  echo "$sc ($METHOD): reference $ref, own relMSE $own"
+  for t in $TIMES; do
+    new=""; base=""
+    for s in $SEEDS; do
+      for v in new base; do
+        if [ "$v" = new ]; then b=$N; else b=$B; fi
+        "$b/tools/iris" render "$sc" --method "$METHOD" --time "$t" --time-total --width "$W" --height 72 --threads 2 \
+          --seed "$s" -o "$OUT/img.exr" > /dev/null 2>&1
+        val=$("$N/bench/render/relmse" "$OUT/img.exr" "$ref")
+        if [ "$v" = new ]; then new="$new $val"; else base="$base $val"; fi
+      done
+    done
+    echo "$new|$base" | awk -v t="$t" -v own="$own" -F'|' '
+      function geo(s,   n, i, a, p) { n = split(s, a, " "); p = 0; for (i = 1; i <= n; i++) p += log(a[i]); return exp(p / n) }
+      { g1 = geo($1); g0 = geo($2)
+        printf "  %s s new: %s  geo %.4g (net %.4g)\n", t, $1, g1, g1 - own
+        printf "  %s s base:%s  geo %.4g (net %.4g)\n", t, $2, g0, g0 - own
+        printf "  %s s gain (net): %.2fx\n", t, (g0 - own) / (g1 - own) }'
+  done
+done
