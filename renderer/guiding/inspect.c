@@ -113,7 +113,8 @@ iris_status iris_guiding_dump_caches(const iris_guiding *g, const iris_guide_set
   if (!values || !ids || !d2 || !text)
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory");
   if (st == IRIS_OK)
-    text_len = (size_t)snprintf(text, text_cap, "# pixel_x pixel_y cache x y z nx ny nz photons_used source map\n");
+    text_len = (size_t)snprintf(text, text_cap, "# pixel_x pixel_y cache x y z nx ny nz photons_used source map portal"
+                                   " (none, or centre x y z, half-axes ux uy uz vx vy vz, weight)\n");
   for (int j = 0; st == IRIS_OK && j < DUMP_ROWS; ++j)
     for (int i = 0; st == IRIS_OK && i < DUMP_COLS; ++i) {
       int px = (int)((i + 0.5) * s->camera->width / DUMP_COLS);
@@ -144,12 +145,21 @@ iris_status iris_guiding_dump_caches(const iris_guiding *g, const iris_guide_set
       }
       snprintf(path, sizeof path, "%s/cache_px%04d_py%04d_photons.png", dir, px, py);
       st = write_map_png(map, values, path, err);
-      if (st == IRIS_OK && text_len + 256 < text_cap)
+      if (st == IRIS_OK && text_len + 512 < text_cap) {
         text_len += (size_t)snprintf(text + text_len, text_cap - text_len,
-                                     "%d %d %u %.4f %.4f %.4f %.3f %.3f %.3f %u %s %s\n", px, py, pick[0],
+                                     "%d %d %u %.4f %.4f %.4f %.3f %.3f %.3f %u %s %s", px, py, pick[0],
                                      (double)c->p.x, (double)c->p.y, (double)c->p.z, (double)c->frame.n.x,
                                      (double)c->frame.n.y, (double)c->frame.n.z, c->photons,
                                      c->from_camera ? "camera" : "photon", c->sphere ? "sphere" : "hemisphere");
+        const iris_portal *pt = &c->portal;
+        text_len += c->portal_weight > 0.0f
+                        ? (size_t)snprintf(text + text_len, text_cap - text_len,
+                                           " %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.4f %.3f\n", (double)pt->o.x,
+                                           (double)pt->o.y, (double)pt->o.z, (double)pt->u.x, (double)pt->u.y,
+                                           (double)pt->u.z, (double)pt->v.x, (double)pt->v.y, (double)pt->v.z,
+                                           (double)c->portal_weight)
+                        : (size_t)snprintf(text + text_len, text_cap - text_len, " none\n");
+      }
     }
   if (st == IRIS_OK) {
     char path[1200];

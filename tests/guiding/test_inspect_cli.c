@@ -3,7 +3,9 @@
  * the guide's inspection hook (guiding.h: iris_guiding_params.inspect), so
  * this fails when the hook is not wired: DIR/caches.txt lists 12 pixels, a
  * pdf and a photon-count PNG per listed cache exist, and OUT-caches.png is
- * written next to the EXR. Without a guided method both flags are refused. */
+ * written next to the EXR; on the door some listed caches show their portal,
+ * in the door's plane (x = 0). Without a guided method both flags are
+ * refused. */
 #include <stdio.h>
 #include <string.h>
 
@@ -52,6 +54,35 @@ int main(int argc, char **argv) {
   }
   iris_check_record(lines == 12 && listed > 0 && pngs == listed, __FILE__, __LINE__,
                     "caches.txt: %d pixel lines (want 12), %d of %d PNGs found", lines, pngs, listed);
+  /* the door: the portals of the caches that have one */
+  snprintf(sub, sizeof sub, "%s/door-dumps", dir);
+  if (CHECK(iris_mkdir_p(sub, &e) == IRIS_OK)) {
+    rc = iris_test_run_cli(dir, argv[1], "render door --method guided-nee --spp 1 --height 72 --dump-caches door-dumps "
+                           "-o door.exr --quiet", out, sizeof out, err, sizeof err);
+    iris_check_record(rc == 0, __FILE__, __LINE__, "door with inspection: exit %d: %s", rc, err);
+    snprintf(path, sizeof path, "%s/door-dumps/caches.txt", dir);
+    f = fopen(path, "r");
+    int portals = 0, none = 0, bad = 0;
+    if (CHECK(f != NULL)) {
+      char line[512];
+      while (fgets(line, sizeof line, f)) {
+        if (line[0] == '#') continue;
+        float v[22];
+        char src[16], map[16], last[32];
+        int n = sscanf(line, "%f %f %f %f %f %f %f %f %f %f %15s %15s %f %f %f %f %f %f %f %f %f %f", &v[0], &v[1],
+                       &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], src, map, &v[12], &v[13], &v[14],
+                       &v[15], &v[16], &v[17], &v[18], &v[19], &v[20], &v[21]);
+        if (n == 22) portals++, bad += !(v[12] > -0.01f && v[12] < 0.01f && v[21] > 0.0f && v[21] <= 1.0f);
+        else if (n == 12 && sscanf(line, "%*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %*s %31s", last) == 1 &&
+                 strcmp(last, "none") == 0)
+          none++;
+      }
+      fclose(f);
+    }
+    iris_check_record(portals > 0 && bad == 0 && portals + none == 12, __FILE__, __LINE__,
+                      "door caches.txt: %d portals (%d off the door's plane), %d none, want 12 lines", portals, bad,
+                      none);
+  }
   /* refused without a guided method, nothing written */
   rc = iris_test_run_cli(dir, argv[1], "render cornell-box --method mis --spp 1 --dump-caches dumps -o no.exr",
                          out, sizeof out, err, sizeof err);
