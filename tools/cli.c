@@ -182,7 +182,11 @@ int iris_cli_load_scene(const char *cmd, const char *input, const iris_import_op
   *out = NULL;
   iris_status st;
   iris_phase_begin("loading", "loading the scene");
-  if (iris_path_exists(input)) {
+  struct stat sb;
+  const bool folder = stat(input, &sb) == 0 && S_ISDIR(sb.st_mode);
+  if (folder && !iris_builtin_exists(input)) { /* a folder is never a scene; a built-in's name wins over one */
+    return iris_cli_usage_error(cmd, "'%s' is a folder, not a scene file", input);
+  } else if (!folder && iris_path_exists(input)) {
     st = iris_import_file(input, opts, out, &err);
   } else if (iris_builtin_exists(input) && opts && opts->variant) {
     st = iris_error_set(&err, IRIS_ERR_USAGE, input, 0, NULL,

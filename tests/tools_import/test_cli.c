@@ -6,6 +6,7 @@
 #include <cjson/cJSON.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -185,6 +186,22 @@ static void test_bad_input(void) {
     const char *nl = strchr(err_text, '\n');
     CHECK(strstr(err_text, "iris: ") == err_text && nl && nl[1] == '\0'); /* exactly one line */
     CHECK(!exists("gltf-out.json") && !exists("gltf-out.meshes"));
+  }
+  /* A folder is never a scene file: refused by name, and a built-in scene's
+   * name still means the built-in where a folder of that name is at hand. */
+  char folder[700];
+  snprintf(folder, sizeof folder, "%s/a-folder", dir);
+  if (CHECK(mkdir(folder, 0755) == 0)) {
+    EXPECT_RUN("render a-folder --spp 1 -o folder-out.exr", 2, "'a-folder' is a folder, not a scene file");
+    CHECK(!exists("folder-out.exr"));
+    EXPECT_RUN("import a-folder -o folder-out.json", 2, "'a-folder' is not an .obj");
+    rmdir(folder);
+  }
+  snprintf(folder, sizeof folder, "%s/cornell-box", dir);
+  if (CHECK(mkdir(folder, 0755) == 0)) {
+    EXPECT_RUN("render cornell-box --spp 1 --width 16 --height 16 --quiet -o builtin.exr", 0, NULL);
+    CHECK(exists("builtin.exr"));
+    rmdir(folder);
   }
 }
 
