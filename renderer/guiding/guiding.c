@@ -565,6 +565,7 @@ static void find_portals(void *ctx, uint64_t begin, uint64_t end, int thread_ind
 #define PORTAL_JOINED_MAX 64
 #define PORTAL_VIEWERS 4 /* finders that tighten a joined rectangle */
 #define PORTAL_MIN_SHARE 0.05f /* a cache without a portal takes a joined one that brings this much of its light */
+#define PORTAL_EXTEND_TRIED 4  /* ... among this many (64 probes each): linear work in the caches */
 
 typedef struct joined_portal {
   iris_portal p;
@@ -592,7 +593,8 @@ static float cache_density(void *ctx, iris_vec3 wi) {
 /* A cache that found no portal of its own takes the joined one through
  * which the most of its incident light came (its map's share through it,
  * iris_portal_share), if that is at least PORTAL_MIN_SHARE and at least half
- * the probes reach the opening. The portal's samples are worth more than
+ * the probes reach the opening; of the wholes facing it, the
+ * PORTAL_EXTEND_TRIED largest in its view are tried. The portal's samples are worth more than
  * that share: the light through an opening is the part whose paths vary
  * most (the door: 98% of the second moment, docs/guiding.md). */
 static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
@@ -602,12 +604,28 @@ static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_i
     if (iris_cancel_requested()) return;
     iris_cache *cache = &c->g->caches[i];
     if (cache->portal_weight > 0.0f) continue;
-    share_ctx sc = {c->g, (uint32_t)i};
-    float best = 0.0f;
-    int best_j = -1;
+    /* the PORTAL_EXTEND_TRIED wholes that face it and look largest from it
+     * (area |cos| / distance^2 of their centre), ties to the lower index */
+    int tried[PORTAL_EXTEND_TRIED], n_tried = 0;
+    float size[PORTAL_EXTEND_TRIED];
     for (int j = 0; j < c->count; ++j) {
       const joined_portal *jp = &c->joined[j];
       if (!iris_portal_present(&jp->p) || !iris_portal_faces(&jp->p, jp->side, cache->p, cache->frame.n)) continue;
+      const iris_vec3 to = iris_sub(jp->p.o, cache->p), nrm = iris_cross(jp->p.u, jp->p.v);
+      const float d2 = iris_dot(to, to), w = 4.0f * fabsf(iris_dot(to, nrm)) / (d2 * sqrtf(d2));
+      int at = n_tried < PORTAL_EXTEND_TRIED ? n_tried++ : PORTAL_EXTEND_TRIED;
+      while (at > 0 && size[at - 1] < w) {
+        if (at < PORTAL_EXTEND_TRIED) tried[at] = tried[at - 1], size[at] = size[at - 1];
+        --at;
+      }
+      if (at < PORTAL_EXTEND_TRIED) tried[at] = j, size[at] = w;
+    }
+    share_ctx sc = {c->g, (uint32_t)i};
+    float best = 0.0f;
+    int best_j = -1;
+    for (int t = 0; t < n_tried; ++t) {
+      const int j = tried[t];
+      const joined_portal *jp = &c->joined[j];
       float reach;
       const float share = iris_portal_share(c->accel, &jp->p, cache->p, cache->frame.n,
                                             iris_hash4(c->seed, PORTAL_STREAM, i, 1 + (uint64_t)j), cache_density, &sc,
