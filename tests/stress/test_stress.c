@@ -34,7 +34,11 @@ typedef struct budget {
 } budget;
 
 static const budget BUDGETS[] = {
-    {"stress-gap", {64, 64, 64, 32, 32}},
+    /* guided 64: since the caches join the slit into one portal (docs/guiding.md, "Portals"),
+     * the 32-spp guided image of this seed had 2 regions at |z| 5.2 (limit 4.95) that 64, 128,
+     * 256 and 4096 spp bring to 2.2, 1.9, 3.1 and 1.7 (energy 0.95-1.01 of the reference): the
+     * portal's paths through the slit to the light are rare and heavy at 32 spp */
+    {"stress-gap", {64, 64, 64, 64, 32}},
     {"stress-veach-lights", {64, 64, 64, 16, 16}},
     {"stress-caustic", {64, 64, 64, 32, 32}},
     {"stress-thin-walls", {64, 64, 64, 32, 32}},
