@@ -21,7 +21,7 @@ mkdir -p "$R"
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 for sc in $SCENES; do
-  case $sc in door*) W=96 ;; *) W=108 ;; esac
+  case $sc in door*|stress*) W=96 ;; *) W=108 ;; esac
   ref="$R/ref_$sc.exr"
   if [ ! -f "$ref" ]; then
     "$N/tools/iris" render "$sc" --method mis --sampler independent --spp "${REFSPP:-32768}" --width "$W" --height 72 \
