@@ -44,6 +44,14 @@ bool iris_portal_faces(const iris_portal *p, iris_vec3 side, iris_vec3 x, iris_v
   return iris_dot(iris_sub(p->o, x), n) > 0.0f;
 }
 
+/* Probe i of an 8 x 8 stratified grid, jittered by the hash stream h
+ * (advanced): its cell coordinates plus jitter, each in [0, 8). */
+static void stratum(uint64_t *h, int i, float *ca, float *cb) {
+  *h = iris_mix64(*h + 0x9e3779b97f4a7c15ULL);
+  *ca = (float)(i % 8) + iris_u64_to_unit(*h);
+  *cb = (float)(i / 8) + iris_u64_to_unit(iris_mix64(*h ^ 0x5bd1e995ULL));
+}
+
 typedef struct probe {
   iris_vec3 d, h, ng; /* direction, hit point and its normal turned towards the probe */
   float t;            /* hit distance; INFINITY: escaped */
@@ -82,9 +90,9 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
   int count = 0;
   uint64_t h = seed;
   for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
-    h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
-    const float j1 = iris_u64_to_unit(h), j2 = iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL));
-    const float u1 = ((float)(i % 8) + j1) / 8.0f, u2 = ((float)(i / 8) + j2) / 8.0f;
+    float ca, cb;
+    stratum(&h, i, &ca, &cb);
+    const float u1 = ca / 8.0f, u2 = cb / 8.0f;
     const float omc = u1 * omc_max, cosv = 1.0f - omc, sinv = sqrtf(fmaxf(0.0f, omc * (2.0f - omc)));
     const float phi = 2.0f * (float)IRIS_PI * u2;
     const iris_vec3 d = iris_normalize(iris_frame_to_world(&f, iris_v3(sinv * cosf(phi), sinv * sinf(phi), cosv)));
@@ -191,9 +199,9 @@ bool iris_portal_find(const struct iris_accel *accel, iris_vec3 c, iris_vec3 n, 
     int through = 0, lit_n = 0, wall_n = 0;
     double lit = 0.0, wall = 0.0;
     for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
-      h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
-      const float qa = a0 + da * ((float)(i % 8) + iris_u64_to_unit(h));
-      const float qb = b0 + db * ((float)(i / 8) + iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL)));
+      float ca, cb;
+      stratum(&h, i, &ca, &cb);
+      const float qa = a0 + da * ca, qb = b0 + db * cb;
       const iris_vec3 target = iris_add(po, iris_add(iris_scale(e1, qa), iris_scale(e2, qb)));
       const iris_vec3 d = iris_normalize(iris_sub(target, c));
       if (!(iris_dot(d, n) > 0.0f)) continue;
@@ -280,9 +288,9 @@ float iris_portal_share(const struct iris_accel *accel, const iris_portal *p, ir
   int through = 0;
   uint64_t h = seed;
   for (int i = 0; i < IRIS_PORTAL_PROBES; ++i) {
-    h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
-    const float u1 = ((float)(i % 8) + iris_u64_to_unit(h)) / 8.0f;
-    const float u2 = ((float)(i / 8) + iris_u64_to_unit(iris_mix64(h ^ 0x5bd1e995ULL))) / 8.0f;
+    float ca, cb;
+    stratum(&h, i, &ca, &cb);
+    const float u1 = ca / 8.0f, u2 = cb / 8.0f;
     const iris_vec3 target = iris_add(p->o, iris_add(iris_scale(p->u, 2.0f * u1 - 1.0f), iris_scale(p->v, 2.0f * u2 - 1.0f)));
     const iris_vec3 to = iris_sub(target, c);
     const float tc = iris_length(to);

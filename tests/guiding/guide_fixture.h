@@ -5,9 +5,12 @@
 #ifndef IRIS_TESTS_GUIDING_GUIDE_FIXTURE_H
 #define IRIS_TESTS_GUIDING_GUIDE_FIXTURE_H
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "check.h"
+#include "chi2.h"
 #include "renderer/accel.h"
 #include "renderer/envmap.h"
 #include "renderer/guiding/guiding.h"
@@ -117,6 +120,21 @@ static inline bool test_full_sample(void *vc, const double u[3], double dir[3]) 
 static inline double test_full_pdf(void *vc, const double dir[3]) {
   test_sampler_ctx *c = vc;
   return c->s.pdf(c->s.ctx, c->sp, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
+}
+
+/* The whole sampler at sp against its own pdf: chi-square over the sphere
+ * (400 000 samples, level 0.01 over n_tests) and the pdf's integral 1
+ * (5e-3), recorded at the caller's file and line as "guided sampler with
+ * WHAT". */
+static inline chi2_result test_full_chi2(iris_direction_sampler s, const iris_shading_point *sp, uint64_t key,
+                                         int n_tests, const char *what, const char *file, int line) {
+  test_sampler_ctx c = {s, sp, key, 0};
+  chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
+  chi2_result r = chi2_run(&dom, test_full_sample, test_full_pdf, &c, 400000, 0.01, n_tests);
+  iris_check_record(r.passed, file, line, "guided sampler with %s: %s", what, r.message);
+  iris_check_record(fabs(r.pdf_integral - 1.0) <= 5e-3, file, line, "guided sampler with %s: pdf integral %.6f", what,
+                    r.pdf_integral);
+  return r;
 }
 
 #endif

@@ -186,11 +186,7 @@ static void test_env_spheres(void) {
     const iris_guide_vertex_state *v = iris_guide_vertex_get(&sp.guide);
     if (!(v->glint > 0.0f && v->alpha > 0.0f)) continue;
     tested = true;
-    test_sampler_ctx c = {s, &sp, 0x61696e74ULL, 0};
-    chi2_domain dom = {CHI2_SPHERE, 64, 128, 23};
-    chi2_result r = chi2_run(&dom, test_full_sample, test_full_pdf, &c, 400000, 0.01, N_TESTS);
-    iris_check_record(r.passed, __FILE__, __LINE__, "guided sampler with a glint: %s", r.message);
-    CHECK_NEAR(r.pdf_integral, 1.0, 5e-3);
+    chi2_result r = test_full_chi2(s, &sp, 0x61696e74ULL, N_TESTS, "a glint", __FILE__, __LINE__);
     printf("  sampler at (%.2f, 0, %.2f): alpha %.2f, glint share %.2f, spot radius %.3f m at %.2f m: p = %.3g, pdf "
            "integral %.5f\n",
            (double)xs[i].x, (double)xs[i].z, (double)v->alpha, (double)v->glint, (double)v->spot.radius,
