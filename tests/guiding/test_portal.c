@@ -4,10 +4,11 @@
  *  - joining: rectangles in one plane that overlap join into the box of both,
  *    not across planes, sides or gaps;
  *  - on the door scene the caches whose indirect light came through the door
- *    find it: every portal lies in the door's plane within the door (plus 5
+ *    find it: every portal lies in the door's plane within the door (plus 1
  *    cm), seen from room A, most of room A's caches have one, and their
- *    rectangles, joined, cover most of the door (each cache alone sees a
- *    part); none with portals off; the same for 1 and 2 threads;
+ *    rectangles, joined and tightened to the opening's edges, cover 98% of
+ *    the door (each cache alone sees a part; the 24 x 24 grid alone left 2-3
+ *    cm strips out); none with portals off; the same for 1 and 2 threads;
  *  - the whole guided sampler at a room-A floor point with a portal passes
  *    chi-square over the sphere against its own pdf (which integrates to 1):
  *    the sampler and the MIS density agree with the portal in the mixture;
@@ -100,7 +101,7 @@ static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool porta
 }
 
 /* Every portal in the door's plane (x = 0) within the door (z in [-0.3,
- * 0.3], y in [0, 2]) widened by 5 cm, found from room A; returns how many
+ * 0.3], y in [0, 2]) widened by 1 cm, found from room A; returns how many
  * room-A caches have one, *cover the mean share of the door's area their
  * rectangles cover. */
 static int check_portals(const iris_guiding *g, double *cover) {
@@ -112,9 +113,9 @@ static int check_portals(const iris_guiding *g, double *cover) {
     found++;
     const iris_portal *p = &c->portal;
     const float zext = fabsf(p->u.z) + fabsf(p->v.z), yext = fabsf(p->u.y) + fabsf(p->v.y);
-    const bool ok = fabsf(p->o.x) < 0.05f && fabsf(p->u.x) < 1e-3f && fabsf(p->v.x) < 1e-3f &&
-                    p->o.z - zext >= -0.35f && p->o.z + zext <= 0.35f && p->o.y - yext >= -0.05f &&
-                    p->o.y + yext <= 2.05f && c->p.x < 0.0f;
+    const bool ok = fabsf(p->o.x) < 0.01f && fabsf(p->u.x) < 1e-3f && fabsf(p->v.x) < 1e-3f &&
+                    p->o.z - zext >= -0.31f && p->o.z + zext <= 0.31f && p->o.y - yext >= -0.01f &&
+                    p->o.y + yext <= 2.01f && c->p.x < 0.0f;
     const double z0 = fmax(p->o.z - zext, -0.3), z1 = fmin(p->o.z + zext, 0.3);
     const double y0 = fmax(p->o.y - yext, 0.0), y1 = fmin(p->o.y + yext, 2.0);
     if (c->p.x < 0.0f) *cover += fmax(z1 - z0, 0.0) * fmax(y1 - y0, 0.0) / 1.2;
@@ -153,7 +154,7 @@ static void test_door(void) {
          (unsigned long long)g->stats.portal_caches, room_a, room_a_caches, 100.0 * cover);
   iris_check_record(room_a >= 30 && (double)room_a >= 0.6 * (double)room_a_caches, __FILE__, __LINE__,
                     "only %d of room A's %zu caches found the door", room_a, room_a_caches);
-  iris_check_record(cover >= 0.88, __FILE__, __LINE__, "room A's portals cover %.0f%% of the door on average",
+  iris_check_record(cover >= 0.98, __FILE__, __LINE__, "room A's portals cover %.0f%% of the door on average",
                     100.0 * cover);
   /* the same with 2 threads */
   {
