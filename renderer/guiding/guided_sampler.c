@@ -64,6 +64,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   v->spot = (iris_guide_lamp){{0.0f, 0.0f, 0.0f}, 0.0f};
   v->portal = 0.0f;
   v->portal_of = 0xff;
+  v->portal_faces = 0;
   v->p = sp->si.p;
   if (v->m > 0) {
     /* Learned selection probabilities (training, docs/guiding.md): the tied
@@ -122,8 +123,9 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
       float best = 0.0f;
       for (int i = 0; i < v->m; ++i) {
         const iris_cache *c = &g->caches[v->ids[i]];
-        if (c->portal_weight > best && iris_portal_faces(&c->portal, c->p, v->p, sp->frame.n))
-          best = c->portal_weight, v->portal_of = (uint8_t)i;
+        if (!(c->portal_weight > 0.0f) || !iris_portal_faces(&c->portal, c->p, v->p, sp->frame.n)) continue;
+        v->portal_faces |= (uint8_t)(1u << i);
+        if (c->portal_weight > best) best = c->portal_weight, v->portal_of = (uint8_t)i;
       }
       if (v->portal_of != 0xff) v->portal = IRIS_PORTAL_SHARE;
     }

@@ -564,7 +564,6 @@ static void find_portals(void *ctx, uint64_t begin, uint64_t end, int thread_ind
  * with each: the work stays linear in the caches). */
 #define PORTAL_JOINED_MAX 64
 #define PORTAL_VIEWERS 4 /* finders that tighten a joined rectangle */
-#define PORTAL_MIN_SHARE 0.05f /* a cache without a portal takes a joined one that brings this much of its light */
 #define PORTAL_EXTEND_TRIED 4  /* ... among this many (64 probes each): linear work in the caches */
 
 typedef struct joined_portal {
@@ -590,13 +589,16 @@ static float cache_density(void *ctx, iris_vec3 wi) {
   return iris_guiding_cache_pdf(c->g, &c->id, 1, wi);
 }
 
-/* A cache that found no portal of its own takes the joined one through
- * which the most of its incident light came (its map's share through it,
- * iris_portal_share), if that is at least PORTAL_MIN_SHARE and at least half
- * the probes reach the opening; of the wholes facing it, the
- * PORTAL_EXTEND_TRIED largest in its view are tried. The portal's samples are worth more than
- * that share: the light through an opening is the part whose paths vary
- * most (the door: 98% of the second moment, docs/guiding.md). */
+/* A cache that found no portal of its own takes, as a candidate, the
+ * joined one through which the most of its incident light came (its map's
+ * share through it, iris_portal_share, the portal's weight), if any came
+ * through it and at least half the probes reach the opening; of the wholes
+ * facing it, the PORTAL_EXTEND_TRIED largest in its view are tried. Training
+ * decides which portals stay (train.c): the map's share is no measure of
+ * what the portal's samples are worth, the light through an opening being
+ * the part whose paths vary most (the door: 98% of the second moment), and
+ * a cache that sees the opening at a grazing angle has a small share of it
+ * in its coarse texels (docs/guiding.md). */
 static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
   (void)thread_index;
   const extend_ctx *c = ctx;
@@ -630,7 +632,7 @@ static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_i
       const float share = iris_portal_share(c->accel, &jp->p, cache->p, cache->frame.n,
                                             iris_hash4(c->seed, PORTAL_STREAM, i, 1 + (uint64_t)j), cache_density, &sc,
                                             &reach);
-      if (reach >= 0.5f && share >= PORTAL_MIN_SHARE && share > best) best = share, best_j = j;
+      if (reach >= 0.5f && share > best) best = share, best_j = j;
     }
     if (best_j >= 0) cache->portal = c->joined[best_j].p, cache->portal_weight = fminf(best, 1.0f);
   }

@@ -24,6 +24,13 @@ struct iris_accel;
  * has a portal (measured on the door, docs/guiding.md: 0.1-0.2 best). */
 #define IRIS_PORTAL_SHARE 0.15f
 
+/* A cache that found no opening itself takes a joined one through which
+ * some of its light came, as a candidate: training keeps it where the
+ * samples say it lowers their second moment, and without enough samples it
+ * is kept only if at least this share of the cache's light came through it
+ * (docs/guiding.md, "Portals"). */
+#define IRIS_PORTAL_MIN_SHARE 0.05f
+
 /* A rectangle: centre o, orthogonal half-axes u and v (its normal
  * u x v); u = v = 0: none. */
 typedef struct iris_portal {

@@ -74,6 +74,9 @@ typedef struct train_sample {
   int8_t light; /* the vertex's light sample (iris_path_vertex.light) */
   uint32_t light_leaf; /* ... the light-tree leaf of the light it chose (UINT32_MAX: none, no tree) */
   float light_value;   /* ... and its value (iris_path_vertex.light_value) */
+  iris_vec3 p;         /* the vertex: where the tied caches' portals are seen from */
+  float alpha;         /* the guide's share there (the mixture without a portal: (1 - alpha) pb + alpha pc) */
+  uint8_t portal_faces; /* tied caches whose portal faces the vertex (iris_guide_vertex_state) */
 } train_sample;
 
 typedef struct sample_buffer {
@@ -135,6 +138,9 @@ static bool record_path(pass_ctx *c, const iris_path_record *rec, iris_vec3 L_en
     t.q = pv->pdf;
     t.pb = pv->pdf_bsdf;
     t.pc = iris_guide_vertex_guide_pdf(c->g, v, pv->wi);
+    t.p = v->p;
+    t.alpha = v->alpha;
+    t.portal_faces = v->portal_faces;
     t.light = pv->light;
     t.light_leaf = UINT32_MAX;
     t.light_value = 0.0f;
@@ -194,7 +200,52 @@ typedef struct train_state {
                                         vertices it served, and those that brought light */
   iris_light_select_nee *nee;        /* per cache, IRIS_LIGHT_SELECT_NEE_SLOTS: what the light samples
                                         brought by tree leaf (NULL: no learned light selection) */
+  double *portal_m;                  /* per cache, over all passes, 2 each: the second moment of the
+                                        samples where its portal faces the vertex without it and with it */
+  uint32_t *portal_n;                /* ... and how many samples */
 } train_state;
+
+/* ---- portals kept by training ------------------------------------------------ */
+
+/* Samples a cache's portal needs before training decides whether it stays. */
+#define PORTAL_MIN_SAMPLES 64
+
+/* One sample at a vertex that a cache's portal faces: its contribution to
+ * the second moment sum h^2 / (q p') of the vertex's mixture p' without the
+ * portal, (1 - alpha) pb + alpha pc, and with it at IRIS_PORTAL_SHARE (the
+ * importance-weighted estimate of the integral of h^2 / p' from samples
+ * drawn with density q, as the selection probability alpha is learned). */
+static void portal_add(train_state *ts, uint32_t id, const iris_portal *portal, const train_sample *t) {
+  if (!(t->h != 0.0f) || !(t->q > 0.0f) || !isfinite(t->h) || !isfinite(t->pb) || !isfinite(t->pc)) return;
+  const double rest = (1.0 - (double)t->alpha) * (double)t->pb + (double)t->alpha * (double)t->pc;
+  const double with = (1.0 - (double)IRIS_PORTAL_SHARE) * rest +
+                      (double)IRIS_PORTAL_SHARE * (double)iris_portal_pdf(portal, t->p, t->wi);
+  if (!(rest > 0.0) || !(with > 0.0)) return;
+  const double h2 = (double)t->h * (double)t->h / (double)t->q;
+  ts->portal_m[2 * (size_t)id] += h2 / rest;
+  ts->portal_m[2 * (size_t)id + 1] += h2 / with;
+  ts->portal_n[id]++;
+}
+
+/* After training: a cache keeps its portal where the samples at vertices it
+ * faces had a lower second moment with it than without it; where fewer than
+ * PORTAL_MIN_SAMPLES were seen (or no training ran: m = NULL), where at least
+ * IRIS_PORTAL_MIN_SHARE of its light came through it (every finder's does). */
+static void settle_portals(iris_guiding *g, const double *m, const uint32_t *n) {
+  g->stats.portal_caches = 0;
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    iris_cache *c = &g->caches[i];
+    if (!(c->portal_weight > 0.0f)) continue;
+    const bool keep = m && n[i] >= PORTAL_MIN_SAMPLES ? m[2 * i + 1] < m[2 * i]
+                                                       : c->portal_weight >= IRIS_PORTAL_MIN_SHARE;
+    if (keep) {
+      g->stats.portal_caches++;
+    } else {
+      memset(&c->portal, 0, sizeof c->portal);
+      c->portal_weight = 0.0f;
+    }
+  }
+}
 
 /* Adds a tile's samples to the caches whose id is `lane` modulo `lanes`:
  * every cache receives its samples in tile order, whatever the lanes. */
@@ -213,6 +264,7 @@ static void merge_samples(iris_guiding *g, train_state *ts, const sample_buffer 
       if (ts->nee && t->light_leaf != UINT32_MAX)
         iris_light_select_nee_add(ts->nee + (size_t)id * IRIS_LIGHT_SELECT_NEE_SLOTS, t->light_leaf, t->light_value);
       iris_alpha_learner_add(&ts->learner[id], t->h, t->q, t->pb, t->pc);
+      if (t->portal_faces & (1u << j)) portal_add(ts, id, &c->portal, t);
       if (!(t->li > 0.0f)) continue;
       /* Li cos / q estimates the integral of Li cos over the sphere; splatted
        * at wi it estimates each texel's share (the photons' histogram is
@@ -286,6 +338,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   if (total <= 0 || g->cache_count == 0 || !g->photon_hist) {
     free(g->photon_hist);
     g->photon_hist = NULL;
+    settle_portals(g, NULL, NULL);
     return IRIS_OK;
   }
   const size_t caches = g->cache_count;
@@ -297,7 +350,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   train_state ts = {malloc(caches * sizeof(float)), calloc(floats ? floats : 1, sizeof(float)),
                     calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(double)),
                     calloc(caches, sizeof(iris_alpha_learner)), NULL, NULL, NULL,
-                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t)), NULL};
+                    calloc(caches, sizeof(uint32_t)), calloc(caches, sizeof(uint32_t)), NULL,
+                    calloc(2 * caches, sizeof(double)), calloc(caches, sizeof(uint32_t))};
   const bool learn_nee = p->light_samples && g->lights.count != NULL && g->lights.tree != NULL;
   if (learn_nee) ts.nee = calloc(caches * IRIS_LIGHT_SELECT_NEE_SLOTS, sizeof *ts.nee);
   if (ts.radiance_photons)
@@ -313,7 +367,7 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   sample_buffer *buf = calloc(TRAIN_BATCH_TILES, sizeof *buf);
   iris_status st = IRIS_OK;
   if (!ts.radiance_photons || !ts.acc || !ts.n || !ts.irr || !ts.learner || !hist || !buf || !ts.light_tries ||
-      !ts.light_lit || (learn_nee && !ts.nee) ||
+      !ts.light_lit || (learn_nee && !ts.nee) || !ts.portal_m || !ts.portal_n ||
       (subs && (!ts.fine_acc || !ts.fine_n || !ts.photon_sub)))
     st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the training passes");
 
@@ -393,6 +447,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   if (st == IRIS_OK && p->light_min < 1.0f)
     for (size_t i = 0; i < caches; ++i)
       if (ts.light_tries[i] >= LIGHT_MIN_TRIES && ts.light_lit[i] == 0) g->caches[i].light = p->light_min;
+  /* Portals: which stay, from all passes' samples (the candidates too, until now) */
+  if (st == IRIS_OK) settle_portals(g, ts.portal_m, ts.portal_n);
   /* The learned light tables again, now with what the light samples brought */
   if (st == IRIS_OK && learn_nee) iris_light_select_learn_nee(&g->lights, ts.nee, ts.light_tries, ts.light_lit);
   for (int t = 0; t < TRAIN_BATCH_TILES && buf; ++t) free(buf[t].s);
@@ -409,6 +465,8 @@ iris_status iris_guiding_train(iris_guiding *g, const iris_guide_setup *s, iris_
   free(ts.light_tries);
   free(ts.light_lit);
   free(ts.nee);
+  free(ts.portal_m);
+  free(ts.portal_n);
   free(g->photon_hist);
   g->photon_hist = NULL;
   g->stats.train_spp = done;

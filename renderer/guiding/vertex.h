@@ -30,6 +30,8 @@ typedef struct iris_guide_vertex_state {
   iris_guide_lamp spot;                 /* the glint spot seen from p (glints.h) */
   float portal;                         /* probability of a portal sample, before the rest (portal.h) */
   uint8_t portal_of;                    /* the tied cache (index into ids) whose portal; 0xff: none */
+  uint8_t portal_faces;                 /* bit i: tied cache i has a portal that faces the vertex (what
+                                           training weighs: train.c, "Portals kept by training") */
 } iris_guide_vertex_state;
 _Static_assert(sizeof(iris_guide_vertex_state) <= IRIS_GUIDE_VERTEX_BYTES, "guide vertex state too large");
 
