@@ -155,8 +155,10 @@ typedef struct iris_cache {
                         [IRIS_GLINT_SHARE_MIN, IRIS_GLINT_SHARE_MAX]; else 0 ("Glints"); with
                         the shares above <= 1 */
   iris_portal portal;  /* the opening its indirect light came through (portal.h); none: u = v = 0 */
-  float portal_weight; /* the share of its indirect photon energy in the cone the portal was
-                          looked for in (a vertex takes its tied caches' heaviest portal) */
+  float portal_weight; /* a finder's: the share of its indirect photon energy in the cone the
+                          portal was looked for in; a cache that took a joined opening: the share
+                          of its map's light through it (iris_portal_share); training keeps or
+                          drops each portal (train.c); a vertex takes its tied caches' heaviest */
   uint8_t lamp[IRIS_CACHE_LAMPS]; /* index into iris_guiding.lamps */
   uint8_t sphere;    /* full-sphere map (transmissive surface) */
   uint8_t from_camera;
