@@ -8,6 +8,8 @@
 # geometric mean net of the reference's own relMSE, and the ratio BASE / NEW.
 # NEW_ARGS / BASE_ARGS in the environment: extra `iris render` options of
 # each side (NEW and BASE may then be one build: bench/guiding/portal_ab.sh).
+# BUDGET=spp in the environment: TIMES are samples per pixel instead (`--spp`,
+# error per sample: deterministic, free of the machine's speed).
 # usage: bench/guiding/ab_builds.sh NEW BASE REFDIR "TIMES" "SEEDS" [METHOD [SCENE...]]
 #   e.g. git worktree add /tmp/base HEAD~1 && cmake -S /tmp/base -B /tmp/base/build -DCMAKE_BUILD_TYPE=Release &&
 #        cmake --build /tmp/base/build --target iris relmse &&
@@ -34,18 +36,20 @@ for sc in $SCENES; do
     for s in $SEEDS; do
       for v in new base; do
         if [ "$v" = new ]; then b=$N; extra=${NEW_ARGS:-}; else b=$B; extra=${BASE_ARGS:-}; fi
+        if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t"; else budget="--time $t --time-total"; fi
         # shellcheck disable=SC2086
-        "$b/tools/iris" render "$sc" --method "$METHOD" --time "$t" --time-total --width "$W" --height 72 --threads 2 \
+        "$b/tools/iris" render "$sc" --method "$METHOD" $budget --width "$W" --height 72 --threads 2 \
           --seed "$s" $extra -o "$OUT/img.exr" > /dev/null 2>&1
         val=$("$N/bench/render/relmse" "$OUT/img.exr" "$ref")
         if [ "$v" = new ]; then new="$new $val"; else base="$base $val"; fi
       done
     done
-    echo "$new|$base" | awk -v t="$t" -v own="$own" -v nl="${NEW_LABEL:-new}" -v bl="${BASE_LABEL:-base}" -F'|' '
+    unit=s; [ "${BUDGET:-time}" = spp ] && unit=spp
+    echo "$new|$base" | awk -v t="$t" -v unit="$unit" -v own="$own" -v nl="${NEW_LABEL:-new}" -v bl="${BASE_LABEL:-base}" -F'|' '
       function geo(s,   n, i, a, p) { n = split(s, a, " "); p = 0; for (i = 1; i <= n; i++) p += log(a[i]); return exp(p / n) }
       { g1 = geo($1); g0 = geo($2)
-        printf "  %s s %s:%s  geo %.4g (net %.4g)\n", t, nl, $1, g1, g1 - own
-        printf "  %s s %s:%s  geo %.4g (net %.4g)\n", t, bl, $2, g0, g0 - own
-        printf "  %s s gain (net): %.2fx\n", t, (g0 - own) / (g1 - own) }'
+        printf "  %s %s %s:%s  geo %.4g (net %.4g)\n", t, unit, nl, $1, g1, g1 - own
+        printf "  %s %s %s:%s  geo %.4g (net %.4g)\n", t, unit, bl, $2, g0, g0 - own
+        printf "  %s %s gain (net): %.2fx\n", t, unit, (g0 - own) / (g1 - own) }'
   done
 done

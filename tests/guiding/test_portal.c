@@ -105,7 +105,7 @@ static iris_guiding *build_trained(const iris_scene *sc, test_guide_scene *t, bo
   return test_guide_build_in(sc, t, gp, 7, threads, 16);
 }
 
-/* Without training (16 spp: its 5% rounds to none), as a short render builds it. */
+/* Without training (train_spp 0), as a short render builds it (16 spp: its 5% rounds to none). */
 static iris_guiding *build(const iris_scene *sc, test_guide_scene *t, bool portals, int threads) {
   return build_trained(sc, t, portals, threads, 0);
 }
