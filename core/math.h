@@ -57,7 +57,13 @@ static inline iris_vec3 iris_normalize(iris_vec3 a) {
   float l = iris_length(a);
   return l > 0.0f ? iris_scale(a, 1.0f / l) : a;
 }
-static inline float iris_max3(iris_vec3 a) { return fmaxf(a.x, fmaxf(a.y, a.z)); }
+/* fmaxf / fminf inline: glibc's x86-64 versions are calls (its maxss/minss
+ * need a NaN fix-up that GCC inlines only under -ffinite-math-only). Same
+ * results as those: a NaN operand yields the other one, and equal operands
+ * (+0 and -0) yield b, as maxss/minss do. */
+static inline float iris_fmaxf(float a, float b) { return (a > b || b != b) ? a : b; }
+static inline float iris_fminf(float a, float b) { return (a < b || b != b) ? a : b; }
+static inline float iris_max3(iris_vec3 a) { return iris_fmaxf(a.x, iris_fmaxf(a.y, a.z)); }
 static inline float iris_avg3(iris_vec3 a) { return (a.x + a.y + a.z) * (1.0f / 3.0f); }
 static inline bool iris_isfinite3(iris_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 static inline float iris_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }

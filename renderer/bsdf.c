@@ -664,7 +664,7 @@ iris_bsdf iris_bsdf_from_material(const iris_material *mat, iris_vec3 color, flo
   /* Cycles clamps the Glass IOR to >= 1e-5; an unset (0) IOR gets the node
    * default (Glass 1.45) or the glTF default (1.5). */
   float default_ior = mat->type == IRIS_MATERIAL_GLASS ? 1.45f : 1.5f;
-  b.ior = (isfinite(mat->ior) && mat->ior > 0.0f) ? fmaxf(mat->ior, 1e-5f) : default_ior;
+  b.ior = (isfinite(mat->ior) && mat->ior > 0.0f) ? iris_fmaxf(mat->ior, 1e-5f) : default_ior;
   b.metallic = iris_clampf(isfinite(metallic) ? metallic : 0.0f, 0.0f, 1.0f);
   b.specular = sanitize1(mat->specular);
   b.specular_color = color_from(mat->specular_color);

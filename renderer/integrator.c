@@ -560,7 +560,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (est >= 0.0f && !(pixel_estimate > 0.0f))
       pixel_estimate = iris_avg3(L) + iris_avg3(beta_before) * est;
     if (bounce + 1 >= it->rr_depth && !aimed) {
-      float q = fminf(1.0f, sqrtf(iris_max3(beta)));
+      float q = iris_fminf(1.0f, sqrtf(iris_max3(beta)));
       if (est >= 0.0f && pixel_estimate > 0.0f)
         q = iris_clampf(RR_WINDOW * iris_max3(beta_before) * est / pixel_estimate, 0.1f * q, 1.0f);
       if (iris_sampler_slot(rng, IRIS_SLOT_RR) >= q) break;

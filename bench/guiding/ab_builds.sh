@@ -9,7 +9,10 @@
 # NEW_ARGS / BASE_ARGS in the environment: extra `iris render` options of
 # each side (NEW and BASE may then be one build: bench/guiding/portal_ab.sh).
 # BUDGET=spp in the environment: TIMES are samples per pixel instead (`--spp`,
-# error per sample: deterministic, free of the machine's speed).
+# error per sample: deterministic, free of the machine's speed); then also each
+# build's rays per image sample (closest-hit and shadow rays of the whole
+# render, the guide's training passes included, from `--json`) and the ratio
+# of net relMSE x rays per sample, a per-unit-of-work measure free of the clock.
 # usage: bench/guiding/ab_builds.sh NEW BASE REFDIR "TIMES" "SEEDS" [METHOD [SCENE...]]
 #   e.g. git worktree add /tmp/base HEAD~1 && cmake -S /tmp/base -B /tmp/base/build -DCMAKE_BUILD_TYPE=Release &&
 #        cmake --build /tmp/base/build --target iris relmse &&
@@ -32,16 +35,18 @@ for sc in $SCENES; do
   own=$("$N/bench/render/relmse" --own "$ref")
   echo "$sc ($METHOD): reference $ref, own relMSE $own"
   for t in $TIMES; do
-    new=""; base=""
+    new=""; base=""; new_rays=""; base_rays=""
     for s in $SEEDS; do
       for v in new base; do
         if [ "$v" = new ]; then b=$N; extra=${NEW_ARGS:-}; else b=$B; extra=${BASE_ARGS:-}; fi
-        if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t"; else budget="--time $t --time-total"; fi
+        if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t --json"; else budget="--time $t --time-total"; fi
         # shellcheck disable=SC2086
         "$b/tools/iris" render "$sc" --method "$METHOD" $budget --width "$W" --height 72 --threads 2 \
-          --seed "$s" $extra -o "$OUT/img.exr" > /dev/null 2>&1
+          --seed "$s" $extra -o "$OUT/img.exr" > "$OUT/run.json" 2>/dev/null
         val=$("$N/bench/render/relmse" "$OUT/img.exr" "$ref")
-        if [ "$v" = new ]; then new="$new $val"; else base="$base $val"; fi
+        rays=$(awk -F: '/"rays":/ { r = $2 + 0 } /"samples":/ { n = $2 + 0 } END { if (n > 0) printf "%.4f", r / n; else print 0 }' \
+          "$OUT/run.json" | tr -d ',')
+        if [ "$v" = new ]; then new="$new $val"; new_rays="$new_rays $rays"; else base="$base $val"; base_rays="$base_rays $rays"; fi
       done
     done
     unit=s; [ "${BUDGET:-time}" = spp ] && unit=spp
@@ -51,5 +56,12 @@ for sc in $SCENES; do
         printf "  %s %s %s:%s  geo %.4g (net %.4g)\n", t, unit, nl, $1, g1, g1 - own
         printf "  %s %s %s:%s  geo %.4g (net %.4g)\n", t, unit, bl, $2, g0, g0 - own
         printf "  %s %s gain (net): %.2fx\n", t, unit, (g0 - own) / (g1 - own) }'
+    if [ "${BUDGET:-time}" = spp ]; then
+      echo "$new|$base|$new_rays|$base_rays" | awk -v own="$own" -F'|' '
+        function geo(s,   n, i, a, p) { n = split(s, a, " "); p = 0; for (i = 1; i <= n; i++) p += log(a[i]); return exp(p / n) }
+        { r1 = geo($3); r0 = geo($4)
+          printf "  rays per sample: new %.3f, base %.3f; per unit of work (net relMSE x rays): %.2fx\n",
+                 r1, r0, ((geo($2) - own) * r0) / ((geo($1) - own) * r1) }'
+    fi
   done
 done

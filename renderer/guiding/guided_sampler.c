@@ -22,7 +22,7 @@ int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t 
   float best = -2.0f;
   for (uint32_t i = 0; i < m; ++i) {
     cosv[i] = iris_dot(g->caches[near[i]].frame.n, n);
-    best = fmaxf(best, cosv[i]);
+    best = iris_fmaxf(best, cosv[i]);
   }
   if (!(best > g->params.cos_min)) return 0;
   int count = 0;
@@ -46,13 +46,15 @@ float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, 
 float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
   if (sp->delta) return 0.0f;
   float r = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
-  return fminf(r, g->params.alpha_max);
+  return iris_fminf(r, g->params.alpha_max);
 }
 
 static void guided_prepare(void *ctx, iris_shading_point *sp) {
   const iris_guiding *g = ctx;
   iris_guide_vertex_state *v = (iris_guide_vertex_state *)sp->guide.bytes;
-  v->alpha = iris_guiding_alpha(g, sp);
+  /* iris_guiding_alpha, with the roughness kept for the learned alpha below */
+  const float rough = sp->delta ? 0.0f : iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
+  v->alpha = sp->delta ? 0.0f : iris_fminf(rough, g->params.alpha_max);
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
   if (v->m == 0) v->alpha = 0.0f;
   v->radiance = -1.0f;
@@ -77,7 +79,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
       /* the sky through a pane: the plane of the tied cache with the largest share */
       if (c->pane_share > pane) pane = c->pane_share, v->pane = (uint8_t)i;
       sky += c->pane_share;
-      light = fmaxf(light, c->light); /* any tied cache that saw light arrive keeps it sampled */
+      light = iris_fmaxf(light, c->light); /* any tied cache that saw light arrive keeps it sampled */
       sky += c->sky_through;
       for (int k = 0; k < IRIS_CACHE_LAMPS; ++k) lamp += c->lamp_share[k];
       glint += c->glint_share;
@@ -92,14 +94,13 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
     /* Lamps behind glass: the same for light that came straight through
      * glass from a lamp, which the lamp's cone finds; one mixture with the
      * sky's (the shares are of the same photons: they sum to at most 1). */
-    v->lamp = fminf(lamp / (float)v->m, 1.0f - v->sky);
+    v->lamp = iris_fminf(lamp / (float)v->m, 1.0f - v->sky);
     /* Glints: where the tied caches lie among glint photons, the spot the
      * vertex's nearest ones left (glints.h), if they agree on one. */
     if (glint > 0.0f && iris_glints_spot(&g->glints, v->p, sp->frame.n, &v->spot))
-      v->glint = fmaxf(0.0f, fminf(glint / (float)v->m, 1.0f - v->sky - v->lamp));
-    const float rough = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
+      v->glint = iris_fmaxf(0.0f, iris_fminf(glint / (float)v->m, 1.0f - v->sky - v->lamp));
     const float a_free = learned == v->m ? a / (float)v->m : g->params.alpha_max;
-    if (learned == v->m) v->alpha = fminf(rough, a_free);
+    if (learned == v->m) v->alpha = iris_fminf(rough, a_free);
     /* Behind glass, the lobe's roughness caps only the caches' part: their
      * texels cannot follow a glossy lobe, but the map through glass and a
      * lamp's cone are exact directions that stand in for light sampling,
@@ -109,7 +110,7 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
      * far lower there). Glints keep the cap: light sampling still reaches
      * their light. docs/guiding.md, "Glass seen from glossy vertices". */
     const float exact = v->sky + v->lamp;
-    const float a_exact = isfinite(rough) ? fmaxf(a_free, g->params.alpha_max) : a_free;
+    const float a_exact = isfinite(rough) ? iris_fmaxf(a_free, g->params.alpha_max) : a_free;
     if (exact > 0.0f && a_exact > v->alpha) {
       const float total = v->alpha * (1.0f - exact) + a_exact * exact;
       v->sky *= a_exact / total;
