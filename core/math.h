@@ -59,8 +59,10 @@ static inline iris_vec3 iris_normalize(iris_vec3 a) {
 }
 /* fmaxf / fminf inline: glibc's x86-64 versions are calls (its maxss/minss
  * need a NaN fix-up that GCC inlines only under -ffinite-math-only). Same
- * results as those: a NaN operand yields the other one, and equal operands
- * (+0 and -0) yield b, as maxss/minss do. */
+ * results as those for every float but a signalling NaN (which no arithmetic
+ * produces; glibc returns a NaN for it): a quiet NaN operand yields the other
+ * one, and equal operands (+0 and -0) yield b, as maxss/minss do
+ * (tests/core/test_math.c checks it against libm bit for bit). */
 static inline float iris_fmaxf(float a, float b) { return (a > b || b != b) ? a : b; }
 static inline float iris_fminf(float a, float b) { return (a < b || b != b) ? a : b; }
 static inline float iris_max3(iris_vec3 a) { return iris_fmaxf(a.x, iris_fmaxf(a.y, a.z)); }
