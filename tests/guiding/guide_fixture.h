@@ -17,6 +17,7 @@
 #include "renderer/lights.h"
 #include "renderer/render.h"
 #include "renderer/texture.h"
+#include "scenes/builtin.h"
 
 /* A scene set up for rendering by hand (a 48x36 camera): what
  * test_guide_build uses and frees, kept for tests that trace paths with the
@@ -48,6 +49,19 @@ static inline bool test_guide_scene_open(const iris_scene *s, iris_method method
   }
   fprintf(stderr, "scene set-up failed: %s\n", err.message);
   test_guide_scene_close(t);
+  return false;
+}
+
+/* The built-in scene `name` in *sc, opened as test_guide_scene_open does:
+ * both checked (CHECK), and on failure nothing is left to free. */
+static inline bool test_guide_builtin_open(const char *name, iris_method method, iris_scene **sc,
+                                           test_guide_scene *t) {
+  iris_error err;
+  *sc = NULL;
+  if (!CHECK(iris_builtin_create(name, sc, &err) == IRIS_OK)) return false;
+  if (CHECK(test_guide_scene_open(*sc, method, t))) return true;
+  iris_scene_destroy(*sc);
+  *sc = NULL;
   return false;
 }
 

@@ -132,12 +132,8 @@ static void test_env_spheres(void) {
   iris_scene *sc = NULL;
   iris_error err;
   iris_error_clear(&err);
-  if (!CHECK(iris_builtin_create("env-spheres", &sc, &err) == IRIS_OK)) return;
   test_guide_scene t;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return;
-  }
+  if (!test_guide_builtin_open("env-spheres", IRIS_METHOD_GUIDED_NEE, &sc, &t)) return;
   const iris_vec3 sun = sun_direction(t.lights.envmap);
   iris_guiding *g = build(sc, &t, true, 2);
   if (!CHECK(g != NULL)) goto done;

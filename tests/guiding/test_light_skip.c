@@ -53,13 +53,8 @@ static learned learn(const char *scene, float light_min, int train_spp, int thre
   learned l;
   memset(&l, 0, sizeof l);
   iris_scene *sc = NULL;
-  iris_error err;
   test_guide_scene t;
-  if (!CHECK(iris_builtin_create(scene, &sc, &err) == IRIS_OK)) return l;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return l;
-  }
+  if (!test_guide_builtin_open(scene, IRIS_METHOD_GUIDED_NEE, &sc, &t)) return l;
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
   gp.train_spp = train_spp;
@@ -145,13 +140,8 @@ static double z_of(double s1, double q1, double s2, double q2, double n) {
 
 static void test_unbiased(const char *scene, int spp) {
   iris_scene *sc = NULL;
-  iris_error err;
   test_guide_scene t;
-  if (!CHECK(iris_builtin_create(scene, &sc, &err) == IRIS_OK)) return;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return;
-  }
+  if (!test_guide_builtin_open(scene, IRIS_METHOD_GUIDED_NEE, &sc, &t)) return;
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
   iris_guiding *g = test_guide_build_in(sc, &t, gp, 3, 2, 64);

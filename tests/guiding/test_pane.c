@@ -153,13 +153,8 @@ static const iris_vec3 GLOSSY_C = {-0.8f, 0.5f, -0.9f};
 
 static void test_glossy_vertex(void) {
   iris_scene *sc = NULL;
-  iris_error err;
-  if (!CHECK(iris_builtin_create("sky-room-pane", &sc, &err) == IRIS_OK)) return;
   test_guide_scene t;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return;
-  }
+  if (!test_guide_builtin_open("sky-room-pane", IRIS_METHOD_GUIDED_NEE, &sc, &t)) return;
   iris_guiding_params gp = iris_guiding_params_default();
   gp.force = true;
   iris_guiding *g = test_guide_build_in(sc, &t, gp, 5, 2, 64); /* trained: the caches learn alpha */

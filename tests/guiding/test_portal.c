@@ -144,12 +144,8 @@ static int check_portals(const iris_guiding *g, double *cover) {
 static void test_door(void) {
   iris_scene *sc = NULL;
   iris_error err;
-  if (!CHECK(iris_builtin_create("door", &sc, &err) == IRIS_OK)) return;
   test_guide_scene t;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return;
-  }
+  if (!test_guide_builtin_open("door", IRIS_METHOD_GUIDED_NEE, &sc, &t)) return;
   iris_guiding *g = build(sc, &t, true, 1);
   if (!CHECK(g != NULL)) {
     test_guide_scene_close(&t);
@@ -246,13 +242,8 @@ static void test_door(void) {
  * training also weighs every candidate that the rule without it refuses. */
 static void test_trained_drop(void) {
   iris_scene *sc = NULL;
-  iris_error err;
-  if (!CHECK(iris_builtin_create("corridor-rooms", &sc, &err) == IRIS_OK)) return;
   test_guide_scene t;
-  if (!CHECK(test_guide_scene_open(sc, IRIS_METHOD_GUIDED_NEE, &t))) {
-    iris_scene_destroy(sc);
-    return;
-  }
+  if (!test_guide_builtin_open("corridor-rooms", IRIS_METHOD_GUIDED_NEE, &sc, &t)) return;
   iris_guiding *g0 = build(sc, &t, true, 2), *g1 = build_trained(sc, &t, true, 2, 8);
   if (CHECK(g0 != NULL && g1 != NULL)) {
     printf("corridor-rooms: %llu caches with a portal without training, %llu with 8 spp of it\n",
