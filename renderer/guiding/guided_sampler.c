@@ -43,16 +43,11 @@ float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, 
   return m > 0 ? sum / (float)m : 0.0f;
 }
 
-float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp) {
-  if (sp->delta) return 0.0f;
-  float r = iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
-  return iris_fminf(r, g->params.alpha_max);
-}
-
 static void guided_prepare(void *ctx, iris_shading_point *sp) {
   const iris_guiding *g = ctx;
   iris_guide_vertex_state *v = (iris_guide_vertex_state *)sp->guide.bytes;
-  /* iris_guiding_alpha, with the roughness kept for the learned alpha below */
+  /* cache-sampling probability alpha = min(roughness, alpha_max), 0 at a delta
+   * BSDF; the roughness is kept for the learned alpha below */
   const float rough = sp->delta ? 0.0f : iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
   v->alpha = sp->delta ? 0.0f : iris_fminf(rough, g->params.alpha_max);
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;

@@ -247,8 +247,6 @@ int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t 
 /* Solid-angle density of cache sampling for world direction wi at a point
  * with picked caches ids[0..m). */
 float iris_guiding_cache_pdf(const iris_guiding *g, const uint32_t *ids, int m, iris_vec3 wi);
-/* Cache-sampling probability alpha = min(roughness, alpha_max) at a shading point. */
-float iris_guiding_alpha(const iris_guiding *g, const iris_shading_point *sp);
 
 /* Builds the guide from `options` (an iris_guiding_params, NULL = defaults)
  * for iris_render; destroy frees it. */
