@@ -58,11 +58,16 @@ def main():
     if len(sys.argv) != 4:
         sys.exit(__doc__)
     iris, outdir, shared = sys.argv[1:]
+    env = os.path.join(shared, "assets", "env", "immenstadter_horn_1k.hdr")
+    if not os.path.isfile(env):  # before anything is written
+        sys.exit(f"env_spheres_glass.py: {env}: no such environment map (SHARED_DIR is the shared folder)")
     os.makedirs(outdir, exist_ok=True)
     obj, mtl, scene = (os.path.join(outdir, n) for n in ("spheres.obj", "spheres.mtl", "esg.json"))
     write_obj(obj, mtl)
-    env = os.path.join(shared, "assets", "env", "immenstadter_horn_1k.hdr")
-    subprocess.run([iris, "import", obj, "-o", scene, "--env", env], check=True)
+    if subprocess.run([iris, "import", obj, "-o", scene, "--env", env]).returncode != 0:
+        for f in (obj, mtl):
+            os.remove(f)
+        sys.exit(f"env_spheres_glass.py: {iris} import failed (its message above); nothing written")
     with open(scene) as f:
         s = json.load(f)
     s["cameras"] = [{"name": "camera", "position": [0, 1.4, 6.5], "target": [0, 0.7, 0], "up": [0, 1, 0],
