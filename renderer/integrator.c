@@ -554,8 +554,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
      * q = RR_WINDOW * beta_before_this_bounce * est / pixel_estimate, clamped
      * to [0.1 q_plain, 1]: a path is not killed for following the guide (which
      * lowers beta) nor in bright regions, and is killed early where little
-     * light is left (docs/guiding.md, "Russian roulette"). Any q in (0, 1]
-     * with beta / q keeps the estimator unbiased. */
+     * light is left (docs/guiding.md, "Russian roulette"). At a delta vertex
+     * (glass, a mirror) they have no estimate, and beta there still holds the
+     * last guided vertex's density, which the plain rule would punish: the
+     * roulette looks only at what the vertex itself takes,
+     * q = min(1, sqrt(max beta / max beta_before)) (clear glass: 1).
+     * Any q in (0, 1] with beta / q keeps the estimator unbiased. */
     float est = adjoint_rr ? it->guide.radiance_estimate(it->guide.ctx, &sp) : -1.0f;
     if (est >= 0.0f && !(pixel_estimate > 0.0f))
       pixel_estimate = iris_avg3(L) + iris_avg3(beta_before) * est;
@@ -563,6 +567,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       float q = iris_fminf(1.0f, sqrtf(iris_max3(beta)));
       if (est >= 0.0f && pixel_estimate > 0.0f)
         q = iris_clampf(RR_WINDOW * iris_max3(beta_before) * est / pixel_estimate, 0.1f * q, 1.0f);
+      else if (adjoint_rr && sp.delta)
+        q = iris_fminf(1.0f, sqrtf(iris_max3(beta) / iris_max3(beta_before)));
       if (iris_sampler_slot(rng, IRIS_SLOT_RR) >= q) break;
       beta = iris_scale(beta, 1.0f / q);
     }
