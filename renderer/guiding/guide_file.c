@@ -390,6 +390,7 @@ static bool get_stats(reader *r, iris_guiding_stats *s) {
   s->indirect_share = get_f64(r);
   s->seen_indirect_energy = get_f64(r);
   s->pilot_share = -1.0;
+  s->caustic_share = -1.0;
   uint8_t skipped = get_u8(r);
   if (!(s->indirect_share >= -1.0 && s->indirect_share <= 1.0) ||
       !(s->seen_indirect_energy >= -1.0 && s->seen_indirect_energy <= 1.0))

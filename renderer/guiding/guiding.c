@@ -827,6 +827,29 @@ static void skip(iris_guiding *g, const char *why) {
   snprintf(g->stats.reason, sizeof g->stats.reason, "%s", why);
 }
 
+#define CAUSTIC_MIN 16 /* photons focused through glass that keep the guide */
+#define CAUSTIC_SHARE_MIN 0.1 /* ... carrying this share of the indirect photon energy */
+
+/* Light focused through glass onto what the guide serves (caustic photons:
+ * delta vertices only from the light, one of them a refraction) is light
+ * that light sampling cannot reach and the caches can, however little of the
+ * scene's light is indirect: where CAUSTIC_MIN such photons carry at least
+ * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
+ * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
+ * The stats then hold that share. */
+static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) {
+  size_t n = 0;
+  double caustic = 0.0, indirect = 0.0;
+  for (size_t i = 0; i < photons->count; ++i) {
+    const iris_photon *ph = &photons->photons[i];
+    if (ph->bounce > 0) indirect += ph->energy;
+    if (ph->caustic) caustic += ph->energy, n++;
+  }
+  if (!(n >= CAUSTIC_MIN && caustic >= CAUSTIC_SHARE_MIN * indirect)) return false;
+  g->stats.caustic_share = caustic / indirect;
+  return true;
+}
+
 /* --method auto only (s->deciding; an explicit guided-nee is built anyway):
  * skips the guide where what the camera sees is lit mostly directly, on the
  * first photons it is given (the pilot's, or the full pass's without one). */
@@ -834,6 +857,7 @@ static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris
   if (!s->deciding || g->params.force || g->stats.seen_indirect_energy >= 0.0) return false;
   g->stats.seen_indirect_energy = seen_indirect_energy(s, photons);
   if (!(g->stats.seen_indirect_energy >= 0.0 && g->stats.seen_indirect_energy < IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN)) return false;
+  if (keeps_for_caustics(g, photons)) return false;
   char why[160];
   snprintf(why, sizeof why, "what the camera sees is lit mostly directly: %.0f%% of its photon energy indirect (< %.0f%%)",
            100.0 * g->stats.seen_indirect_energy, 100.0 * IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN);
@@ -912,7 +936,8 @@ static iris_status pilot(iris_guiding *g, const iris_guide_setup *s, int stride,
   g->stats.pilot_paths = photons->paths;
   g->stats.pilot_share = indirect_share(s, photons);
   g->stats.pilot_seconds = iris_time_now() - t0;
-  if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN && !keeps_for_glints(g, s, photons)) {
+  if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN && !keeps_for_glints(g, s, photons) &&
+      !keeps_for_caustics(g, photons)) {
     char why[160];
     snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons in a %llu-path pilot",
              100.0 * g->stats.pilot_share, (unsigned long long)photons->paths);
@@ -957,7 +982,8 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
    * sampling's job; there the guide costs more per sample than it saves
    * (docs/guiding.md, benchmark). Door 75%, Cornell 65%. */
   g->stats.indirect_share = indirect_share(s, &photons);
-  if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN && !keeps_for_glints(g, s, &photons)) {
+  if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN && !keeps_for_glints(g, s, &photons) &&
+      !keeps_for_caustics(g, &photons)) {
     iris_photons_destroy(&photons);
     char why[160];
     snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons",
@@ -1199,7 +1225,7 @@ iris_status iris_guiding_build(const iris_guide_setup *setup, const iris_guiding
   g->stats.cache_k = g->params.cache_k;
   g->stats.camera_stride = stride;
   g->stats.pdf_floor = g->params.pdf_floor;
-  g->stats.pilot_share = g->stats.indirect_share = g->stats.seen_indirect_energy = -1.0;
+  g->stats.pilot_share = g->stats.indirect_share = g->stats.seen_indirect_energy = g->stats.caustic_share = -1.0;
   g->env = setup->lights->envmap; /* training samples the sky behind glass */
   st0 = copy_lamps(g, setup->lights, err);
   if (st0 != IRIS_OK) {

@@ -183,6 +183,9 @@ typedef struct iris_guiding_stats {
   uint64_t pilot_paths;   /* photon paths of the pilot (0: none ran) */
   double pilot_share;     /* share of indirect photons the 30% rule saw in the pilot (-1: none) */
   double indirect_share;  /* ... and in the full pass (-1: the full pass did not run) */
+  double caustic_share;   /* the share of the indirect photon energy focused through glass
+                             where that kept the guide against the "lit mostly directly"
+                             rules, else -1 (docs/guiding.md, "--method auto") */
   double pilot_seconds;
 } iris_guiding_stats;
 

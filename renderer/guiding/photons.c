@@ -121,6 +121,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
   float pane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
   bool smooth_reflected = false; /* the last vertex reflected it off a smooth surface ("Glints") */
   int smooth_seen = 0;           /* smooth vertices recorded as glint targets */
+  bool delta_only = true, refracted = false; /* the vertices so far (iris_photon.caustic) */
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
     /* the emission's numbers come first: bounce b draws layout bounce b + 1 */
     iris_sampler_set_bounce(&rng, bounce + 1);
@@ -147,7 +148,9 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       const bool paned = specular_only && deltas == 1 && !straight && pane[3] > 0.0f;
       for (int k = 0; k < 4; ++k) ph.pane[k] = paned ? pane[k] : 0.0f;
       ph.glint = smooth_reflected && !ph.sky_through && !ph.lamp_through && !paned;
+      ph.caustic = delta_only && refracted;
       block_push(out, &ph);
+      delta_only = false;
       specular_only = lamp_only = false;
     }
     const bool smooth = iris_photon_smooth(&sp);
@@ -158,6 +161,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
     smooth_reflected = smooth && !(ds.lobe & IRIS_LOBE_TRANSMISSION);
+    refracted |= sp.delta && (ds.lobe & IRIS_LOBE_TRANSMISSION);
     if (sp.delta && specular_only && ++deltas == 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION) && sp.bsdf.ior > 0.0f &&
         sp.bsdf.ior != 1.0f) {
       /* n on the side the photon came from (the sky's); entering the

@@ -34,6 +34,9 @@ typedef struct iris_photon {
   float energy;     /* mean of the RGB photon power */
   uint8_t bounce;   /* 0: straight from the light (direct illumination) */
   uint8_t transmits : 1; /* the surface has transmission lobes (full-sphere cache) */
+  uint8_t caustic : 1;   /* it left its light through delta vertices only, one of them at least
+                            a refraction: light focused through glass, which light sampling
+                            cannot find ("--method auto", caustics) */
   uint8_t glint : 1;     /* its last vertex reflected it off a smooth surface (iris_photon_smooth),
                             and it is none of the kinds below: the light glint spots find (glints.h) */
   uint8_t sky_through; /* from the environment map after delta vertices only (bounce > 0),

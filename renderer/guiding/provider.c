@@ -62,6 +62,11 @@ void iris_guiding_describe(const iris_guiding *g, char *buf, size_t size) {
     size_t l = strlen(sky);
     snprintf(sky + l, sizeof sky - l, "; portals: %llu caches", (unsigned long long)s->portal_caches);
   }
+  if (s->caustic_share >= 0.0) { /* "--method auto": light focused through glass kept the guide */
+    size_t l = strlen(sky);
+    snprintf(sky + l, sizeof sky - l, "; kept for light focused through glass (%.0f%% of the indirect photon energy)",
+             100.0 * s->caustic_share);
+  }
   /* caches where light sampling became optional ("Light sampling where no light arrives") */
   size_t dark = 0;
   for (size_t i = 0; i < g->cache_count; ++i) dark += g->caches[i].light < 1.0f;
