@@ -95,9 +95,11 @@ static void test_decisions(void) {
       {"stress-thin-walls", IRIS_METHOD_GUIDED_NEE, "the race: guided-nee"},
       /* 28% indirect photons, but 29% of their energy focused through the
        * glass sphere: light only the guide finds, so the race decides. At this
-       * test's 32 x 24 (24 caches, no training at 1 spp) it measures
-       * guided-nee's tail and says mis; at 96 x 72 and 4 s it chooses
-       * guided-nee, 2.3x mis there (docs/guiding.md, "--method auto") */
+       * test's 32 x 24 and 1 spp (no training) its paths happen to hold a few
+       * of the caustic's fireflies (floor -> glass -> the 10 cm lamp, drawn by
+       * the BSDF or the caches) on guided-nee's side and it says mis; at 96 x
+       * 72 and 4 s auto chooses guided-nee, 2.4x mis there (docs/guiding.md,
+       * "--method auto") */
       {"stress-caustic", IRIS_METHOD_MIS, "the race: guided-nee 0."},
       {"veach-mis", IRIS_METHOD_MIS, "lit mostly directly"},
       {"furnace-diffuse", IRIS_METHOD_MIS, "lit mostly directly"},
