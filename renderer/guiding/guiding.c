@@ -837,16 +837,27 @@ static void skip(iris_guiding *g, const char *why) {
  * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
  * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
  * The stats then hold that share. */
-static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) {
-  size_t n = 0;
-  double caustic = 0.0, indirect = 0.0;
+/* Photons of one mark (glint or caustic): how many, their energy, and the
+ * energy of all indirect photons, which the keep rules compare it with. */
+typedef struct marked_photons {
+  size_t n;
+  double energy, indirect;
+} marked_photons;
+
+static marked_photons count_marked(const iris_photon_map *photons, bool caustic) {
+  marked_photons m = {0, 0.0, 0.0};
   for (size_t i = 0; i < photons->count; ++i) {
     const iris_photon *ph = &photons->photons[i];
-    if (ph->bounce > 0) indirect += ph->energy;
-    if (ph->caustic) caustic += ph->energy, n++;
+    if (ph->bounce > 0) m.indirect += ph->energy;
+    if (caustic ? ph->caustic : ph->glint) m.energy += ph->energy, m.n++;
   }
-  if (!(n >= CAUSTIC_MIN && caustic >= CAUSTIC_SHARE_MIN * indirect)) return false;
-  g->stats.caustic_share = caustic / indirect;
+  return m;
+}
+
+static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) {
+  marked_photons m = count_marked(photons, true);
+  if (!(m.n >= CAUSTIC_MIN && m.energy >= CAUSTIC_SHARE_MIN * m.indirect)) return false;
+  g->stats.caustic_share = m.energy / m.indirect;
   return true;
 }
 
@@ -875,14 +886,8 @@ static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris
  * ("Glints"). `auto` decides by its rules. */
 static bool keeps_for_glints(const iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons) {
   if (!g->params.glints || s->deciding) return false;
-  size_t glinted = 0;
-  double glint_energy = 0.0, indirect = 0.0;
-  for (size_t i = 0; i < photons->count; ++i) {
-    const iris_photon *ph = &photons->photons[i];
-    if (ph->bounce > 0) indirect += ph->energy;
-    if (ph->glint) glint_energy += ph->energy, glinted++;
-  }
-  return glinted >= GLINT_PILOT_MIN && glint_energy >= IRIS_GLINT_SHARE_MIN * indirect;
+  marked_photons m = count_marked(photons, false);
+  return m.n >= GLINT_PILOT_MIN && m.energy >= IRIS_GLINT_SHARE_MIN * m.indirect;
 }
 
 double iris_guiding_photon_paths(double caches, int cache_k, size_t light_groups, double sky_share) {
