@@ -47,9 +47,9 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   const iris_guiding *g = ctx;
   iris_guide_vertex_state *v = (iris_guide_vertex_state *)sp->guide.bytes;
   /* cache-sampling probability alpha = min(roughness, alpha_max), 0 at a delta
-   * BSDF; the roughness is kept for the learned alpha below */
+   * BSDF (roughness 0); the roughness is kept for the learned alpha below */
   const float rough = sp->delta ? 0.0f : iris_bsdf_guiding_roughness(&sp->bsdf); /* INFINITY for diffuse */
-  v->alpha = sp->delta ? 0.0f : iris_fminf(rough, g->params.alpha_max);
+  v->alpha = iris_fminf(rough, g->params.alpha_max);
   v->m = v->alpha > 0.0f ? iris_guiding_pick(g, sp->si.p, sp->frame.n, v->ids) : 0;
   if (v->m == 0) v->alpha = 0.0f;
   v->radiance = -1.0f;

@@ -830,13 +830,6 @@ static void skip(iris_guiding *g, const char *why) {
 #define CAUSTIC_MIN 16 /* photons focused through glass that keep the guide */
 #define CAUSTIC_SHARE_MIN 0.1 /* ... carrying this share of the indirect photon energy */
 
-/* Light focused through glass onto what the guide serves (caustic photons:
- * delta vertices only from the light, one of them a refraction) is light
- * that light sampling cannot reach and the caches can, however little of the
- * scene's light is indirect: where CAUSTIC_MIN such photons carry at least
- * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
- * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
- * The stats then hold that share. */
 /* Photons of one mark (glint or caustic): how many, their energy, and the
  * energy of all indirect photons, which the keep rules compare it with. */
 typedef struct marked_photons {
@@ -854,6 +847,13 @@ static marked_photons count_marked(const iris_photon_map *photons, bool caustic)
   return m;
 }
 
+/* Light focused through glass onto what the guide serves (caustic photons:
+ * delta vertices only from the light, one of them a refraction) is light
+ * that light sampling cannot reach and the caches can, however little of the
+ * scene's light is indirect: where CAUSTIC_MIN such photons carry at least
+ * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
+ * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
+ * The stats then hold that share. */
 static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) {
   marked_photons m = count_marked(photons, true);
   if (!(m.n >= CAUSTIC_MIN && m.energy >= CAUSTIC_SHARE_MIN * m.indirect)) return false;

@@ -65,6 +65,14 @@ static inline bool test_guide_builtin_open(const char *name, iris_method method,
   return false;
 }
 
+/* The guide setup of a render of `spp` samples (sobol) for an open scene:
+ * no time budget, not deciding for auto, no film, no phases. */
+static inline iris_guide_setup test_guide_setup(const iris_scene *s, test_guide_scene *t, uint64_t seed, int threads,
+                                                int spp) {
+  iris_guide_setup gs = {s, t->acc, &t->lights, &t->tx, &t->cam, &t->it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
+  return gs;
+}
+
 /* The guide of a render of `spp` samples (sobol) for an open scene. */
 static inline iris_guiding *test_guide_build_in(const iris_scene *s, test_guide_scene *t, iris_guiding_params gp,
                                                 uint64_t seed, int threads, int spp) {
@@ -72,7 +80,7 @@ static inline iris_guiding *test_guide_build_in(const iris_scene *s, test_guide_
   iris_error_clear(&err);
   iris_guiding *g = NULL;
   gp.use_nee = iris_method_uses_nee(t->it.method);
-  iris_guide_setup gs = {s, t->acc, &t->lights, &t->tx, &t->cam, &t->it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
+  iris_guide_setup gs = test_guide_setup(s, t, seed, threads, spp);
   if (iris_guiding_build(&gs, &gp, &g, &err) != IRIS_OK) fprintf(stderr, "build failed: %s\n", err.message);
   return g;
 }

@@ -26,8 +26,7 @@ static bool trace(const char *name, iris_photon_map *map) {
   if (!test_guide_builtin_open(name, IRIS_METHOD_GUIDED_NEE, &s, &t)) return false;
   iris_error err;
   iris_error_clear(&err);
-  iris_guide_setup gs = {s, t.acc, &t.lights, &t.tx, &t.cam, &t.it, 5, 2, NULL, 16, 0.0, IRIS_SAMPLER_SOBOL, false,
-                         NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
+  iris_guide_setup gs = test_guide_setup(s, &t, 5, 2, 16);
   bool ok = CHECK(iris_photons_trace(&gs, IRIS_EMIT_BY_POWER, 65536, map, &err) == IRIS_OK);
   test_guide_scene_close(&t);
   iris_scene_destroy(s);
