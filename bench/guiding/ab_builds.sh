@@ -13,6 +13,8 @@
 # build's rays per image sample (closest-hit and shadow rays of the whole
 # render, the guide's training passes included, from `--json`) and the ratio
 # of net relMSE x rays per sample, a per-unit-of-work measure free of the clock.
+# NEW_METHOD / BASE_METHOD in the environment: each side's method instead of
+# METHOD (e.g. one build's auto against its mis).
 # usage: bench/guiding/ab_builds.sh NEW BASE REFDIR "TIMES" "SEEDS" [METHOD [SCENE...]]
 #   e.g. git worktree add /tmp/base HEAD~1 && cmake -S /tmp/base -B /tmp/base/build -DCMAKE_BUILD_TYPE=Release &&
 #        cmake --build /tmp/base/build --target iris relmse &&
@@ -33,15 +35,16 @@ for sc in $SCENES; do
       --seed 999 --threads 2 --variance --quiet -o "$ref"
   fi
   own=$("$N/bench/render/relmse" --own "$ref")
-  echo "$sc ($METHOD): reference $ref, own relMSE $own"
+  echo "$sc (new ${NEW_METHOD:-$METHOD}, base ${BASE_METHOD:-$METHOD}): reference $ref, own relMSE $own"
   for t in $TIMES; do
     new=""; base=""; new_rays=""; base_rays=""
     for s in $SEEDS; do
       for v in new base; do
-        if [ "$v" = new ]; then b=$N; extra=${NEW_ARGS:-}; else b=$B; extra=${BASE_ARGS:-}; fi
+        if [ "$v" = new ]; then b=$N; extra=${NEW_ARGS:-}; m=${NEW_METHOD:-$METHOD}
+        else b=$B; extra=${BASE_ARGS:-}; m=${BASE_METHOD:-$METHOD}; fi
         if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t --json"; else budget="--time $t --time-total"; fi
         # shellcheck disable=SC2086
-        "$b/tools/iris" render "$sc" --method "$METHOD" $budget --width "$W" --height 72 --threads 2 \
+        "$b/tools/iris" render "$sc" --method "$m" $budget --width "$W" --height 72 --threads 2 \
           --seed "$s" $extra -o "$OUT/img.exr" > "$OUT/run.json" 2>/dev/null
         val=$("$N/bench/render/relmse" "$OUT/img.exr" "$ref")
         rays=$(awk -F: '/"rays":/ { r = $2 + 0 } /"samples":/ { n = $2 + 0 } END { if (n > 0) printf "%.4f", r / n; else print 0 }' \
