@@ -10,6 +10,8 @@
 #include "renderer/guiding/vertex.h"
 
 #define TIE_EPS 1e-4f
+/* the largest pdf table guided_prepare loads ahead (an 8 x 8 hemisphere map) */
+#define IRIS_GUIDE_PREFETCH_BYTES 256u
 
 int iris_guiding_pick(const iris_guiding *g, iris_vec3 p, iris_vec3 n, uint32_t ids[IRIS_GUIDING_PICK_K]) {
   if (g->cache_count == 0) return 0;
@@ -128,13 +130,17 @@ static void guided_prepare(void *ctx, iris_shading_point *sp) {
   }
   /* The pdf tables of the tied caches are needed after this vertex's shadow
    * ray (the light sample's mixture pdf): start loading them now so the ray
-   * hides the memory latency. Not the alias tables: sampling reads one entry,
-   * and loading all of them cost more than it saved (docs/guiding.md). */
+   * hides the memory latency — where a table is a few cache lines (an 8 x 8
+   * hemisphere's 256 bytes). A 16 x 16 map's 1 KB, or a sphere's, per tied
+   * cache is 16+ lines of which the density reads one: loading them all cost
+   * more than it hid. Not the alias tables: sampling reads one entry
+   * (docs/guiding.md, "Cost of a guided-nee sample"). */
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
-    const size_t texels = ci->sphere ? g->sphere.texel_count : g->hemi.texel_count;
+    const size_t bytes = (ci->sphere ? g->sphere.texel_count : g->hemi.texel_count) * sizeof(float);
+    if (bytes > IRIS_GUIDE_PREFETCH_BYTES) continue;
     const char *pdf = (const char *)(g->pdf + ci->table);
-    for (size_t b = 0; b < texels * sizeof(float); b += 64) __builtin_prefetch(pdf + b);
+    for (size_t b = 0; b < bytes; b += 64) __builtin_prefetch(pdf + b);
   }
   for (int i = 0; i < v->m; ++i) {
     const iris_cache *ci = &g->caches[v->ids[i]];
