@@ -381,7 +381,7 @@ static float power_heuristic(float pa, float pb) {
  * against the path's direction sampler when `mis`. The light was chosen at
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
-                               const iris_light_choice *choice, float u_region, const iris_sampler *rng, bool mis,
+                               const iris_light_choice *choice, const iris_sampler *rng, bool mis,
                                float p_light, iris_path_stats *stats, int8_t *outcome, float *value) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
@@ -391,7 +391,7 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
       iris_lights_choice_is_environment_map(it->lights, choice)) {
     iris_vec3 wi;
     float pdf, s, t;
-    guided = it->guide.sample_environment(it->guide.ctx, it->lights->envmap, sp, u_region, u0, u1, &wi, &pdf, &s, &t);
+    guided = it->guide.sample_environment(it->guide.ctx, it->lights->envmap, sp, u0, u1, &wi, &pdf, &s, &t);
     if (guided == 0 || (guided > 0 && !iris_lights_environment_sample_at(it->lights, choice, sp->si.p, wi, pdf, s,
                                                                           t, &ls)))
       return iris_v3(0, 0, 0);
@@ -493,12 +493,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the guide prepares. */
     iris_light_choice choice = {0, 0.0f, false};
-    float u_choice = 0.0f, u_region = 0.0f; /* IRIS_SLOT_ENV_REGION is the pair's second number */
-    if (nee && !sp.delta) {
-      if (env_guided) iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_CHOICE, &u_choice, &u_region);
-      else u_choice = iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE);
-      iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), u_choice, &choice);
-    }
+    if (nee && !sp.delta)
+      iris_lights_choose(it->lights, sp.si.p, light_normal(&sp), iris_sampler_slot(rng, IRIS_SLOT_LIGHT_CHOICE), &choice);
     iris_integrator_prepare_direction(it, &sp);
     int8_t light_outcome = -1; /* for the recorded vertex: -1 no shadow ray, 0 blocked, 1 lit */
     float light_value = 0.0f;  /* ... and what it brought before the MIS weight */
@@ -506,7 +502,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (nee && !sp.delta) {
       if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
       if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
-        L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, u_region, rng, mis, p_light, stats,
+        L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
                                                      &light_outcome, &light_value)));
     }
 

@@ -56,7 +56,6 @@ enum {
   IRIS_DIM_PIXEL = 0,          /* 2D: position in the pixel */
   IRIS_DIM_BOUNCE0 = 2,
   IRIS_SLOT_LIGHT_CHOICE = 0,  /* NEE: which light */
-  IRIS_SLOT_ENV_REGION = 1,    /* NEE of an environment map guided by the caches: cache and region */
   IRIS_SLOT_LOBE = 2,          /* BSDF: which lobe */
   IRIS_SLOT_LIGHT_SKIP = 3,    /* light sampling at a vertex where the guide makes it optional
                                   (the lobe's pair: two independent 1D decisions) */
@@ -141,10 +140,10 @@ typedef struct iris_direction_sampler {
    * prepared vertex (guiding's sky visibility). Returns -1 when it has nothing to add there
    * (the lights sample the map themselves), 0 when nothing could be sampled,
    * 1 with a direction, its solid-angle density (of the map alone, the light
-   * choice left out) and its map coordinates. u picks among its own choices,
-   * (u0, u1) as the map's sampling uses them. */
-  int (*sample_environment)(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u,
-                            float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t);
+   * choice left out) and its map coordinates, from the light sample's pair
+   * (u0, u1), which also makes its own choices. */
+  int (*sample_environment)(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u0,
+                            float u1, iris_vec3 *wi, float *pdf, float *s, float *t);
   /* With sample_environment: its density for the direction at map
    * coordinates (s, t) over the map's own, at the vertex whose prepared state
    * is v (for the MIS weight of a ray that left that vertex and escaped). */

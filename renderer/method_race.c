@@ -43,11 +43,11 @@ static void counted_prefetch(void *ctx, iris_vec3 p) {
   const counted_guide *c = ctx;
   c->inner.prefetch(c->inner.ctx, p);
 }
-static int counted_environment(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u,
-                               float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
+static int counted_environment(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u0,
+                               float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
   const counted_guide *c = ctx;
   tl_calls++;
-  return c->inner.sample_environment(c->inner.ctx, env, sp, u, u0, u1, wi, pdf, s, t);
+  return c->inner.sample_environment(c->inner.ctx, env, sp, u0, u1, wi, pdf, s, t);
 }
 static float counted_scale(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t) {
   const counted_guide *c = ctx;

@@ -79,12 +79,15 @@ void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size);
 /* Whether sv was built for env (and is in use). */
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
 
-/* Light sampling of the map env (the one sv serves) at a vertex whose tied caches are ids[0..m):
- * u picks the cache, the branch and the region, (u0, u1) the direction as
- * iris_envmap_sample_st does. *pdf is the whole strategy's solid-angle
- * density (not the light choice's probability); *s, *t the map coordinates. */
-bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u, float u0, float u1, iris_vec3 *d,
-                        float *pdf, float *s, float *t);
+/* Light sampling of the map env (the one sv serves) at a vertex whose tied caches are ids[0..m)
+ * from the pair (u0, u1): u0 picks the cache, the branch, the region and the
+ * row in it (rescaled after each choice), u1 the column, so that the pair's
+ * stratification carries into each region; with the map's branch (u0
+ * rescaled, u1) as iris_envmap_sample_st takes them. *pdf is the whole
+ * strategy's solid-angle density (not the light choice's probability); *s, *t
+ * the map coordinates. */
+bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u0, float u1,
+                        iris_vec3 *d, float *pdf, float *s, float *t);
 /* Whether any of the tied caches ids[0..m) samples its own regions (else the
  * density is the map's: iris_skyvis_scale is 1 whatever the direction). */
 bool iris_skyvis_guides(const iris_skyvis *sv, const uint32_t *ids, int m);

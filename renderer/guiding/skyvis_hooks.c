@@ -27,12 +27,12 @@ iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setu
 }
 
 /* Light sampling of the map from the vertex's tied caches. */
-static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u,
-                                     float u0, float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
+static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u0,
+                                     float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
   if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
-  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u, u0, u1, wi, pdf, s, t) ? 1 : 0;
+  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u0, u1, wi, pdf, s, t) ? 1 : 0;
 }
 
 static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, float s,

@@ -62,7 +62,7 @@ static bool mix_sample(void *vc, const double u[3], double dir[3]) {
   mix_ctx *c = vc;
   iris_vec3 d;
   float pdf, s, t;
-  if (!iris_skyvis_sample(c->sv, c->env, c->ids, c->m, (float)u[2], (float)u[0], (float)u[1], &d, &pdf, &s, &t))
+  if (!iris_skyvis_sample(c->sv, c->env, c->ids, c->m, (float)u[0], (float)u[1], &d, &pdf, &s, &t))
     return false;
   /* the density it reports is the one the pdf gives for its direction (up to
    * a cell edge's rounding) */
