@@ -215,29 +215,31 @@ static int search_row(const float *row, int n, float u) {
 bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u0,
                         float u1, iris_vec3 *d, float *pdf, float *s, float *t) {
   if (!sv->built || m <= 0) return iris_envmap_sample_st(env, u0, u1, d, pdf, s, t);
-  /* Every choice from u0, the first number of the pixel's stratified pair,
+  /* Every choice from u1, the second number of the pixel's stratified pair,
    * rescaled at each step (the tied cache, its regions or the map, the region,
-   * the row within it), the column from u1: the directions drawn in one
-   * region keep the pair's stratification (docs/guiding.md, "Sky visibility"). */
+   * then the column within it), the row from u0 as it comes: the directions
+   * drawn in one region keep the pair's stratification, and the map's row is
+   * the one the path loop loaded ahead from (u0, u1) (docs/guiding.md, "Sky
+   * visibility"). */
   const float top = 0x1.fffffep-1f;
-  const float um = u0 * (float)m;
+  const float um = u1 * (float)m;
   int j = (int)um;
   j = j < 0 ? 0 : j >= m ? m - 1 : j;
-  const float ub = iris_clampf(um - (float)j, 0.0f, top); /* the rest of u0, uniform in [0, 1) */
+  const float ub = iris_clampf(um - (float)j, 0.0f, top); /* the rest of u1, uniform in [0, 1) */
   const uint32_t id = ids[j];
   float pdf_map;
   if (sv->sees[id] != IRIS_SKYVIS_PART) {
-    if (!iris_envmap_sample_st(env, ub, u1, d, &pdf_map, s, t)) return false;
+    if (!iris_envmap_sample_st(env, u0, ub, d, &pdf_map, s, t)) return false;
   } else if (ub < sv->beta) {
     const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
     const float ur = fminf(ub / sv->beta, top);
     const int region = search_row(row, sv->region_count, ur);
     const float lo = region > 0 ? row[region - 1] : 0.0f, hi = row[region];
     const float ui = hi > lo ? iris_clampf((ur - lo) / (hi - lo), 0.0f, top) : 0.0f;
-    if (!iris_envmap_sample_region(env, &sv->regions, region, ui, u1, d, &pdf_map, s, t)) return false;
+    if (!iris_envmap_sample_region(env, &sv->regions, region, u0, ui, d, &pdf_map, s, t)) return false;
   } else {
     const float ua = iris_clampf((ub - sv->beta) / (1.0f - sv->beta), 0.0f, top);
-    if (!iris_envmap_sample_st(env, ua, u1, d, &pdf_map, s, t)) return false;
+    if (!iris_envmap_sample_st(env, u0, ua, d, &pdf_map, s, t)) return false;
   }
   /* the density of the whole strategy: the map's (of the sampled cell, as
    * iris_envmap_sample_st gives it) times the mixture's factor */

@@ -80,10 +80,10 @@ void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size);
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
 
 /* Light sampling of the map env (the one sv serves) at a vertex whose tied caches are ids[0..m)
- * from the pair (u0, u1): u0 picks the cache, the branch, the region and the
- * row in it (rescaled after each choice), u1 the column, so that the pair's
- * stratification carries into each region; with the map's branch (u0
- * rescaled, u1) as iris_envmap_sample_st takes them. *pdf is the whole
+ * from the pair (u0, u1): u1 picks the cache, the branch, the region and the
+ * column in it (rescaled after each choice), u0 the row, so that the pair's
+ * stratification carries into each region; the map's branch takes u0 and
+ * the rescaled u1 as iris_envmap_sample_st does. *pdf is the whole
  * strategy's solid-angle density (not the light choice's probability); *s, *t
  * the map coordinates. */
 bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u0, float u1,
