@@ -5,8 +5,10 @@
 # so that a change of the per-sample cost is not hidden by the photons and
 # the guide's build). Prints each side's minimum and median and the median of
 # the per-pair ratios B/A, which cancels most of the machine's drift; on the
-# 2-core development machine single runs move by up to 30%, paired medians of
-# 10 pairs by about 1-2% (door against itself: 0.99-1.01).
+# 2-core development machine single runs move by up to 30%, and paired medians
+# of 10-16 pairs by 1-4% between runs of one comparison (the door's
+# unchanged code path: 1.007; sky-room with the same instructions in another
+# order: 1.014-1.037), so a difference under ~4% needs several runs.
 # usage: bench/render/passes_ab.sh IRIS_A IRIS_B SCENE METHOD [SPP [PAIRS [WIDTH HEIGHT]]]
 # (env ARGS_A / ARGS_B: more `iris render` options for A / B)
 # e.g. bench/render/passes_ab.sh /tmp/base/build/tools/iris build/tools/iris sky-room guided-nee 48 10
