@@ -14,6 +14,8 @@ extern "C" {
 #define IRIS_INV_PI 0.31830988618379067154f
 #define IRIS_INV_2PI 0.15915494309189533577f
 #define IRIS_INV_4PI 0.07957747154594766788f
+/* The largest float below 1: where a rescaled sample number must stay in [0, 1). */
+#define IRIS_ONE_MINUS_EPSILON 0x1.fffffep-1f
 
 typedef struct iris_vec3 {
   float x, y, z;

@@ -630,7 +630,7 @@ static IRIS_NOINLINE bool gltf_layered_sample(const iris_bsdf *b, iris_vec3 wo, 
     s->lobe = IRIS_LOBE_REFLECTION | IRIS_LOBE_GLOSSY;
   } else {
     float p_base = 1.0f - l.p_coat - l.p_sheen;
-    float u = iris_clampf((u_lobe - l.p_coat - l.p_sheen) / p_base, 0.0f, 0.99999994f);
+    float u = iris_clampf((u_lobe - l.p_coat - l.p_sheen) / p_base, 0.0f, IRIS_ONE_MINUS_EPSILON);
     if (!gltf_base_sample(b, wo, u, u0, u1, s)) return false;
     if (s->lobe & IRIS_LOBE_DELTA) { /* the layers' share of a delta direction */
       s->f = iris_scale(s->f, l.coat_below_o * sheen_scale(&l, s->wi));

@@ -137,7 +137,7 @@ static uint32_t select_at(const iris_lights *L, iris_vec3 ref, float u, float *p
   uint32_t index = g->first;
   if (g->count > 1) {
     float ur = (float)((target - acc) / w[k]);
-    ur = iris_clampf(ur, 0.0f, 0x1.fffffep-1f);
+    ur = iris_clampf(ur, 0.0f, IRIS_ONE_MINUS_EPSILON);
     index = choose_in_group(g, ur, coin);
   }
   *pmf_group = pg;

@@ -179,7 +179,7 @@ size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float
   if (u_remapped) {
     float width = d->cdf[lo + 1] - d->cdf[lo];
     float r = width > 0.0f ? (u - d->cdf[lo]) / width : 0.0f;
-    *u_remapped = iris_clampf(r, 0.0f, 0x1.fffffep-1f);
+    *u_remapped = iris_clampf(r, 0.0f, IRIS_ONE_MINUS_EPSILON);
   }
   return lo;
 }

@@ -401,7 +401,7 @@ bool iris_light_select_choose(const iris_light_select *sel, iris_vec3 p, iris_ve
     if (!(v < 1.0)) v = 0x1.fffffffffffffp-1;
   }
   float fv = (float)v, tree_pmf;
-  if (!(fv < 1.0f)) fv = 0x1.fffffep-1f;
+  if (!(fv < 1.0f)) fv = IRIS_ONE_MINUS_EPSILON;
   /* Where the tree's descent ends in nothing (lights only behind the
    * surface), no light is chosen: its `light` is no sample, and naming it with
    * the mixture's pmf would count that light twice. */

@@ -65,7 +65,7 @@ static inline int iris_refine_pick(const float *m, float *u) {
     c += m[k];
   }
   float r = m[k] > 0.0f ? (x - c) / m[k] : 0.0f;
-  *u = r < 0.0f ? 0.0f : (r >= 1.0f ? 0x1.fffffep-1f : r);
+  *u = r < 0.0f ? 0.0f : (r >= 1.0f ? IRIS_ONE_MINUS_EPSILON : r);
   return k;
 }
 

@@ -69,7 +69,7 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
         for (int k = 0; k < c->probes; ++k) {
           h = iris_mix64(h + 0x9e3779b97f4a7c15ULL);
           float u0 = ((float)k + jitter) / (float)c->probes, u1 = iris_u64_to_unit(h);
-          if (!(u0 < 1.0f)) u0 = 0x1.fffffep-1f;
+          if (!(u0 < 1.0f)) u0 = IRIS_ONE_MINUS_EPSILON;
           iris_vec3 d;
           float pdf, s, t;
           if (!iris_envmap_sample_region(c->env, R, b, u0, u1, &d, &pdf, &s, &t)) continue;
@@ -221,24 +221,24 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
    * drawn in one region keep the pair's stratification, and the map's row is
    * the one the path loop loaded ahead from (u0, u1) (docs/guiding.md, "Sky
    * visibility"). */
-  const float top = 0x1.fffffep-1f;
   const float um = u1 * (float)m;
   int j = (int)um;
   j = j < 0 ? 0 : j >= m ? m - 1 : j;
-  const float ub = iris_clampf(um - (float)j, 0.0f, top); /* the rest of u1, uniform in [0, 1) */
+  /* the rest of u1, uniform in [0, 1) */
+  const float ub = iris_clampf(um - (float)j, 0.0f, IRIS_ONE_MINUS_EPSILON);
   const uint32_t id = ids[j];
   float pdf_map;
   if (sv->sees[id] != IRIS_SKYVIS_PART) {
     if (!iris_envmap_sample_st(env, u0, ub, d, &pdf_map, s, t)) return false;
   } else if (ub < sv->beta) {
     const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
-    const float ur = fminf(ub / sv->beta, top);
+    const float ur = fminf(ub / sv->beta, IRIS_ONE_MINUS_EPSILON);
     const int region = search_row(row, sv->region_count, ur);
     const float lo = region > 0 ? row[region - 1] : 0.0f, hi = row[region];
-    const float ui = hi > lo ? iris_clampf((ur - lo) / (hi - lo), 0.0f, top) : 0.0f;
+    const float ui = hi > lo ? iris_clampf((ur - lo) / (hi - lo), 0.0f, IRIS_ONE_MINUS_EPSILON) : 0.0f;
     if (!iris_envmap_sample_region(env, &sv->regions, region, u0, ui, d, &pdf_map, s, t)) return false;
   } else {
-    const float ua = iris_clampf((ub - sv->beta) / (1.0f - sv->beta), 0.0f, top);
+    const float ua = iris_clampf((ub - sv->beta) / (1.0f - sv->beta), 0.0f, IRIS_ONE_MINUS_EPSILON);
     if (!iris_envmap_sample_st(env, u0, ua, d, &pdf_map, s, t)) return false;
   }
   /* the density of the whole strategy: the map's (of the sampled cell, as

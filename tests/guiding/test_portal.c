@@ -60,7 +60,7 @@ static void test_rectangle(void) {
   int zero = 0;
   for (int i = 0; i <= 64; ++i)
     for (int j = 0; j <= 64; ++j) {
-      float u1 = fminf((float)i / 64.0f, 0x1.fffffep-1f), u2 = fminf((float)j / 64.0f, 0x1.fffffep-1f);
+      float u1 = fminf((float)i / 64.0f, IRIS_ONE_MINUS_EPSILON), u2 = fminf((float)j / 64.0f, IRIS_ONE_MINUS_EPSILON);
       zero += !(iris_portal_pdf(&c.p, c.x, iris_portal_sample(&c.p, c.x, u1, u2)) > 0.0f);
     }
   iris_check_record(zero == 0, __FILE__, __LINE__, "%d drawn directions with density 0", zero);
