@@ -17,15 +17,12 @@ R=$1; SPP=$2; SEEDS=$3; MAXB=${4:-1000}
 if [ $# -ge 4 ]; then shift 4; else shift $#; fi
 SCENES=${*:-door door-shielded}
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
-W=$(mktemp -d)
-trap 'git -C "$REPO" worktree remove --force "$W/src" >/dev/null 2>&1; rm -rf "$W"' EXIT
-git -C "$REPO" worktree add -f --detach "$W/src" HEAD >/dev/null
-git -C "$W/src" apply "$REPO/bench/guiding/connect_prototype.patch"
-cmake -S "$W/src" -B "$W/src/build" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$W/src/build" -j2 --target iris relmse > /dev/null
+# shellcheck source=bench/guiding/scratch_patch.sh
+. "$REPO/bench/guiding/scratch_patch.sh"
+scratch_build connect_prototype.patch
 mkdir -p "$W/on/tools" "$W/on/bench/render"
-printf '#!/bin/sh\nIRIS_CONNECT=1 IRIS_CONNECT_MAXB=%s exec %s "$@"\n' "$MAXB" "$W/src/build/tools/iris" > "$W/on/tools/iris"
+printf '#!/bin/sh\nIRIS_CONNECT=1 IRIS_CONNECT_MAXB=%s exec %s "$@"\n' "$MAXB" "$SCRATCH/build/tools/iris" > "$W/on/tools/iris"
 chmod +x "$W/on/tools/iris"
-ln -s "$W/src/build/bench/render/relmse" "$W/on/bench/render/relmse"
+ln -s "$SCRATCH/build/bench/render/relmse" "$W/on/bench/render/relmse"
 # shellcheck disable=SC2086 # SCENES is a list
-BUDGET=spp "$REPO/bench/guiding/ab_builds.sh" "$W/on" "$W/src/build" "$R" "$SPP" "$SEEDS" guided-nee $SCENES
+BUDGET=spp "$REPO/bench/guiding/ab_builds.sh" "$W/on" "$SCRATCH/build" "$R" "$SPP" "$SEEDS" guided-nee $SCENES

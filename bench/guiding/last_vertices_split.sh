@@ -20,14 +20,11 @@ M=${1:-guided-nee}; SPP=${2:-64}; SEED=${3:-1}
 if [ $# -ge 3 ]; then shift 3; else shift $#; fi
 SCENES=${*:-door door-shielded}
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
-W=$(mktemp -d)
-trap 'git -C "$REPO" worktree remove --force "$W" >/dev/null 2>&1 || rm -rf "$W"' EXIT
-git -C "$REPO" worktree add -f --detach "$W" HEAD >/dev/null
-git -C "$W" apply "$REPO/bench/guiding/last_vertices_split.patch"
-cmake -S "$W" -B "$W/build" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$W/build" -j2 --target iris > /dev/null
+# shellcheck source=bench/guiding/scratch_patch.sh
+. "$REPO/bench/guiding/scratch_patch.sh"
+scratch_build last_vertices_split.patch
 for sc in $SCENES; do
   echo "== $sc ($M, $SPP spp, 96 x 72, seed $SEED)"
-  "$W/build/tools/iris" render "$sc" --method "$M" --spp "$SPP" --width 96 --height 72 --seed "$SEED" \
+  "$SCRATCH/build/tools/iris" render "$sc" --method "$M" --spp "$SPP" --width 96 --height 72 --seed "$SEED" \
     --threads 1 --quiet -o "$W/img.exr" 2>&1 | grep '^XS' | grep -v 'cat 3'
 done

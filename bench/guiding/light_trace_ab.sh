@@ -15,13 +15,10 @@
 set -eu
 REF=$1; SPP=$2; SEEDS=$3
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
-W=$(mktemp -d)
-trap 'git -C "$REPO" worktree remove --force "$W/src" >/dev/null 2>&1; rm -rf "$W"' EXIT
-git -C "$REPO" worktree add -f --detach "$W/src" HEAD >/dev/null
-git -C "$W/src" apply "$REPO/bench/guiding/light_trace_prototype.patch"
-IRIS_SHARED_DIR=${IRIS_SHARED_DIR:-$REPO/../shared} cmake -S "$W/src" -B "$W/src/build" -DCMAKE_BUILD_TYPE=Release > /dev/null
-cmake --build "$W/src/build" -j2 --target iris relmse > /dev/null
-B=$W/src/build
+# shellcheck source=bench/guiding/scratch_patch.sh
+. "$REPO/bench/guiding/scratch_patch.sh"
+scratch_build light_trace_prototype.patch
+B=$SCRATCH/build
 for s in $SEEDS; do
   for lt in 0 1; do
     if [ "$lt" = 1 ]; then export IRIS_LT=1; else unset IRIS_LT; fi
