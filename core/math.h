@@ -71,6 +71,11 @@ static inline float iris_max3(iris_vec3 a) { return iris_fmaxf(a.x, iris_fmaxf(a
 static inline float iris_avg3(iris_vec3 a) { return (a.x + a.y + a.z) * (1.0f / 3.0f); }
 static inline bool iris_isfinite3(iris_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 static inline float iris_clampf(float v, float lo, float hi) { return v < lo ? lo : (v > hi ? hi : v); }
+/* Where u lies in [lo, hi), rescaled to [0, 1) (hi > lo): what is left of a
+ * sample number after it chose the interval, for the next choice. */
+static inline float iris_rescale_unit(float u, float lo, float hi) {
+  return iris_clampf((u - lo) / (hi - lo), 0.0f, IRIS_ONE_MINUS_EPSILON);
+}
 static inline float iris_sqr(float v) { return v * v; }
 static inline float iris_safe_sqrt(float v) { return sqrtf(v > 0.0f ? v : 0.0f); } /* NaN -> 0, as fmaxf, without its call */
 

@@ -351,13 +351,13 @@ bool iris_envmap_sample_st(const iris_envmap *env, float u0, float u1, iris_vec3
   int y = search_guided(env->row_cdf, env->row_guide, H, H, u0);
   float r0 = env->row_cdf[y], r1 = env->row_cdf[y + 1];
   if (!(r1 > r0)) return false;
-  float ur = iris_clampf((u0 - r0) / (r1 - r0), 0.0f, IRIS_ONE_MINUS_EPSILON);
+  float ur = iris_rescale_unit(u0, r0, r1);
   /* cell: the guide entry bounds the search (the walks mend u * blocks's rounding) */
   const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
   int x = search_guided(cdf, &env->guide[(size_t)y * (size_t)env->blocks], env->blocks, W, u1);
   float c0 = cdf[x], c1 = cdf[x + 1];
   if (!(c1 > c0)) return false;
-  float uc = iris_clampf((u1 - c0) / (c1 - c0), 0.0f, IRIS_ONE_MINUS_EPSILON);
+  float uc = iris_rescale_unit(u1, c0, c1);
   float t = ((float)y + ur) / (float)H, s = ((float)x + uc) / (float)W;
   float sin_t = sinf(t * IRIS_PI);
   if (!(sin_t > 0.0f)) return false;
@@ -480,7 +480,7 @@ bool iris_envmap_sample_region(const iris_envmap *env, const iris_envmap_regions
   float a = rc[k], b = rc[k + 1];
   if (!(b > a)) return false;
   const int y = r0 + k;
-  float ur = iris_clampf((u0 - a) / (b - a), 0.0f, IRIS_ONE_MINUS_EPSILON);
+  float ur = iris_rescale_unit(u0, a, b);
   const float *cdf = &env->cdf[(size_t)y * (size_t)env->stride];
   float lo = cdf[c0], hi = cdf[c1];
   if (!(hi > lo)) return false;
@@ -491,7 +491,7 @@ bool iris_envmap_sample_region(const iris_envmap *env, const iris_envmap_regions
   int x = search_cdf(cdf, c0, c1, target);
   float x0 = cdf[x], x1 = cdf[x + 1];
   if (!(x1 > x0)) return false;
-  float uc = iris_clampf((target - x0) / (x1 - x0), 0.0f, IRIS_ONE_MINUS_EPSILON);
+  float uc = iris_rescale_unit(target, x0, x1);
   float t = ((float)y + ur) / (float)H, s = ((float)x + uc) / (float)env->width;
   float sin_t = sinf(t * IRIS_PI);
   if (!(sin_t > 0.0f)) return false;

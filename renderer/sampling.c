@@ -177,9 +177,7 @@ size_t iris_distrib1d_sample(const iris_distrib1d *d, float u, float *pmf, float
   }
   if (pmf) *pmf = iris_distrib1d_pmf(d, lo);
   if (u_remapped) {
-    float width = d->cdf[lo + 1] - d->cdf[lo];
-    float r = width > 0.0f ? (u - d->cdf[lo]) / width : 0.0f;
-    *u_remapped = iris_clampf(r, 0.0f, IRIS_ONE_MINUS_EPSILON);
+    *u_remapped = d->cdf[lo + 1] > d->cdf[lo] ? iris_rescale_unit(u, d->cdf[lo], d->cdf[lo + 1]) : 0.0f;
   }
   return lo;
 }

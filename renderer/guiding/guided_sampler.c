@@ -193,7 +193,7 @@ static bool guided_sample(void *ctx, const iris_shading_point *sp, iris_sampler 
       return guided_finish(g, sp, v, alpha, iris_portal_sample(&g->caches[v->ids[v->portal_of]].portal, v->p, u1, u2),
                            out);
     }
-    u = fminf((u - v->portal) / (1.0f - v->portal), IRIS_ONE_MINUS_EPSILON);
+    u = iris_rescale_unit(u, v->portal, 1.0f);
   }
   if (u >= alpha) {
     if (!iris_integrator_sample_bsdf(sp, rng, out)) return false;

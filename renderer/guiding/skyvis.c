@@ -232,13 +232,13 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
     if (!iris_envmap_sample_st(env, u0, ub, d, &pdf_map, s, t)) return false;
   } else if (ub < sv->beta) {
     const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
-    const float ur = fminf(ub / sv->beta, IRIS_ONE_MINUS_EPSILON);
+    const float ur = iris_rescale_unit(ub, 0.0f, sv->beta);
     const int region = search_row(row, sv->region_count, ur);
     const float lo = region > 0 ? row[region - 1] : 0.0f, hi = row[region];
-    const float ui = hi > lo ? iris_clampf((ur - lo) / (hi - lo), 0.0f, IRIS_ONE_MINUS_EPSILON) : 0.0f;
+    const float ui = hi > lo ? iris_rescale_unit(ur, lo, hi) : 0.0f;
     if (!iris_envmap_sample_region(env, &sv->regions, region, u0, ui, d, &pdf_map, s, t)) return false;
   } else {
-    const float ua = iris_clampf((ub - sv->beta) / (1.0f - sv->beta), 0.0f, IRIS_ONE_MINUS_EPSILON);
+    const float ua = iris_rescale_unit(ub, sv->beta, 1.0f);
     if (!iris_envmap_sample_st(env, u0, ua, d, &pdf_map, s, t)) return false;
   }
   /* the density of the whole strategy: the map's (of the sampled cell, as
