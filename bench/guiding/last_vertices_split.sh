@@ -4,8 +4,9 @@
 # what a bidirectional connection could take over). Builds a scratch copy of
 # HEAD with last_vertices_split.patch (trace_path sums each image sample's
 # light by category and prints the shares at exit; room B is x > 0, as in the
-# door scenes), renders each scene on one thread and prints the XS lines:
-#   cat 0: collected at a vertex in room A (x <= 0)
+# door scenes, and a point on the divider, x = 0, belongs to the room it is
+# seen from), renders each scene on one thread and prints the XS lines:
+#   cat 0: collected at a vertex in room A
 #   cat 1: at a room-B vertex whose path came from room A (..., x_A, y_B, light):
 #          what connecting x to a light subpath's first hit would estimate
 #   cat 2: at a room-B vertex after two or more in room B

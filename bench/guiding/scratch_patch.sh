@@ -1,5 +1,6 @@
 # Sourced by the prototype benchmarks (connect_ab.sh, last_vertices_split.sh,
-# light_trace_ab.sh, variance_aware_ab.sh): scratch_build PATCH builds a throw-away copy of HEAD
+# light_trace_ab.sh, variance_aware_ab.sh, vertex_cache_ab.sh): scratch_build
+# PATCH builds a throw-away copy of HEAD
 # with bench/guiding/PATCH applied (iris and relmse, Release) and sets
 # SCRATCH to its source directory (the build in $SCRATCH/build) and W to a
 # temporary directory for the caller's files; both go when the shell exits.

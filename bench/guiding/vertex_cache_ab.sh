@@ -1,0 +1,42 @@
+#!/bin/sh
+# Connections to a light-vertex cache on the door scenes, measured
+# (docs/guiding.md, "What limits the door scene": a prototype, not built).
+# Builds a scratch copy of HEAD with vertex_cache_prototype.patch (the door
+# scenes only: room B is x > 0; per image sample index, VC_N light paths walk
+# room B and keep the vertex where they enter room A; a camera vertex whose
+# path so far lies in room A connects to one of them, and the paths so made
+# are left out of the camera estimator: a partition of path space, no MIS;
+# IRIS_VC=3 turns it on, IRIS_VC_N and IRIS_VC_D set the light paths per
+# sample index and the shortest connection) and prints, per seed, guided-nee's
+# relMSE against REFDIR/ref_SCENE.exr without and with it, at BUDGET: a
+# number of samples per pixel, or "4s" for 4 s with the setup counted.
+# usage: bench/guiding/vertex_cache_ab.sh REFDIR BUDGET "SEEDS" SCENE...
+#   REFDIR holds 96 x 72 references ref_door.exr / ref_door-shielded.exr, e.g.
+#   `iris render door --method mis --sampler independent --spp 32768 --width 96
+#   --height 72 --seed 999 -o REFDIR/ref_door.exr`
+set -eu
+REFDIR=$1; BUDGET=$2; SEEDS=$3
+shift 3
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+# shellcheck source=bench/guiding/scratch_patch.sh
+. "$REPO/bench/guiding/scratch_patch.sh"
+scratch_build vertex_cache_prototype.patch
+B=$SCRATCH/build
+case "$BUDGET" in
+  *s) budget="--time ${BUDGET%s} --time-total" ;;
+  *) budget="--spp $BUDGET" ;;
+esac
+for sc in "$@"; do
+  for s in $SEEDS; do
+    for vc in 0 3; do
+      # shellcheck disable=SC2086
+      out=$(IRIS_VC=$vc "$B/tools/iris" render "$sc" --method guided-nee $budget --width 96 --height 72 \
+        --seed "$s" --threads 2 --json --quiet -o "$W/img.exr" 2> "$W/err")
+      spp=$(echo "$out" | awk -F: '/"spp":/ { gsub(/[ ,\t]/, "", $2); print $2 }')
+      rays=$(echo "$out" | awk -F: '/"rays":/ { gsub(/[ ,\t]/, "", $2); print $2 }')
+      light=$(sed -n 's/.*light rays \([0-9]*\).*/\1/p' "$W/err")
+      echo "$sc seed $s vertex cache $vc: relMSE $("$B/bench/render/relmse" "$W/img.exr" "$REFDIR/ref_$sc.exr")," \
+        "spp $spp, rays $rays (+ ${light:-0} light-path rays)"
+    done
+  done
+done
