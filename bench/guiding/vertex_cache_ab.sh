@@ -2,12 +2,15 @@
 # Connections to a light-vertex cache on the door scenes, measured
 # (docs/guiding.md, "What limits the door scene": a prototype, not built).
 # Builds a scratch copy of HEAD with vertex_cache_prototype.patch (the door
-# scenes only: room B is x > 0; per image sample index, VC_N light paths walk
-# room B and keep the vertex where they enter room A; a camera vertex whose
-# path so far lies in room A connects to one of them, and the paths so made
-# are left out of the camera estimator: a partition of path space, no MIS;
-# IRIS_VC=3 turns it on, IRIS_VC_N and IRIS_VC_D set the light paths per
-# sample index and the shortest connection) and prints, per seed, guided-nee's
+# scenes only: room B is x > 0, a point on the divider in the room it is seen
+# from; per image sample index, IRIS_VC_N light paths (default 864) walk room
+# B and keep the vertex where they enter room A; a camera vertex whose path so
+# far lies in room A connects to one of them if they are more than IRIS_VC_D apart
+# (default 0.3 m), and the paths so made are left out of the camera
+# estimator: a partition of path space, no MIS; IRIS_VC=3 turns it on, the
+# camera's paths going on into room B with probability 0.1 once they are
+# such a path; 1: in full; 2: not at all, which loses the paths that come back
+# to room A, a bias) and prints, per seed, guided-nee's
 # relMSE against REFDIR/ref_SCENE.exr without and with it, at BUDGET: a
 # number of samples per pixel, or "4s" for 4 s with the setup counted.
 # usage: bench/guiding/vertex_cache_ab.sh REFDIR BUDGET "SEEDS" SCENE...
