@@ -113,6 +113,7 @@ static inline bool iris_sampler_kind_parse(const char *name, iris_sampler_kind *
  * docs/rendering.md, "Dimension layout"). */
 typedef struct iris_sampler {
   uint64_t key;       /* independent: hash(seed, stream, sample); sobol: hash(seed, stream, sample >> 32) */
+  uint64_t sample;    /* the sample index (what is shared by all streams: a pass's light-vertex cache) */
   uint32_t index_rev; /* sobol: the sample index's low 32 bits, bit-reversed */
   uint32_t dimension;
   iris_sampler_kind kind;
@@ -123,6 +124,7 @@ static inline iris_sampler iris_sampler_start_kind(iris_sampler_kind kind, uint6
   iris_sampler s;
   s.kind = kind;
   s.dimension = 0;
+  s.sample = sample;
   if (kind == IRIS_SAMPLER_SOBOL) {
     s.key = iris_hash4(seed, stream, sample >> 32, 0x50b01ULL);
     s.index_rev = iris_reverse_bits32((uint32_t)sample);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "renderer/normal_map.h"
+#include "renderer/vcache.h"
 
 static const char *const METHOD_NAMES[IRIS_METHOD_COUNT] = {"bsdf", "nee", "mis", "guided",
                                                              "guided-nee", "auto"};
@@ -445,6 +446,17 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o, prev_n = iris_v3(0, 0, 0);
   stats->paths++;
+  /* Connections to a light-vertex cache (vcache.h): only image paths (not
+   * training's); the state says whether the path so far is one the
+   * connections make, whose light the camera then leaves out. */
+  const iris_vcache_pool *vpool = it->vcache && !rec ? iris_vcache_get(it->vcache, rng->sample) : NULL;
+  const iris_vcache_params *vp = vpool ? iris_vcache_settings(it->vcache) : NULL;
+  int vc_phase = 0, vc_k = 0; /* 0: every vertex so far in region A; 1: k >= 1 there, then only B; 2: other */
+  iris_vec3 vc_prev = {0, 0, 0}, vc_last = {0, 0, 0}; /* x_{k-1}, x_k */
+  bool vc_prev_nd = false, vc_last_nd = false, vc_last_plain = false;
+  bool vc_made = false;       /* phase 1 and a path the connections make */
+  bool vc_rouletted = false;  /* its continuation was rouletted */
+  iris_vec3 L_connect = iris_v3(0, 0, 0);
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
     /* The map's tables load while the ray is traced and the hit shaded
@@ -482,7 +494,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (!prev_delta && nee)
         w = mis ? power_heuristic(prev_pdf, prev_light * iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si))
                 : 0.0f;
-      L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+      if (!(vc_phase == 1 && vc_made)) L = iris_add(L, iris_scale(iris_mul(beta, le), w));
       if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
     }
     last = NULL;
@@ -490,6 +502,27 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
 
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
+    if (vpool) {
+      const bool in_a = iris_vcache_in_a(vp, si.p, iris_neg(ray.d)), plain = iris_vcache_plain(&sp, si.ng);
+      if (vc_phase == 0 && in_a) {
+        vc_k++;
+        vc_prev = vc_last, vc_prev_nd = vc_last_nd;
+        vc_last = si.p, vc_last_nd = !sp.delta, vc_last_plain = plain;
+      } else if (vc_phase == 0) {
+        vc_phase = vc_k >= 1 ? 1 : 2;
+        const iris_vec3 d = iris_sub(vc_last, vc_prev);
+        vc_made = vc_k >= 2 && vc_prev_nd && vc_last_plain && plain && iris_dot(d, d) > vp->min_d2;
+      } else if (vc_phase == 1 && (in_a || !plain)) {
+        vc_made = false; /* back in A, or a vertex no light path walks: the camera's again */
+      }
+      /* What follows is the connections' until the path comes back to A: go
+       * on with probability 0.1 only (weighted 10; unbiased). */
+      if (vc_phase == 1 && vc_made && !vc_rouletted) {
+        vc_rouletted = true;
+        if (iris_sampler_slot(rng, IRIS_SLOT_CONNECT) >= 0.1f) break;
+        beta = iris_scale(beta, 10.0f);
+      }
+    }
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the guide prepares. */
     iris_light_choice choice = {0, 0.0f, false};
@@ -502,8 +535,34 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (nee && !sp.delta) {
       if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
       if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
-        L = iris_add(L, iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
-                                                     &light_outcome, &light_value)));
+      {
+        const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
+                                                          &light_outcome, &light_value));
+        if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
+          L = iris_add(L, dl);
+      }
+    }
+    if (vpool && vc_phase == 0 && !sp.delta && vpool->count > 0) {
+      /* connect to one z of the pool, drawn uniformly; the pool holds what
+       * vp->paths light paths left, so each counts count / paths */
+      uint32_t j = (uint32_t)(iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count);
+      if (j >= vpool->count) j = vpool->count - 1;
+      const iris_vcache_vertex *z = &vpool->v[j];
+      const iris_vec3 d = iris_sub(z->p, sp.si.p);
+      const float d2 = iris_dot(d, d);
+      if (d2 > vp->min_d2 && bounce + 2 + z->m <= it->max_depth + 1) {
+        const iris_vec3 w = iris_scale(d, 1.0f / sqrtf(d2));
+        const float cos_z = -iris_dot(w, z->n);
+        const iris_vec3 fx = iris_integrator_bsdf_eval(&sp, w);
+        if (cos_z > 0.0f && iris_max3(fx) > 0.0f) {
+          iris_ray sh = iris_spawn_ray_to(sp.si.p, sp.si.ng, z->p, z->n);
+          stats->shadow_rays++;
+          if (!iris_accel_occluded(it->accel, &sh))
+            L_connect = iris_add(L_connect, iris_scale(iris_mul(iris_mul(beta, fx), z->f_power),
+                                                       fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 *
+                                                           (float)vpool->count / (float)vp->paths));
+        }
+      }
     }
 
     iris_direction_sample ds;
@@ -575,6 +634,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (rec) rec->count = 0;
     return iris_v3(0, 0, 0);
   }
+  if (iris_isfinite3(L_connect)) L = iris_add(L, L_connect);
+  else stats->nan_count++;
   return L;
 }
 

@@ -62,6 +62,8 @@ enum {
   IRIS_SLOT_LIGHT_POS = 4,     /* 2D: NEE point on the light */
   IRIS_SLOT_DIRECTION = 6,     /* 2D: BSDF direction, or the position in the guide's texel */
   IRIS_SLOT_RR = 8,            /* Russian roulette */
+  IRIS_SLOT_CONNECT = 9,       /* connections (vcache.h): which pool vertex, or whether the path goes on
+                                  (the roulette's pair: two independent 1D decisions) */
   IRIS_SLOT_GUIDE_SELECT = 10, /* guided: BSDF or cache */
   IRIS_SLOT_GUIDE_CACHE = 12,  /* 2D: guided: which of the tied caches, and the texel (alias table) */
   IRIS_SLOT_GUIDE_TEXEL = 13,
@@ -154,6 +156,12 @@ typedef struct iris_direction_sampler {
    * Light samples are divided by it and MIS counts light sampling's density
    * times it, at the vertex and at the emitter the next ray hits. */
   float (*light_probability)(void *ctx, const iris_shading_point *sp);
+  /* Optional: the opening the guide found (guiding's portals) for
+   * connections to a light-vertex cache (vcache.h): a point o on its plane,
+   * the unit normal n pointing away from the side of the caches that keep it,
+   * the opening's longer side, and the share of all caches that keep it.
+   * false: none. */
+  bool (*opening)(void *ctx, iris_vec3 *o, iris_vec3 *n, float *size, float *share);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */
@@ -167,6 +175,7 @@ typedef struct iris_integrator {
   int max_depth;      /* Cycles' bounces: 0 = direct light only, B = B+1 surface hits */
   int rr_depth;       /* Russian roulette from this bounce on (default 3) */
   iris_direction_sampler guide; /* used by the guided methods; sample == NULL: BSDF */
+  struct iris_vcache *vcache;   /* connections to a light-vertex cache (renderer/vcache.h); NULL: none */
   iris_material default_material; /* for meshes with material -1 (diffuse 0.8) */
 } iris_integrator;
 

@@ -69,7 +69,8 @@ static iris_direction_sampler counting(counted_guide *c) {
                               g->prefetch ? counted_prefetch : NULL,
                               g->sample_environment ? counted_environment : NULL,
                               g->environment_scale ? counted_scale : NULL,
-                              g->light_probability ? counted_light : NULL};
+                              g->light_probability ? counted_light : NULL,
+                              NULL}; /* the opening is read before the race, not during it */
   return w;
 }
 

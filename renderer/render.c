@@ -1,6 +1,7 @@
 /* The render loop: set-up, passes of samples over all pixels, output files. */
 #include "renderer/render.h"
 #include "renderer/light_hidden.h"
+#include "renderer/vcache.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -223,6 +224,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
   }
   void *light_state = NULL; /* the guide built for the light choice alone (nee, mis) */
+  iris_vcache *vcache = NULL; /* connections to a light-vertex cache (vcache.h) */
   if (st == IRIS_OK && resolve) it.method = IRIS_METHOD_GUIDED_NEE; /* the guide builds for it */
   if (st == IRIS_OK && iris_cancel_requested()) st = iris_cancel_error(err); /* in the light tables */
   if (st == IRIS_OK) st = iris_film_create(&res->film, b.x1 - b.x0, b.y1 - b.y0, err);
@@ -245,6 +247,31 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
                            p.phase, p.phase_ctx, t0, keep_training ? &res->film : NULL, b, learned};
     st = p.guide->build(&gs, &it.guide, &guide_state, err);
   }
+  /* Connections to a light-vertex cache (docs/guiding.md, "Connections to a
+   * light-vertex cache"): where the guide found an opening most caches'
+   * light came through, with its plane as the regions' border. Its pools
+   * depend on the seed and the whole frame only, not on windows, offsets or
+   * threads. */
+  if (st == IRIS_OK && p.connect != IRIS_CONNECT_OFF && it.guide.opening && lights.tri_count > 0) {
+    iris_vcache_params vp;
+    float size = 0.0f, share = 0.0f;
+    if (it.guide.opening(it.guide.ctx, &vp.o, &vp.n, &size, &share) &&
+        (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE) && size > 0.0f) {
+      const uint64_t frame = (uint64_t)res->camera.width * (uint64_t)res->camera.height / 8u;
+      vp.eps = 1e-4f * size;
+      vp.min_d2 = iris_sqr(IRIS_CONNECT_MIN_DISTANCE * size);
+      vp.paths = (uint32_t)(frame < 256 ? 256 : frame > 2048 ? 2048 : frame);
+      vp.seed = p.seed;
+      vp.threads = p.threads;
+      st = iris_vcache_create(&vcache, &vp, &it, err);
+      if (st == IRIS_OK) {
+        it.vcache = vcache;
+        iris_infof("connections: to a light-vertex cache behind the opening at (%.3g, %.3g, %.3g) kept by %.0f%% of "
+                   "the caches, %u light paths per sample index",
+                   vp.o.x, vp.o.y, vp.o.z, 100.0 * share, vp.paths);
+      }
+    }
+  }
   if (st == IRIS_OK && resolve) {
     /* --method auto: guided-nee where the guide says it is of use and it wins
      * the race (or is forced), else mis
@@ -260,6 +287,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       iris_integrator plain = it;
       plain.method = IRIS_METHOD_MIS;
       memset(&plain.guide, 0, sizeof plain.guide);
+      plain.vcache = NULL;
       it.method = IRIS_METHOD_GUIDED_NEE;
       if (st == IRIS_OK)
         st = iris_method_race(&plain, &it, &res->camera, p.seed, p.threads,
@@ -289,6 +317,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     snprintf(res->method_reason, sizeof res->method_reason, "auto: %s (%s)", iris_method_name(p.method), why);
     if (!use) {
       memset(&it.guide, 0, sizeof it.guide);
+      it.vcache = NULL;
       /* The race chose mis: the trained guide's learned light tables serve it
        * (learned from the training's light samples too, and not built twice). */
       if (!(learned && res->raced)) {
@@ -417,6 +446,13 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     for (int i = 0; i < p.threads; i++) iris_path_stats_add(&res->stats, &stats[i]);
   }
   free(stats);
+  if (vcache) { /* the light paths' rays count with the render's */
+    uint64_t vrays = 0, vstored = 0;
+    iris_vcache_counts(vcache, &vrays, &vstored);
+    res->stats.rays += vrays;
+    res->connect_rays = vrays;
+    iris_vcache_destroy(vcache);
+  }
   memset(&lights.learned, 0, sizeof lights.learned);
   if (guide_state && p.guide && p.guide->destroy) p.guide->destroy(guide_state);
   if (light_state && p.guide && p.guide->destroy) p.guide->destroy(light_state);

@@ -29,6 +29,13 @@ extern "C" {
 /* Whether the guide's training samples go into the image by default
  * (iris_render_params.keep_training; docs/guiding.md, "Training samples"). */
 #define IRIS_KEEP_TRAINING_DEFAULT true
+/* Connections to a light-vertex cache by default where the guide's opening is
+ * kept by at least this share of the caches (door 0.23, door-shielded 0.18;
+ * corridor-rooms 0.09 and the office 0.01-0.02, where they do not pay), and
+ * not between points closer than this times the opening's longer side (0.3 m
+ * at the door: closer connections' 1/d^2 stays with the camera). */
+#define IRIS_CONNECT_MIN_SHARE 0.15f
+#define IRIS_CONNECT_MIN_DISTANCE 0.15f
 
 /* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
 typedef struct iris_pixel_bounds {
@@ -123,6 +130,10 @@ typedef struct iris_render_params {
    * "Training samples"): only a render that trains its guide itself and
    * starts at sample offset 0 has them. */
   bool keep_training;
+  /* Connections to a light-vertex cache (vcache.h) for the guided methods:
+   * IRIS_CONNECT_AUTO where the guide's opening is kept by at least
+   * IRIS_CONNECT_MIN_SHARE of the caches, ON wherever the guide found one. */
+  enum { IRIS_CONNECT_AUTO = 0, IRIS_CONNECT_OFF, IRIS_CONNECT_ON } connect;
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
   /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..
@@ -160,6 +171,7 @@ typedef struct iris_render_result {
   char method_reason[IRIS_METHOD_REASON_SIZE]; /* auto: "auto: guided-nee (75% of the photons
                                                   indirect)"; otherwise "" */
   bool raced;                   /* auto ran the race of mis against guided-nee */
+  uint64_t connect_rays;        /* rays of the light paths the connections drew on (0: none ran; in stats.rays too) */
   iris_race_outcome race;       /* its measurements (when raced) */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;

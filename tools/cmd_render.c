@@ -294,6 +294,7 @@ int iris_cmd_render(int argc, char **argv) {
   p.sampler = (iris_sampler_kind)ro.sampler;               /* 0 (sobol) unless given */
   p.light_sampling = (iris_triangle_sampling)ro.light_sampling;
   p.light_sampler = (iris_light_sampler)ro.light_sampler;
+  p.connect = ro.connect;
   if (iris_options_seen(rb, "max-depth")) p.max_depth = ro.max_depth;
   if (iris_options_seen(rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(rb, "width")) p.width = ro.width;

@@ -205,6 +205,7 @@ int iris_cmd_validate(int argc, char **argv) {
   if (iris_options_seen(&rb, "spp")) p.spp = ro.spp;
   p.sampler = (iris_sampler_kind)ro.sampler; /* 0 (sobol) unless given */
   p.light_sampler = (iris_light_sampler)ro.light_sampler;
+  p.connect = ro.connect;
   if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;

@@ -49,6 +49,7 @@ iris_env_options iris_env_options_default(void) {
 static const char *const SAMPLER_CHOICES[] = {"sobol", "independent", NULL};
 static const char *const LIGHT_SAMPLING_CHOICES[] = {"solid-angle", "area", NULL};
 static const char *const LIGHT_SAMPLER_CHOICES[] = {"power", "tree", "learned", NULL}; /* iris_light_sampler */
+static const char *const CONNECT_CHOICES[] = {"auto", "off", "on", NULL}; /* iris_render_params.connect */
 static const iris_option RENDER_ROWS[] = {
     OPT("spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, iris_render_options, spp,
         "samples per pixel (default: the scene's, else 64)"),
@@ -64,6 +65,8 @@ static const iris_option RENDER_ROWS[] = {
            "emitter triangles: solid-angle (default, where it helps) | area"),
     CHOICE("light-sampler", "S", iris_render_options, light_sampler, LIGHT_SAMPLER_CHOICES,
            "NEE's light choice: tree (default: the light tree) | power"),
+    CHOICE("connect", "M", iris_render_options, connect, CONNECT_CHOICES,
+           "guided methods: connections to light paths kept behind the\nopening the guide found: auto (default: where most of the\ncaches' light came through it) | off | on"),
     OPT("max-depth", 0, IRIS_OPT_INT, "B", 0, 1000000, iris_render_options, max_depth,
         "bounces as Cycles counts them, 0 = direct light (default 64)"),
     OPT("threads", 0, IRIS_OPT_INT, "N", 1, 4096, iris_render_options, threads,

@@ -794,6 +794,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           rp.light_sampling = p.light_samplings[k];
           rp.keep_training = p.keep_training[k];
           rp.light_sampler = p.light_samplers[k];
+          rp.connect = p.connect;
           if (p.adaptive[k] != IRIS_ADAPTIVE_OFF) {
             /* @freeze: Cycles' rule at Blender's threshold; @adaptive: the
              * relMSE allocation with the budget alone deciding. No spp cap. */

@@ -612,6 +612,7 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     rp.spp = p.spp;
     rp.sampler = p.sampler;
     rp.light_sampler = p.light_sampler;
+    rp.connect = p.connect;
     rp.seed = p.seed;
     rp.threads = p.threads;
     rp.method = p.methods[k];

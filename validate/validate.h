@@ -64,6 +64,7 @@ typedef struct iris_validate_params {
   int method_count;         /* 0: mis */
   iris_sampler_kind sampler; /* iris's sampler (default sobol) */
   iris_light_sampler light_sampler; /* NEE's light choice (default IRIS_LIGHT_SAMPLER_DEFAULT) */
+  int connect;                      /* iris_render_params.connect (--connect) */
   int spp;                  /* iris samples per pixel (0: IRIS_VALIDATE_DEFAULT_SPP) */
   uint64_t seed;
   int threads;              /* <= 0: all cores (iris and Blender) */

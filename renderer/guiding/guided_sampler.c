@@ -5,6 +5,7 @@
 #include "renderer/guiding/guiding.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "renderer/guiding/vertex.h"
@@ -276,6 +277,56 @@ static void guided_prefetch(void *ctx, iris_vec3 p) {
   if (g->grid.n[0]) iris_pick_grid_prefetch(&g->grid, p);
 }
 
+/* The portal most caches keep (they share the joined opening's rectangle,
+ * "Portals"): the caches' portals sorted, the longest run of equal ones. */
+typedef struct portal_ref {
+  iris_portal portal;
+  uint32_t id;
+} portal_ref;
+
+static int portal_order(const void *a, const void *b) {
+  const portal_ref *pa = a, *pb = b;
+  int c = memcmp(&pa->portal, &pb->portal, sizeof pa->portal);
+  return c ? c : (pa->id > pb->id) - (pa->id < pb->id);
+}
+
+static bool guided_opening(void *ctx, iris_vec3 *o, iris_vec3 *n, float *size, float *share) {
+  const iris_guiding *g = ctx;
+  portal_ref *refs = malloc(sizeof *refs * (g->cache_count ? g->cache_count : 1));
+  if (!refs) return false;
+  uint32_t count = 0;
+  for (size_t i = 0; i < g->cache_count; ++i)
+    if (g->caches[i].portal_weight > 0.0f && iris_portal_present(&g->caches[i].portal))
+      refs[count++] = (portal_ref){g->caches[i].portal, (uint32_t)i};
+  qsort(refs, count, sizeof *refs, portal_order);
+  uint32_t best = 0, best_at = 0;
+  for (uint32_t i = 0; i < count;) {
+    uint32_t j = i + 1;
+    while (j < count && memcmp(&refs[j].portal, &refs[i].portal, sizeof(iris_portal)) == 0) j++;
+    if (j - i > best) best = j - i, best_at = i;
+    i = j;
+  }
+  bool found = false;
+  if (best > 0) {
+    const iris_portal *pt = &refs[best_at].portal;
+    iris_vec3 nn = iris_cross(pt->u, pt->v);
+    const float len = iris_length(nn);
+    if (len > 0.0f && isfinite(len)) {
+      nn = iris_scale(nn, 1.0f / len);
+      int side = 0; /* the caches keeping it lie on the negative side */
+      for (uint32_t i = best_at; i < best_at + best; ++i)
+        side += iris_dot(iris_sub(g->caches[refs[i].id].p, pt->o), nn) < 0.0f ? 1 : -1;
+      *o = pt->o;
+      *n = side >= 0 ? nn : iris_neg(nn);
+      *size = iris_fmaxf(iris_length(pt->u), iris_length(pt->v));
+      *share = (float)best / (float)g->cache_count;
+      found = true;
+    }
+  }
+  free(refs);
+  return found;
+}
+
 iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
   iris_direction_sampler s;
   memset(&s, 0, sizeof s);
@@ -293,5 +344,6 @@ iris_direction_sampler iris_guiding_sampler(iris_guiding *g) {
       break;
     }
   iris_guiding_sky_hooks(g, &s);
+  s.opening = guided_opening;
   return s;
 }

@@ -3,7 +3,9 @@
  * cache placement, filling and the cache tables built with 1 and 2 threads are
  * identical byte for byte, and guided-nee renders of the door scene with 1 and
  * 2 threads match bit for bit (preprocessing included), as do those of the
- * sky-room (light sampling of the map from the caches' sky visibility). A
+ * sky-room (light sampling of the map from the caches' sky visibility); the
+ * door's renders connect to light-vertex caches (vcache.h), whose pools are
+ * built in parallel too. A
  * different seed gives different caches (the test can fail). */
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +53,7 @@ static bool render(const iris_scene *s, int threads, bool keep, iris_render_resu
   /* 40 x 30: not a multiple of the 8-pixel tiles */
   iris_render_params p = iris_test_params(40, 30, 6, IRIS_METHOD_GUIDED_NEE, 5);
   p.keep_training = keep; /* the training samples in the image, or not */
+  p.connect = IRIS_CONNECT_ON; /* the door's connections to light paths (vcache.h) too */
   iris_guiding_params gp = iris_guiding_params_default();
   gp.photons = 60000;
   gp.train_spp = 3; /* the render trains its guide too */
@@ -87,8 +90,10 @@ int main(void) {
     if (CHECK(render(s, 1, keep, &r1))) {
       CHECK_EQ_INT(r1.train_spp, keep ? 3 : 0);
       CHECK_EQ_INT((int)r1.film.count[0], keep ? 9 : 6);
+      CHECK(r1.connect_rays > 0); /* the connections ran */
       if (CHECK(render(s, 2, keep, &r2))) {
         CHECK(same_film(&r1.film, &r2.film));
+        CHECK(r1.connect_rays == r2.connect_rays);
         iris_render_result_destroy(&r2);
       }
       iris_render_result_destroy(&r1);

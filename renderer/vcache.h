@@ -1,0 +1,85 @@
+/* Connections to a light-vertex cache (docs/guiding.md, "Connections to a
+ * light-vertex cache"): light that reaches the camera's side of an opening
+ * after bouncing beyond it, carried by light paths instead of camera paths.
+ *
+ * Two regions are the sides of a plane (the opening's, from the guide's
+ * portals): A, where the caches that keep the portal lie, and B. For every
+ * image sample index s, `paths` light paths leave the emissive triangles (as
+ * photons do), walk region B through plain surfaces (Lambertian reflectors
+ * with flat shading, where cosine sampling is the adjoint's) with roulette, and
+ * the pool of s keeps the plain vertex z where each enters region A after at
+ * least one vertex in B. A camera vertex x whose path so far lies in A
+ * connects to one z of its sample index's pool, drawn uniformly, when |x - z|
+ * exceeds a minimum distance. The paths so made,
+ *   camera, x_1 .. x_{k-1} in A (k >= 2), z = x_k in A and plain, then only
+ *   plain vertices in B up to an emissive triangle, |x_{k-1} - x_k| > d_min,
+ *   within the maximum depth,
+ * are left out of the camera estimator (its light samples of triangles and
+ * the triangles its rays hit): a partition of path space, each path made by
+ * exactly one strategy, so no MIS weight is needed and the sum is unbiased for
+ * any plane. Pools are functions of (seed, s) alone: the image does not depend
+ * on the thread count or on how the samples are partitioned. */
+#ifndef IRIS_RENDERER_VCACHE_H
+#define IRIS_RENDERER_VCACHE_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "core/error.h"
+#include "core/math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+struct iris_integrator;
+struct iris_shading_point;
+
+/* A stored vertex z: its position, its geometric normal on the side the
+ * light arrived from, the light's throughput there times z's BSDF (f power),
+ * and the number m of region-B vertices before it. */
+typedef struct iris_vcache_vertex {
+  iris_vec3 p, n, f_power;
+  int32_t m;
+} iris_vcache_vertex;
+
+typedef struct iris_vcache_pool {
+  uint32_t count;
+  iris_vcache_vertex *v;
+} iris_vcache_pool;
+
+typedef struct iris_vcache_params {
+  iris_vec3 o, n;   /* the plane: region A is its negative side */
+  float eps;        /* a point within eps of the plane belongs to the side it is seen from */
+  float min_d2;     /* the shortest connection, squared */
+  uint32_t paths;   /* light paths per sample index */
+  uint64_t seed;
+  int threads;
+} iris_vcache_params;
+
+typedef struct iris_vcache iris_vcache;
+
+/* The integrator must outlive the cache (its lights, accel and shading). */
+iris_status iris_vcache_create(iris_vcache **out, const iris_vcache_params *p, const struct iris_integrator *it,
+                               iris_error *err);
+void iris_vcache_destroy(iris_vcache *vc);
+/* The pool of sample index s, built on first use (with the next 31 indices,
+ * in parallel; thread-safe). NULL where s is past the cache's reach or memory
+ * ran out: then the path neither connects nor leaves anything out. */
+const iris_vcache_pool *iris_vcache_get(iris_vcache *vc, uint64_t s);
+const iris_vcache_params *iris_vcache_settings(const iris_vcache *vc);
+/* Rays the light paths traced so far, and the vertices stored. */
+void iris_vcache_counts(const iris_vcache *vc, uint64_t *rays, uint64_t *stored);
+
+/* Whether x, reached along a ray whose reverse is wo, lies in region A. */
+static inline bool iris_vcache_in_a(const iris_vcache_params *p, iris_vec3 x, iris_vec3 wo) {
+  float d = iris_dot(iris_sub(x, p->o), p->n);
+  return d < -p->eps || (d <= p->eps && iris_dot(wo, p->n) < 0.0f);
+}
+/* A plain vertex: a Lambertian reflector (no other lobe) with flat shading. */
+bool iris_vcache_plain(const struct iris_shading_point *sp, iris_vec3 ng);
+
+#ifdef __cplusplus
+}
+#endif
+#endif
