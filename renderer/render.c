@@ -149,6 +149,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     /* the power sampler keeps the hash renders had before the light tree */
     if (p.light_sampler != IRIS_LIGHT_SAMPLER_POWER)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_sampler, 0x7ee11ULL, 2);
+    /* connections asked for or refused: parts must agree (the default keeps the hash) */
+    if (p.connect != IRIS_CONNECT_AUTO) res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.connect, 0xc0ecULL, 3);
   }
   /* What the render will need against what the machine has, before any of it
    * is built (docs/performance.md, "Memory estimate"). Logged (with the
@@ -489,6 +491,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("sampler", "%s", iris_sampler_kind_name(r->sampler));
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
   META("light_sampler", "%s", iris_light_sampler_name(r->light_sampler));
+  META("connect", "%s", r->connect_rays > 0 ? "on" : "off"); /* connections to a light-vertex cache ran */
   META("spp", "%d", r->spp);
   META("train_spp", "%d", r->train_spp);
   META("seed", "%llu", (unsigned long long)r->seed);
