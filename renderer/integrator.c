@@ -455,7 +455,6 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_vec3 vc_prev = {0, 0, 0}, vc_last = {0, 0, 0}; /* x_{k-1}, x_k */
   bool vc_prev_nd = false, vc_last_nd = false, vc_last_plain = false;
   bool vc_made = false;       /* phase 1 and a path the connections make */
-  bool vc_rouletted = false;  /* its continuation was rouletted */
   iris_vec3 L_connect = iris_v3(0, 0, 0);
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -512,15 +511,14 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         vc_phase = vc_k >= 1 ? 1 : 2;
         const iris_vec3 d = iris_sub(vc_last, vc_prev);
         vc_made = vc_k >= 2 && vc_prev_nd && vc_last_plain && plain && iris_dot(d, d) > vp->min_d2;
+        /* What follows is the connections' until the path comes back to A:
+         * go on with probability 0.1 only (weighted 10; unbiased). */
+        if (vc_made) {
+          if (iris_sampler_slot(rng, IRIS_SLOT_CONNECT) >= 0.1f) break;
+          beta = iris_scale(beta, 10.0f);
+        }
       } else if (vc_phase == 1 && (in_a || !plain)) {
         vc_made = false; /* back in A, or a vertex no light path walks: the camera's again */
-      }
-      /* What follows is the connections' until the path comes back to A: go
-       * on with probability 0.1 only (weighted 10; unbiased). */
-      if (vc_phase == 1 && vc_made && !vc_rouletted) {
-        vc_rouletted = true;
-        if (iris_sampler_slot(rng, IRIS_SLOT_CONNECT) >= 0.1f) break;
-        beta = iris_scale(beta, 10.0f);
       }
     }
     /* Choose the light for NEE now, with the number sample_direct will draw,

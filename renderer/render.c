@@ -449,10 +449,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   }
   free(stats);
   if (vcache) { /* the light paths' rays count with the render's */
-    uint64_t vrays = 0, vstored = 0;
-    iris_vcache_counts(vcache, &vrays, &vstored);
-    res->stats.rays += vrays;
-    res->connect_rays = vrays;
+    res->connect_rays = iris_vcache_rays(vcache);
+    res->stats.rays += res->connect_rays;
     iris_vcache_destroy(vcache);
   }
   memset(&lights.learned, 0, sizeof lights.learned);

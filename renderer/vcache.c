@@ -29,7 +29,7 @@ struct iris_vcache {
   const iris_integrator *it;
   chunk *_Atomic chunks[MAX_CHUNKS];
   pthread_mutex_t lock;
-  atomic_uint_fast64_t rays, stored;
+  atomic_uint_fast64_t rays;
 };
 
 bool iris_vcache_plain(const iris_shading_point *sp, iris_vec3 ng) {
@@ -63,10 +63,7 @@ void iris_vcache_destroy(iris_vcache *vc) {
 
 const iris_vcache_params *iris_vcache_settings(const iris_vcache *vc) { return &vc->p; }
 
-void iris_vcache_counts(const iris_vcache *vc, uint64_t *rays, uint64_t *stored) {
-  *rays = atomic_load(&((iris_vcache *)vc)->rays);
-  *stored = atomic_load(&((iris_vcache *)vc)->stored);
-}
+uint64_t iris_vcache_rays(const iris_vcache *vc) { return atomic_load(&((iris_vcache *)vc)->rays); }
 
 static bool push(iris_vcache_pool *pool, uint32_t *cap, const iris_vcache_vertex *v) {
   if (pool->count == *cap) {
@@ -161,11 +158,10 @@ const iris_vcache_pool *iris_vcache_get(iris_vcache *vc, uint64_t s) {
       b.ch = ch;
       b.first = c * CHUNK;
       iris_parallel_for(CHUNK, 1, vc->p.threads, build_task, &b);
-      uint64_t rays = 0, stored = 0;
+      uint64_t rays = 0;
       bool ok = true;
-      for (uint32_t i = 0; i < CHUNK; ++i) rays += b.rays[i], stored += ch->pool[i].count, ok = ok && b.ok[i];
+      for (uint32_t i = 0; i < CHUNK; ++i) rays += b.rays[i], ok = ok && b.ok[i];
       atomic_fetch_add(&vc->rays, rays);
-      atomic_fetch_add(&vc->stored, stored);
       if (ok) {
         atomic_store_explicit(&vc->chunks[c], ch, memory_order_release);
       } else { /* out of memory: these sample indices go without */

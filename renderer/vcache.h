@@ -68,8 +68,8 @@ void iris_vcache_destroy(iris_vcache *vc);
  * ran out: then the path neither connects nor leaves anything out. */
 const iris_vcache_pool *iris_vcache_get(iris_vcache *vc, uint64_t s);
 const iris_vcache_params *iris_vcache_settings(const iris_vcache *vc);
-/* Rays the light paths traced so far, and the vertices stored. */
-void iris_vcache_counts(const iris_vcache *vc, uint64_t *rays, uint64_t *stored);
+/* Rays the light paths traced so far. */
+uint64_t iris_vcache_rays(const iris_vcache *vc);
 
 /* Whether x, reached along a ray whose reverse is wo, lies in region A. */
 static inline bool iris_vcache_in_a(const iris_vcache_params *p, iris_vec3 x, iris_vec3 wo) {
