@@ -563,7 +563,6 @@ static void find_portals(void *ctx, uint64_t begin, uint64_t end, int thread_ind
 /* At most this many joined openings (each cache's rectangle is compared
  * with each: the work stays linear in the caches). */
 #define PORTAL_JOINED_MAX 64
-#define PORTAL_VIEWERS 4 /* finders that tighten a joined rectangle */
 #define PORTAL_EXTEND_TRIED 4  /* ... among this many (64 probes each): linear work in the caches */
 
 typedef struct joined_portal {
@@ -643,47 +642,26 @@ static void extend_portals(void *ctx, uint64_t begin, uint64_t end, int thread_i
  * and so does every cache that found none but gets enough of its light
  * through a whole one (extend_portals). */
 static void join_portals(iris_guiding *g, const iris_guide_setup *s, int threads) {
+  const size_t n = g->cache_count;
+  iris_portal *parts = malloc(sizeof *parts * (n ? n : 1)), whole[PORTAL_JOINED_MAX];
+  iris_vec3 *at = malloc(sizeof *at * 2 * (n ? n : 1)), side[PORTAL_JOINED_MAX];
+  uint8_t *group = malloc(n ? n : 1); /* whole of each cache; 0xff: none */
+  if (!parts || !at || !group) { /* the finders' own rectangles stay */
+    free(parts), free(at), free(group);
+    return;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const iris_cache *cache = &g->caches[i];
+    if (cache->portal_weight > 0.0f) parts[i] = cache->portal;
+    else memset(&parts[i], 0, sizeof parts[i]);
+    at[i] = cache->p, at[n + i] = cache->frame.n;
+  }
+  const int count = iris_portal_join_all(s->accel, parts, at, at + n, n, whole, side, PORTAL_JOINED_MAX, group);
   joined_portal joined[PORTAL_JOINED_MAX];
-  int count = 0;
-  uint8_t *group = malloc(g->cache_count ? g->cache_count : 1); /* whole of each cache; 0xff: none */
-  if (!group) return; /* the finders' own rectangles stay */
-  for (size_t i = 0; i < g->cache_count; ++i) {
-    iris_cache *cache = &g->caches[i];
-    group[i] = 0xff;
-    if (!(cache->portal_weight > 0.0f)) continue;
-    int j = 0;
-    while (j < count && !iris_portal_join(&joined[j].p, joined[j].side, &cache->portal, cache->p)) ++j;
-    if (j == count && count < PORTAL_JOINED_MAX) joined[count++] = (joined_portal){cache->portal, cache->p};
-    if (j < count) group[i] = (uint8_t)j;
-  }
-  /* wholes that grew into each other since are one */
-  for (bool merged = true; merged;) {
-    merged = false;
-    for (int j = 0; j < count && !merged; ++j)
-      for (int k = j + 1; k < count && !merged; ++k) {
-        if (!iris_portal_join(&joined[j].p, joined[j].side, &joined[k].p, joined[k].side)) continue;
-        merged = true;
-        joined[k] = joined[--count];
-        for (size_t i = 0; i < g->cache_count; ++i)
-          if (group[i] == k) group[i] = (uint8_t)j;
-          else if (group[i] == count) group[i] = (uint8_t)k;
-      }
-  }
-  /* each whole tightened to what up to PORTAL_VIEWERS of its finders (spread
-   * over the cache order) see through it; one that none sees through is dropped */
-  for (int j = 0; j < count; ++j) {
-    size_t members = 0, seen = 0;
-    for (size_t i = 0; i < g->cache_count; ++i) members += group[i] == j;
-    iris_vec3 at[PORTAL_VIEWERS], nrm[PORTAL_VIEWERS];
-    int viewers = 0;
-    for (size_t i = 0; i < g->cache_count && viewers < PORTAL_VIEWERS; ++i)
-      if (group[i] == j && seen++ * PORTAL_VIEWERS >= (size_t)viewers * members)
-        at[viewers] = g->caches[i].p, nrm[viewers++] = g->caches[i].frame.n;
-    if (!iris_portal_tighten(s->accel, &joined[j].p, at, nrm, viewers)) memset(&joined[j].p, 0, sizeof joined[j].p);
-  }
-  for (size_t i = 0; i < g->cache_count; ++i)
+  for (int j = 0; j < count; ++j) joined[j] = (joined_portal){whole[j], side[j]};
+  for (size_t i = 0; i < n; ++i)
     if (group[i] != 0xff && iris_portal_present(&joined[group[i]].p)) g->caches[i].portal = joined[group[i]].p;
-  free(group);
+  free(parts), free(at), free(group);
   extend_ctx e = {g, s->accel, s->seed, joined, count};
   if (count > 0) iris_parallel_for(g->cache_count, 16, threads, extend_portals, &e);
 }

@@ -371,3 +371,43 @@ bool iris_portal_tighten(const struct iris_accel *accel, iris_portal *p, const i
   p->o = o;
   return true;
 }
+
+int iris_portal_join_all(const struct iris_accel *accel, const iris_portal *parts, const iris_vec3 *finder_p,
+                         const iris_vec3 *finder_n, size_t n, iris_portal *whole, iris_vec3 *side, int max,
+                         uint8_t *group) {
+  int count = 0;
+  if (max > 255) max = 255;
+  for (size_t i = 0; i < n; ++i) {
+    group[i] = 0xff;
+    if (!iris_portal_present(&parts[i])) continue;
+    int j = 0;
+    while (j < count && !iris_portal_join(&whole[j], side[j], &parts[i], finder_p[i])) ++j;
+    if (j == count && count < max) whole[count] = parts[i], side[count++] = finder_p[i];
+    if (j < count) group[i] = (uint8_t)j;
+  }
+  /* wholes that grew into each other since are one */
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (int j = 0; j < count && !merged; ++j)
+      for (int k = j + 1; k < count && !merged; ++k) {
+        if (!iris_portal_join(&whole[j], side[j], &whole[k], side[k])) continue;
+        merged = true;
+        --count;
+        whole[k] = whole[count], side[k] = side[count];
+        for (size_t i = 0; i < n; ++i)
+          if (group[i] == k) group[i] = (uint8_t)j;
+          else if (group[i] == count) group[i] = (uint8_t)k;
+      }
+  }
+  for (int j = 0; j < count; ++j) {
+    size_t members = 0, seen = 0;
+    for (size_t i = 0; i < n; ++i) members += group[i] == j;
+    iris_vec3 at[IRIS_PORTAL_VIEWERS], nrm[IRIS_PORTAL_VIEWERS];
+    int viewers = 0;
+    for (size_t i = 0; i < n && viewers < IRIS_PORTAL_VIEWERS; ++i)
+      if (group[i] == j && seen++ * IRIS_PORTAL_VIEWERS >= (size_t)viewers * members)
+        at[viewers] = finder_p[i], nrm[viewers++] = finder_n[i];
+    if (!iris_portal_tighten(accel, &whole[j], at, nrm, viewers)) memset(&whole[j], 0, sizeof whole[j]);
+  }
+  return count;
+}

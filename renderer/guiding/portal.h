@@ -10,6 +10,7 @@
 #define IRIS_RENDERER_GUIDING_PORTAL_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "core/math.h"
@@ -88,6 +89,20 @@ bool iris_portal_join(iris_portal *a, iris_vec3 side_a, const iris_portal *b, ir
 #define IRIS_PORTAL_TIGHTEN_GRID 24
 bool iris_portal_tighten(const struct iris_accel *accel, iris_portal *p, const iris_vec3 *viewer,
                          const iris_vec3 *viewer_n, int viewers);
+
+/* Joins parts found by several finders into wholes: parts[i] (absent: not
+ * a part), found from finder_p[i] (normal finder_n[i]), that lie in one plane
+ * and overlap are joined serially, in order (deterministic), wholes that grew
+ * into each other since are merged, and each whole is tightened to what up
+ * to IRIS_PORTAL_VIEWERS of its finders (spread over the order) see through
+ * it; one that none sees through is dropped (left absent). whole[] (and
+ * side[], the first finder's position: the side it is seen from) get at most
+ * `max` (<= 255) wholes; group[i] the whole of part i, 0xff for none (absent,
+ * or past `max`). Returns the number of wholes. */
+#define IRIS_PORTAL_VIEWERS 4
+int iris_portal_join_all(const struct iris_accel *accel, const iris_portal *parts, const iris_vec3 *finder_p,
+                         const iris_vec3 *finder_n, size_t n, iris_portal *whole, iris_vec3 *side, int max,
+                         uint8_t *group);
 
 /* A cache's density of incident light over world directions. */
 typedef float (*iris_portal_density)(void *ctx, iris_vec3 wi);
