@@ -472,8 +472,13 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
                                                  !prev_delta && mis ? &env_pdf : NULL, st);
       if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
-        if (env_guided && !prev_delta && mis && bounce > 0) /* the map's coordinates of ray.d: st */
-          env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, st[0], st[1]);
+        if (env_guided && !prev_delta && mis && bounce > 0) { /* the map's coordinates of ray.d: st */
+          float add;
+          env_pdf *= it->guide.environment_scale(it->guide.ctx, it->lights->envmap, &prev_guide, iris_normalize(ray.d),
+                                                 st[0], st[1], &add);
+          if (add > 0.0f) /* the sky's windows: their density times the map's choice */
+            env_pdf += add * iris_lights_select_pmf_at(it->lights, prev_p, prev_n, (uint32_t)it->lights->environment);
+        }
         env_pdf *= prev_light;
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;

@@ -146,10 +146,13 @@ typedef struct iris_direction_sampler {
    * (u0, u1), which also makes its own choices. */
   int (*sample_environment)(void *ctx, const struct iris_envmap *env, const iris_shading_point *sp, float u0,
                             float u1, iris_vec3 *wi, float *pdf, float *s, float *t);
-  /* With sample_environment: its density for the direction at map
-   * coordinates (s, t) over the map's own, at the vertex whose prepared state
-   * is v (for the MIS weight of a ray that left that vertex and escaped). */
-  float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t);
+  /* With sample_environment: its density for the direction wi at map
+   * coordinates (s, t), at the vertex whose prepared state is v (for the MIS
+   * weight of a ray that left that vertex and escaped), as the map's own
+   * density times the returned scale plus *add (the part that is not a
+   * multiple of the map's: sky visibility's windows). */
+  float (*environment_scale)(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, iris_vec3 wi,
+                             float s, float t, float *add);
   /* Optional: after prepare, the probability in (0, 1] with which the vertex
    * samples a light at all (guiding: < 1 where training never saw a light
    * sample arrive, docs/guiding.md "Light sampling where no light arrives").

@@ -49,10 +49,11 @@ static int counted_environment(void *ctx, const struct iris_envmap *env, const i
   tl_calls++;
   return c->inner.sample_environment(c->inner.ctx, env, sp, u0, u1, wi, pdf, s, t);
 }
-static float counted_scale(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, float s, float t) {
+static float counted_scale(void *ctx, const struct iris_envmap *env, const iris_guide_vertex *v, iris_vec3 wi, float s,
+                           float t, float *add) {
   const counted_guide *c = ctx;
   tl_calls++;
-  return c->inner.environment_scale(c->inner.ctx, env, v, s, t);
+  return c->inner.environment_scale(c->inner.ctx, env, v, wi, s, t, add);
 }
 static float counted_light(void *ctx, const iris_shading_point *sp) {
   const counted_guide *c = ctx;

@@ -25,8 +25,11 @@ static void drop_tables(iris_skyvis *sv) {
   iris_envmap_regions_destroy(&sv->regions);
   free(sv->cdf);
   free(sv->sees);
+  free(sv->cache_window);
   sv->cdf = NULL;
   sv->sees = NULL;
+  sv->cache_window = NULL;
+  sv->window_count = 0;
   sv->region_count = 0;
   sv->memory_bytes = 0;
 }
@@ -44,7 +47,28 @@ typedef struct probe_ctx {
   int probes;
   uint64_t seed;
   uint64_t *probes_by_thread, *escaped_by_thread; /* [threads * 8]: a cache line each */
+  iris_portal *window; /* per cache: the opening found into its escaping probes' cone (or none) */
 } probe_ctx;
+
+#define WINDOW_STREAM 0x736b7977696eULL /* the window probes' hash stream */
+
+/* The opening a cache sees the sky through: the cone around the mean of its
+ * escaping probes (esc[0..n), weighted by |cos|) that holds them all, looked
+ * into by portal.h's finder. None unless at least 4 escaped. */
+static void find_window(const probe_ctx *c, size_t i, const iris_vec3 *esc, int n) {
+  memset(&c->window[i], 0, sizeof c->window[i]);
+  const iris_cache *cache = &c->caches[i];
+  if (n < 4 || cache->sphere) return;
+  iris_vec3 sum = iris_v3(0, 0, 0);
+  for (int k = 0; k < n; ++k) sum = iris_add(sum, iris_scale(esc[k], fabsf(iris_dot(esc[k], cache->frame.n))));
+  if (!(iris_dot(sum, sum) > 0.0f)) return;
+  const iris_vec3 axis = iris_normalize(sum);
+  float cos_max = 1.0f;
+  for (int k = 0; k < n; ++k) cos_max = fminf(cos_max, iris_dot(esc[k], axis));
+  cos_max = fmaxf(cos_max - 0.02f, -0.99f); /* the probes' own spacing: a little wider */
+  iris_portal_find(c->accel, cache->p, cache->frame.n, axis, cos_max, iris_hash4(c->seed, WINDOW_STREAM, i, 0), NULL,
+                   NULL, &c->window[i]);
+}
 
 /* Cache i: per region, the map's probability times the mean over the probes
  * of visibility x |cos| (one-sided caches: directions below the surface count
@@ -54,8 +78,10 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
   iris_skyvis *sv = c->sv;
   const iris_envmap_regions *R = &sv->regions;
   uint64_t traced = 0, escaped = 0;
+  iris_vec3 *esc = malloc(sizeof *esc * (size_t)sv->region_count * (size_t)c->probes);
   for (uint64_t i = begin; i < end; ++i) {
     if (iris_cancel_requested()) break;
+    int n_esc = 0;
     const iris_cache *cache = &c->caches[i];
     const iris_vec3 n = cache->frame.n;
     float *row = &sv->cdf[i * (size_t)sv->region_count];
@@ -85,6 +111,7 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
           if (iris_accel_occluded(c->accel, &ray)) continue;
           escaped++;
           seen += fabs((double)cosv);
+          if (esc) esc[n_esc++] = d;
         }
         w = (double)R->prob[b] * seen / (double)c->probes;
         open += (double)R->prob[b] * facing / (double)c->probes;
@@ -101,9 +128,45 @@ static void probe_caches(void *ctx, uint64_t begin, uint64_t end, int thread_ind
       /* the last region with weight ends at exactly 1 */
       for (int b = sv->region_count - 1; b >= 0 && row[b] >= 1.0f - 1e-6f; --b) row[b] = 1.0f;
     }
+    if (sv->sees[i] == IRIS_SKYVIS_PART && esc) find_window(c, i, esc, n_esc);
+    else memset(&c->window[i], 0, sizeof c->window[i]);
   }
+  free(esc);
   c->probes_by_thread[8 * (size_t)thread_index] += traced;
   c->escaped_by_thread[8 * (size_t)thread_index] += escaped;
+}
+
+typedef struct extend_ctx {
+  iris_skyvis *sv;
+  const iris_cache *caches;
+  const iris_accel *accel;
+  uint64_t seed;
+} extend_ctx;
+
+static float no_density(void *ctx, iris_vec3 wi) {
+  (void)ctx, (void)wi;
+  return 0.0f;
+}
+
+/* A cache that sees part of the sky but found no opening itself (its probes'
+ * cone held more than the window, or too few probes fell on the wall) takes
+ * the window it reaches best through, if at least half of the probes to
+ * points on it get there (iris_portal_share's reach). */
+static void extend_windows(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  const extend_ctx *c = ctx;
+  iris_skyvis *sv = c->sv;
+  for (uint64_t i = begin; i < end; ++i) {
+    if (sv->sees[i] != IRIS_SKYVIS_PART || sv->cache_window[i] != 0xff || c->caches[i].sphere) continue;
+    float best = 0.5f;
+    for (int j = 0; j < sv->window_count; ++j) {
+      if (!iris_portal_present(&sv->window[j])) continue;
+      float reach;
+      iris_portal_share(c->accel, &sv->window[j], c->caches[i].p, c->caches[i].frame.n,
+                        iris_hash4(c->seed, WINDOW_STREAM, i, 1 + (uint64_t)j), no_density, NULL, &reach);
+      if (reach >= best) best = reach + 1e-6f, sv->cache_window[i] = (uint8_t)j;
+    }
+  }
 }
 
 iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, size_t cache_count, const iris_accel *accel,
@@ -128,7 +191,14 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the sky visibility of %zu caches",
                           cache_count);
   }
-  probe_ctx c = {sv, env, caches, accel, p->probes, seed, counts, counts + 8 * (size_t)nt};
+  iris_portal *window = calloc(cache_count, sizeof *window);
+  if (!window) {
+    free(counts);
+    iris_skyvis_destroy(sv);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the sky visibility of %zu caches",
+                          cache_count);
+  }
+  probe_ctx c = {sv, env, caches, accel, p->probes, seed, counts, counts + 8 * (size_t)nt, window};
   iris_parallel_for(cache_count, 16, nt, probe_caches, &c);
   for (int t = 0; t < nt; ++t) {
     sv->probes += counts[8 * (size_t)t];
@@ -137,6 +207,7 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
   free(counts);
   for (size_t i = 0; i < cache_count; ++i) sv->part_caches += sv->sees[i] == IRIS_SKYVIS_PART;
   if (iris_cancel_requested()) {
+    free(window);
     iris_skyvis_destroy(sv);
     return iris_cancel_error(err);
   }
@@ -147,9 +218,39 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
   if ((double)sv->part_caches < SKYVIS_MIN_PART * (double)cache_count) {
     /* Nearly every cache sees all its sky or none: the map's own sampling
      * does as well, without the cost of the mixture (an open scene). */
+    free(window);
     drop_tables(sv);
     return IRIS_OK;
   }
+  /* The caches' openings joined into whole windows (serially: deterministic). */
+  sv->cache_window = malloc(cache_count);
+  iris_vec3 *at = malloc(sizeof *at * 2 * cache_count), side[IRIS_SKYVIS_WINDOWS];
+  if (sv->cache_window && at) {
+    for (size_t i = 0; i < cache_count; ++i) at[i] = caches[i].p, at[cache_count + i] = caches[i].frame.n;
+    sv->window_count = iris_portal_join_all(accel, window, at, at + cache_count, cache_count, sv->window, side,
+                                            IRIS_SKYVIS_WINDOWS, sv->cache_window);
+    /* only the wholes that stayed (tightening drops one no finder sees through) */
+    uint8_t keep[IRIS_SKYVIS_WINDOWS];
+    int kept = 0;
+    for (int j = 0; j < sv->window_count; ++j) {
+      keep[j] = iris_portal_present(&sv->window[j]) ? (uint8_t)kept : 0xff;
+      if (keep[j] != 0xff) sv->window[kept++] = sv->window[j];
+    }
+    sv->window_count = kept;
+    for (size_t i = 0; i < cache_count; ++i)
+      if (sv->cache_window[i] != 0xff) sv->cache_window[i] = keep[sv->cache_window[i]];
+    if (sv->window_count > 0) {
+      extend_ctx e = {sv, caches, accel, seed};
+      iris_parallel_for(cache_count, 16, nt, extend_windows, &e);
+    }
+    for (size_t i = 0; i < cache_count; ++i) sv->window_caches += sv->cache_window[i] != 0xff;
+    sv->memory_bytes += cache_count;
+  } else { /* no windows: the regions alone */
+    free(sv->cache_window);
+    sv->cache_window = NULL;
+  }
+  free(at);
+  free(window);
   sv->built = true;
   sv->map_width = env->width;
   sv->map_height = env->height;
@@ -159,11 +260,15 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
 
 void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size) {
   if (size) buf[0] = '\0';
+  char windows[96] = "";
+  if (sv->window_count > 0)
+    snprintf(windows, sizeof windows, " (%zu through %d window%s)", sv->window_caches, sv->window_count,
+             sv->window_count == 1 ? "" : "s");
   if (sv->probed)
-    snprintf(buf, size, "; sky seen from the caches: %llu probes, %.0f%% escaped, %zu caches see part of it%s, %.2f s",
+    snprintf(buf, size, "; sky seen from the caches: %llu probes, %.0f%% escaped, %zu caches see part of it%s%s, %.2f s",
              (unsigned long long)sv->probes,
              sv->probes ? 100.0 * (double)sv->escaped / (double)sv->probes : 0.0, sv->part_caches,
-             sv->built ? "" : " (too few: the map's own sampling)", sv->seconds);
+             sv->built ? "" : " (too few: the map's own sampling)", windows, sv->seconds);
 }
 
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env) {
@@ -181,23 +286,47 @@ static inline float region_ratio(const iris_skyvis *sv, const float *row, int re
 
 bool iris_skyvis_guides(const iris_skyvis *sv, const uint32_t *ids, int m) {
   if (!sv->built) return false;
+  if (m <= 0) return sv->window_count > 0; /* a vertex no cache covers: the windows as a whole */
   for (int i = 0; i < m; ++i)
     if (sv->sees[ids[i]] == IRIS_SKYVIS_PART) return true;
   return false;
 }
 
-float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float s, float t) {
+/* The window cache `id` draws from, NULL for none. */
+static inline const iris_portal *cache_window(const iris_skyvis *sv, uint32_t id) {
+  return sv->cache_window && sv->cache_window[id] != 0xff ? &sv->window[sv->cache_window[id]] : NULL;
+}
+
+float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, iris_vec3 x,
+                        iris_vec3 d, float s, float t, float *window) {
+  *window = 0.0f;
   if (!iris_skyvis_guides(sv, ids, m)) return 1.0f;
+  if (m <= 0) { /* each window alike */
+    float through = 0.0f;
+    for (int j = 0; j < sv->window_count; ++j) through += iris_portal_pdf(&sv->window[j], x, d);
+    *window = IRIS_SKYVIS_WINDOW_SHARE * through / (float)sv->window_count;
+    return 1.0f - IRIS_SKYVIS_WINDOW_SHARE;
+  }
   const int region = iris_envmap_region_of(env, &sv->regions, s, t);
-  float sum = 0.0f;
+  float sum = 0.0f, through = 0.0f, last_pdf = 0.0f;
+  const iris_portal *last = NULL;
   for (int i = 0; i < m; ++i) {
     if (sv->sees[ids[i]] != IRIS_SKYVIS_PART) {
       sum += 1.0f;
       continue;
     }
     const float *row = &sv->cdf[(size_t)ids[i] * (size_t)sv->region_count];
-    sum += (1.0f - sv->beta) + sv->beta * region_ratio(sv, row, region);
+    const float own = (1.0f - sv->beta) + sv->beta * region_ratio(sv, row, region);
+    const iris_portal *w = cache_window(sv, ids[i]);
+    if (w) {
+      sum += (1.0f - IRIS_SKYVIS_WINDOW_SHARE) * own;
+      if (w != last) last = w, last_pdf = iris_portal_pdf(w, x, d); /* tied caches mostly share one */
+      through += IRIS_SKYVIS_WINDOW_SHARE * last_pdf;
+    } else {
+      sum += own;
+    }
   }
+  *window = through / (float)m;
   return sum / (float)m;
 }
 
@@ -212,9 +341,27 @@ static int search_row(const float *row, int n, float u) {
   return lo;
 }
 
-bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u0,
-                        float u1, iris_vec3 *d, float *pdf, float *s, float *t) {
-  if (!sv->built || m <= 0) return iris_envmap_sample_st(env, u0, u1, d, pdf, s, t);
+bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, iris_vec3 x,
+                        float u0, float u1, iris_vec3 *d, float *pdf, float *s, float *t) {
+  if (!iris_skyvis_guides(sv, ids, m)) return iris_envmap_sample_st(env, u0, u1, d, pdf, s, t);
+  if (m <= 0) { /* no cache: one of the windows with their share, else the map */
+    float pdf_map;
+    if (u1 < IRIS_SKYVIS_WINDOW_SHARE) {
+      const float uw = u1 / IRIS_SKYVIS_WINDOW_SHARE * (float)sv->window_count;
+      const int j = uw < (float)(sv->window_count - 1) ? (int)uw : sv->window_count - 1;
+      *d = iris_portal_sample(&sv->window[j], x, u0, iris_clampf(uw - (float)j, 0.0f, IRIS_ONE_MINUS_EPSILON));
+      if (!(iris_portal_pdf(&sv->window[j], x, *d) > 0.0f)) return false;
+      iris_envmap_dir_to_st(env, *d, s, t);
+      pdf_map = iris_envmap_pdf_st(env, *s, *t);
+    } else if (!iris_envmap_sample_st(env, u0, iris_rescale_unit(u1, IRIS_SKYVIS_WINDOW_SHARE, 1.0f), d, &pdf_map, s,
+                                      t)) {
+      return false;
+    }
+    float through;
+    const float scale = iris_skyvis_scale(sv, env, ids, m, x, *d, *s, *t, &through);
+    *pdf = pdf_map * scale + through;
+    return isfinite(*pdf) && *pdf > 0.0f;
+  }
   /* Every choice from u1, the second number of the pixel's stratified pair,
    * rescaled at each step (the tied cache, its regions or the map, the region,
    * then the column within it), the row from u0 as it comes: the directions
@@ -225,24 +372,35 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
   int j = (int)um;
   j = j < 0 ? 0 : j >= m ? m - 1 : j;
   /* the rest of u1, uniform in [0, 1) */
-  const float ub = iris_clampf(um - (float)j, 0.0f, IRIS_ONE_MINUS_EPSILON);
+  float ub = iris_clampf(um - (float)j, 0.0f, IRIS_ONE_MINUS_EPSILON);
   const uint32_t id = ids[j];
   float pdf_map;
-  if (sv->sees[id] != IRIS_SKYVIS_PART) {
-    if (!iris_envmap_sample_st(env, u0, ub, d, &pdf_map, s, t)) return false;
-  } else if (ub < sv->beta) {
-    const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
-    const float ur = iris_rescale_unit(ub, 0.0f, sv->beta);
-    const int region = search_row(row, sv->region_count, ur);
-    const float lo = region > 0 ? row[region - 1] : 0.0f, hi = row[region];
-    const float ui = hi > lo ? iris_rescale_unit(ur, lo, hi) : 0.0f;
-    if (!iris_envmap_sample_region(env, &sv->regions, region, u0, ui, d, &pdf_map, s, t)) return false;
+  const iris_portal *w = cache_window(sv, id);
+  if (w && ub < IRIS_SKYVIS_WINDOW_SHARE) { /* a point on its window (u0 across, the rest of u1 along) */
+    *d = iris_portal_sample(w, x, u0, iris_rescale_unit(ub, 0.0f, IRIS_SKYVIS_WINDOW_SHARE));
+    if (!(iris_portal_pdf(w, x, *d) > 0.0f)) return false; /* x lies in its plane */
+    iris_envmap_dir_to_st(env, *d, s, t);
+    pdf_map = iris_envmap_pdf_st(env, *s, *t);
   } else {
-    const float ua = iris_rescale_unit(ub, sv->beta, 1.0f);
-    if (!iris_envmap_sample_st(env, u0, ua, d, &pdf_map, s, t)) return false;
+    if (w) ub = iris_rescale_unit(ub, IRIS_SKYVIS_WINDOW_SHARE, 1.0f);
+    if (sv->sees[id] != IRIS_SKYVIS_PART) {
+      if (!iris_envmap_sample_st(env, u0, ub, d, &pdf_map, s, t)) return false;
+    } else if (ub < sv->beta) {
+      const float *row = &sv->cdf[(size_t)id * (size_t)sv->region_count];
+      const float ur = iris_rescale_unit(ub, 0.0f, sv->beta);
+      const int region = search_row(row, sv->region_count, ur);
+      const float lo = region > 0 ? row[region - 1] : 0.0f, hi = row[region];
+      const float ui = hi > lo ? iris_rescale_unit(ur, lo, hi) : 0.0f;
+      if (!iris_envmap_sample_region(env, &sv->regions, region, u0, ui, d, &pdf_map, s, t)) return false;
+    } else {
+      const float ua = iris_rescale_unit(ub, sv->beta, 1.0f);
+      if (!iris_envmap_sample_st(env, u0, ua, d, &pdf_map, s, t)) return false;
+    }
   }
   /* the density of the whole strategy: the map's (of the sampled cell, as
-   * iris_envmap_sample_st gives it) times the mixture's factor */
-  *pdf = pdf_map * iris_skyvis_scale(sv, env, ids, m, *s, *t);
+   * iris_envmap_sample_st gives it) times the mixture's factor, and the windows' */
+  float through;
+  const float scale = iris_skyvis_scale(sv, env, ids, m, x, *d, *s, *t, &through);
+  *pdf = pdf_map * scale + through;
   return isfinite(*pdf) && *pdf > 0.0f;
 }

@@ -13,7 +13,19 @@
  * in it by the map; otherwise (and always for a cache that saw nothing, or
  * at least half of the sky it faces) the map as before. The density is the map's times the average over the tied
  * caches of (1 - beta) + beta P_cache(region) / P_map(region), which the
- * integrator also applies to escaping rays' MIS weights. */
+ * integrator also applies to escaping rays' MIS weights.
+ *
+ * Windows: a cache that sees part of the sky also looks for the opening it
+ * sees it through (portal.h, into the cone of its escaping probes); the
+ * caches' rectangles are joined into wholes, and a cache that has one (its
+ * own, or the one it reaches best through) draws, with probability
+ * IRIS_SKYVIS_WINDOW_SHARE, a point uniform on it (its other branches keep
+ * the rest): the sky through a window that is smaller than a region, seen
+ * from afar, which the regions' directions mostly miss. A vertex that no
+ * cache covers (walls the camera does not see, where few photons land) draws
+ * from the windows as a whole with that probability, else from the map. The
+ * windows' density, distance^2 / (area |cos|) through a rectangle, adds to
+ * the mixture's, at light samples and at escaping rays alike. */
 #ifndef IRIS_RENDERER_GUIDING_SKYVIS_H
 #define IRIS_RENDERER_GUIDING_SKYVIS_H
 
@@ -24,6 +36,7 @@
 #include "core/error.h"
 #include "renderer/accel.h"
 #include "renderer/envmap.h"
+#include "renderer/guiding/portal.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -34,6 +47,11 @@ struct iris_cache;
 /* What a cache's probes saw: nothing; less than half of the sky its side
  * faces (weighted by the map and the cosine); at least half of it. */
 enum { IRIS_SKYVIS_NONE = 0, IRIS_SKYVIS_PART = 1, IRIS_SKYVIS_OPEN = 2 };
+
+/* Probability of a cache's window in its light sampling of the map (docs/guiding.md,
+ * "Sky visibility": measured on sky-room), and at most this many windows. */
+#define IRIS_SKYVIS_WINDOW_SHARE 0.25f
+#define IRIS_SKYVIS_WINDOWS 16
 
 /* Built from one map, used with it: the guide keeps no pointer to the map
  * (the lights own it and may be built again around a guide that is kept);
@@ -53,6 +71,10 @@ typedef struct iris_skyvis {
   size_t cache_count;
   uint64_t probes, escaped;     /* shadow rays traced and not blocked */
   size_t part_caches;           /* caches that saw less than half of their sky (the ones that guide) */
+  iris_portal window[IRIS_SKYVIS_WINDOWS]; /* the openings the sky is seen through (joined) */
+  int window_count;
+  uint8_t *cache_window;        /* per cache: its window, 0xff none (only "part" caches have one) */
+  size_t window_caches;         /* caches with a window */
   double seconds;
   size_t memory_bytes;
 } iris_skyvis;
@@ -79,21 +101,24 @@ void iris_skyvis_describe(const iris_skyvis *sv, char *buf, size_t size);
 /* Whether sv was built for env (and is in use). */
 bool iris_skyvis_serves(const iris_skyvis *sv, const iris_envmap *env);
 
-/* Light sampling of the map env (the one sv serves) at a vertex whose tied caches are ids[0..m)
+/* Light sampling of the map env (the one sv serves) at a vertex x whose tied caches are ids[0..m)
  * from the pair (u0, u1): u1 picks the cache, the branch, the region and the
  * column in it (rescaled after each choice), u0 the row, so that the pair's
  * stratification carries into each region; the map's branch takes u0 and
  * the rescaled u1 as iris_envmap_sample_st does. *pdf is the whole
  * strategy's solid-angle density (not the light choice's probability); *s, *t
  * the map coordinates. */
-bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float u0, float u1,
-                        iris_vec3 *d, float *pdf, float *s, float *t);
-/* Whether any of the tied caches ids[0..m) samples its own regions (else the
+bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, iris_vec3 x,
+                        float u0, float u1, iris_vec3 *d, float *pdf, float *s, float *t);
+/* Whether any of the tied caches ids[0..m) samples its own regions or a
+ * window, or, with m = 0 (no cache), whether there are windows (else the
  * density is the map's: iris_skyvis_scale is 1 whatever the direction). */
 bool iris_skyvis_guides(const iris_skyvis *sv, const uint32_t *ids, int m);
-/* That density over the map's own (1 without a sky guide or caches) for the
- * direction at map coordinates (s, t). */
-float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, float s, float t);
+/* That density at x for the direction d at map coordinates (s, t) is
+ * p_map(d) x the returned scale + *window (1 and 0 without a sky guide or
+ * caches): the windows' part is not a multiple of the map's density. */
+float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, iris_vec3 x,
+                        iris_vec3 d, float s, float t, float *window);
 
 #ifdef __cplusplus
 }

@@ -26,21 +26,23 @@ iris_status iris_guiding_build_sky(iris_guiding *g, const iris_guide_setup *setu
   return st;
 }
 
-/* Light sampling of the map from the vertex's tied caches. */
+/* Light sampling of the map from the vertex's tied caches (or, at a vertex
+ * no cache covers, from the windows as a whole). */
 static int guided_sample_environment(void *ctx, const iris_envmap *env, const iris_shading_point *sp, float u0,
                                      float u1, iris_vec3 *wi, float *pdf, float *s, float *t) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = (const iris_guide_vertex_state *)sp->guide.bytes;
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
-  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, u0, u1, wi, pdf, s, t) ? 1 : 0;
+  if (!iris_skyvis_serves(&g->sky, env) || !iris_skyvis_guides(&g->sky, v->ids, v->m)) return -1;
+  return iris_skyvis_sample(&g->sky, env, v->ids, v->m, sp->si.p, u0, u1, wi, pdf, s, t) ? 1 : 0;
 }
 
-static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, float s,
-                                      float t) {
+static float guided_environment_scale(void *ctx, const iris_envmap *env, const iris_guide_vertex *gv, iris_vec3 wi,
+                                      float s, float t, float *add) {
   const iris_guiding *g = ctx;
   const iris_guide_vertex_state *v = iris_guide_vertex_get(gv);
-  if (v->m <= 0 || !iris_skyvis_serves(&g->sky, env)) return 1.0f;
-  return iris_skyvis_scale(&g->sky, env, v->ids, v->m, s, t);
+  *add = 0.0f;
+  if (!iris_skyvis_serves(&g->sky, env)) return 1.0f;
+  return iris_skyvis_scale(&g->sky, env, v->ids, v->m, v->p, wi, s, t, add);
 }
 
 void iris_guiding_sky_hooks(iris_guiding *g, iris_direction_sampler *s) {

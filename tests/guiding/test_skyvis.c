@@ -6,9 +6,14 @@
  *    (0 outside), which integrates to 1;
  *  - the mixture (tied caches picked uniformly, repeated ones, a cache that saw
  *    nothing, beta < 1 and beta = 1) passes chi-square against
- *    iris_skyvis_scale x the map's pdf, which integrates to 1;
+ *    iris_skyvis_scale x the map's pdf, which integrates to 1; so do the
+ *    mixtures with windows (a cache's own, one seen edge-on whose draws are
+ *    lost, and at a vertex without caches the windows as a whole), whose
+ *    density adds the windows' part;
  *  - built from sky-room's real caches: roof caches see all the sky (and take
- *    the map), back-floor caches see only the window's side; the tables are
+ *    the map), back-floor caches see only the window's side; the caches find
+ *    the window (its centre and size within 1 cm) and at least 90% of those
+ *    that see part of the sky draw from it; the tables and windows are
  *    bit-identical for 1 and 2 threads; on env-objects (open sky) fewer than
  *    10% of the caches see less than half of their sky, and the map's own
  *    sampling is kept. */
@@ -56,19 +61,26 @@ typedef struct mix_ctx {
   const iris_envmap *env;
   const uint32_t *ids;
   int m;
+  iris_vec3 x; /* the vertex */
 } mix_ctx;
+
+/* The mixture's density at c->x for d: the map's times the scale plus the windows'. */
+static double mix_density(const mix_ctx *c, iris_vec3 d) {
+  float s, t, through;
+  iris_envmap_dir_to_st(c->env, d, &s, &t);
+  const float scale = iris_skyvis_scale(c->sv, c->env, c->ids, c->m, c->x, d, s, t, &through);
+  return (double)iris_envmap_pdf(c->env, d) * (double)scale + (double)through;
+}
 
 static bool mix_sample(void *vc, const double u[3], double dir[3]) {
   mix_ctx *c = vc;
   iris_vec3 d;
   float pdf, s, t;
-  if (!iris_skyvis_sample(c->sv, c->env, c->ids, c->m, (float)u[0], (float)u[1], &d, &pdf, &s, &t))
+  if (!iris_skyvis_sample(c->sv, c->env, c->ids, c->m, c->x, (float)u[0], (float)u[1], &d, &pdf, &s, &t))
     return false;
   /* the density it reports is the one the pdf gives for its direction (up to
    * a cell edge's rounding) */
-  float s2, t2;
-  iris_envmap_dir_to_st(c->env, d, &s2, &t2);
-  float again = iris_envmap_pdf(c->env, d) * iris_skyvis_scale(c->sv, c->env, c->ids, c->m, s2, t2);
+  const float again = (float)mix_density(c, d);
   if (!(fabsf(again - pdf) <= 1e-3f * pdf)) {
     static int shown;
     if (shown++ < 3) fprintf(stderr, "sampled pdf %g, pdf of the direction %g\n", (double)pdf, (double)again);
@@ -77,14 +89,10 @@ static bool mix_sample(void *vc, const double u[3], double dir[3]) {
   return true;
 }
 static double mix_pdf(void *vc, const double dir[3]) {
-  mix_ctx *c = vc;
-  iris_vec3 d = iris_v3((float)dir[0], (float)dir[1], (float)dir[2]);
-  float s, t;
-  iris_envmap_dir_to_st(c->env, d, &s, &t);
-  return (double)iris_envmap_pdf(c->env, d) * (double)iris_skyvis_scale(c->sv, c->env, c->ids, c->m, s, t);
+  return mix_density(vc, iris_v3((float)dir[0], (float)dir[1], (float)dir[2]));
 }
 
-#define N_TESTS 5
+#define N_TESTS 7
 
 static void test_regions_and_mixture(const char *path) {
   iris_envmap env;
@@ -152,12 +160,48 @@ static void test_regions_and_mixture(const char *path) {
   const float betas[2] = {0.75f, 1.0f};
   for (int k = 0; k < 2; k++) {
     sv.beta = betas[k];
-    mix_ctx mc = {&sv, &env, k == 0 ? ids_a : ids_b, k == 0 ? 4 : 1};
+    mix_ctx mc = {&sv, &env, k == 0 ? ids_a : ids_b, k == 0 ? 4 : 1, iris_v3(0, 0, 0)};
     chi2_result r = chi2_run(&dom, mix_sample, mix_pdf, &mc, 300000, 0.01, N_TESTS);
     iris_check_record(r.passed, __FILE__, __LINE__, "mixture beta %.2f: %s", (double)betas[k], r.message);
     CHECK_NEAR(r.pdf_integral, 1.0, 3e-3);
     printf("mixture beta %.2f over %d caches: p = %.3g, pdf integral %.5f, lost %zu\n", (double)betas[k], mc.m,
            r.p_value, r.pdf_integral, r.lost);
+  }
+  /* Windows: cache 0 draws from a window 2 m away (a 1 x 0.6 m rectangle,
+   * seen obliquely), cache 2 from one the vertex sees edge-on from its plane
+   * (no direction: its draws are lost, its density 0), cache 1 from none; the
+   * vertex at the origin and, for the second case, behind the first window
+   * (its back: directions through it still count, as a ray crosses it either
+   * way). */
+  sv.cache_window = malloc(3);
+  sv.window_count = 2;
+  sv.window[0] = (iris_portal){{0.3f, 0.4f, 2.0f}, {0.5f, 0.0f, 0.1f}, {0.0f, 0.3f, 0.0f}};
+  sv.window[1] = (iris_portal){{0.0f, 0.0f, -1.0f}, {0.0f, 0.0f, 0.4f}, {0.0f, 0.4f, 0.0f}}; /* the plane x = 0 */
+  sv.cache_window[0] = 0, sv.cache_window[1] = 0xff, sv.cache_window[2] = 1;
+  const iris_vec3 xs[2] = {iris_v3(0, 0, 0), iris_v3(0.3f, 0.4f, 3.0f)};
+  const chi2_domain wdom = {CHI2_SPHERE, 16, 32, 92}; /* coarser: the windows' edges make the quadrature slow */
+  for (int k = 0; k < 2; k++) {
+    sv.beta = 0.75f;
+    mix_ctx mc = {&sv, &env, ids_a, 4, xs[k]};
+    chi2_result r = chi2_run(&wdom, mix_sample, mix_pdf, &mc, 200000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "mixture with windows, vertex %d: %s", k, r.message);
+    /* cache 2's window draws nothing from the origin, in its plane: that
+     * share is lost, and the density integrates to 1 less it */
+    const double lost_share = k == 0 ? 0.25 * IRIS_SKYVIS_WINDOW_SHARE : 0.0;
+    CHECK_NEAR(r.pdf_integral, 1.0 - lost_share, 3e-3);
+    printf("mixture with windows (vertex %d) over %d caches: p = %.3g, pdf integral %.5f, lost %zu\n", k, mc.m, r.p_value,
+           r.pdf_integral, r.lost);
+  }
+  /* A vertex no cache covers draws from the windows as a whole (each alike)
+   * and the map: from the origin the second window is edge-on, its half of
+   * the windows' share lost. */
+  {
+    mix_ctx mc = {&sv, &env, NULL, 0, xs[0]};
+    CHECK(iris_skyvis_guides(&sv, NULL, 0));
+    chi2_result r = chi2_run(&wdom, mix_sample, mix_pdf, &mc, 200000, 0.01, N_TESTS);
+    iris_check_record(r.passed, __FILE__, __LINE__, "windows without caches: %s", r.message);
+    CHECK_NEAR(r.pdf_integral, 1.0 - 0.5 * IRIS_SKYVIS_WINDOW_SHARE, 3e-3);
+    printf("windows without caches: p = %.3g, pdf integral %.5f, lost %zu\n", r.p_value, r.pdf_integral, r.lost);
   }
   iris_skyvis_destroy(&sv);
   iris_envmap_destroy(&env);
@@ -215,6 +259,22 @@ static void test_built_from_scene(void) {
       CHECK(back > 0 && back_seeing > 0 && back_wrong == 0);
       iris_envmap_destroy(&env);
     }
+    /* The window: the caches that see part of the sky find it and join their
+     * parts into the whole opening (x = 2, y in [1, 2], z in [-0.6, 0.6]),
+     * which nearly all of them then draw from. */
+    if (CHECK(a->window_count == 1)) {
+      const iris_portal *w = &a->window[0];
+      const float hy = fabsf(w->u.y) + fabsf(w->v.y), hz = fabsf(w->u.z) + fabsf(w->v.z);
+      printf("window: centre (%.4f, %.4f, %.4f), half-sizes %.4f (y) x %.4f (z); %zu of %zu caches that see part of "
+             "the sky draw from it\n",
+             (double)w->o.x, (double)w->o.y, (double)w->o.z, (double)hy, (double)hz, a->window_caches, a->part_caches);
+      CHECK(fabsf(w->o.x - 2.0f) < 0.01f && fabsf(w->o.y - 1.5f) < 0.01f && fabsf(w->o.z) < 0.01f);
+      CHECK(fabsf(hy - 0.5f) < 0.01f && fabsf(hz - 0.6f) < 0.01f);
+      CHECK(a->window_caches * 10 >= a->part_caches * 9);
+    }
+    CHECK(a->window_count == b->window_count && a->window_caches == b->window_caches);
+    CHECK(memcmp(a->window, b->window, sizeof(iris_portal) * (size_t)a->window_count) == 0);
+    CHECK(a->cache_window && b->cache_window && memcmp(a->cache_window, b->cache_window, a->cache_count) == 0);
     CHECK(a->cache_count == b->cache_count && a->probes == b->probes && a->escaped == b->escaped);
     CHECK(memcmp(a->sees, b->sees, a->cache_count) == 0);
     CHECK(memcmp(a->cdf, b->cdf, sizeof(float) * a->cache_count * (size_t)a->region_count) == 0);
