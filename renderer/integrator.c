@@ -383,7 +383,8 @@ static float power_heuristic(float pa, float pb) {
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, const iris_sampler *rng, bool mis,
-                               float p_light, iris_path_stats *stats, int8_t *outcome, float *value) {
+                               float p_light, iris_path_stats *stats, int8_t *outcome, float *value,
+                               const iris_vcache_params *sky_made) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -398,6 +399,10 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
       return iris_v3(0, 0, 0);
   }
   if (guided < 0 && !iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls))
+    return iris_v3(0, 0, 0);
+  /* the map's light through the window at a vertex the connections reach: theirs (vcache.h) */
+  if (sky_made && !isfinite(ls.dist) && iris_lights_choice_is_environment_map(it->lights, choice) &&
+      iris_vcache_through(sky_made, sp->si.p, ls.wi))
     return iris_v3(0, 0, 0);
   iris_vec3 f = bsdf_eval(sp, ls.wi);
   if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return iris_v3(0, 0, 0);
@@ -455,6 +460,9 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_vec3 vc_prev = {0, 0, 0}, vc_last = {0, 0, 0}; /* x_{k-1}, x_k */
   bool vc_prev_nd = false, vc_last_nd = false, vc_last_plain = false;
   bool vc_made = false;       /* phase 1 and a path the connections make */
+  /* with the sky: whether the map's light through the window at this vertex,
+   * and at the one the ray left, is the connections' */
+  bool sky_made = false, prev_sky_made = false;
   iris_vec3 L_connect = iris_v3(0, 0, 0);
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -468,6 +476,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
+      if (prev_sky_made && iris_vcache_through(vp, prev_p, ray.d)) break; /* the connections' */
       float env_pdf = 0.0f, st[2];
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
                                                  !prev_delta && mis ? &env_pdf : NULL, st);
@@ -512,6 +521,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         vc_k++;
         vc_prev = vc_last, vc_prev_nd = vc_last_nd;
         vc_last = si.p, vc_last_nd = !sp.delta, vc_last_plain = plain;
+        if (vp->sky) {
+          const iris_vec3 d = iris_sub(vc_last, vc_prev);
+          sky_made = vc_k >= 2 && vc_prev_nd && plain && iris_dot(d, d) > vp->min_d2;
+        }
+      } else if (vc_phase == 0 && vp->sky) {
+        vc_phase = 2; /* outside: no more connections, nothing left out */
       } else if (vc_phase == 0) {
         vc_phase = vc_k >= 1 ? 1 : 2;
         const iris_vec3 d = iris_sub(vc_last, vc_prev);
@@ -540,7 +555,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
       {
         const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
-                                                          &light_outcome, &light_value));
+                                                          &light_outcome, &light_value, sky_made ? vp : NULL));
         if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
           L = iris_add(L, dl);
       }
@@ -548,7 +563,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (vpool && vc_phase == 0 && !sp.delta && vpool->count > 0) {
       /* connect to one z of the pool, drawn uniformly; the pool holds what
        * vp->paths light paths left, so each counts count / paths */
-      uint32_t j = (uint32_t)(iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count);
+      const float uc = iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count;
+      uint32_t j = (uint32_t)uc;
       if (j >= vpool->count) j = vpool->count - 1;
       const iris_vcache_vertex *z = &vpool->v[j];
       const iris_vec3 d = iris_sub(z->p, sp.si.p);
@@ -558,12 +574,19 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         const float cos_z = -iris_dot(w, z->n);
         const iris_vec3 fx = iris_integrator_bsdf_eval(&sp, w);
         if (cos_z > 0.0f && iris_max3(fx) > 0.0f) {
-          iris_ray sh = iris_spawn_ray_to(sp.si.p, sp.si.ng, z->p, z->n);
-          stats->shadow_rays++;
-          if (!iris_accel_occluded(it->accel, &sh))
-            L_connect = iris_add(L_connect, iris_scale(iris_mul(iris_mul(beta, fx), z->f_power),
-                                                       fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 *
-                                                           (float)vpool->count / (float)vp->paths));
+          const iris_vec3 c = iris_scale(iris_mul(iris_mul(beta, fx), z->f_power),
+                                         fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count /
+                                             (float)vp->paths);
+          /* with the sky, small ones against the pixel's estimate only
+           * sometimes (weighted back): the rest of the pool number decides */
+          float q = 1.0f;
+          if (vp->sky && pixel_estimate > 0.0f)
+            q = iris_fminf(1.0f, iris_avg3(c) / (IRIS_VCACHE_SKY_RR * pixel_estimate));
+          if (q >= 1.0f || uc - (float)j < q) {
+            iris_ray sh = iris_spawn_ray_to(sp.si.p, sp.si.ng, z->p, z->n);
+            stats->shadow_rays++;
+            if (!iris_accel_occluded(it->accel, &sh)) L_connect = iris_add(L_connect, iris_scale(c, 1.0f / q));
+          }
         }
       }
     }
@@ -597,6 +620,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->light_value = light_value;
     }
     prev_delta = ds.delta;
+    prev_sky_made = sky_made;
+    sky_made = false;
     prev_pdf = ds.pdf;
     prev_light = p_light;
     prev_p = sp.si.p;

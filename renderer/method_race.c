@@ -71,7 +71,8 @@ static iris_direction_sampler counting(counted_guide *c) {
                               g->sample_environment ? counted_environment : NULL,
                               g->environment_scale ? counted_scale : NULL,
                               g->light_probability ? counted_light : NULL,
-                              NULL}; /* the opening is read before the race, not during it */
+                              NULL,   /* the opening and the sky's window are read before the race, */
+                              NULL};  /* not during it */
   return w;
 }
 

@@ -256,6 +256,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
    * threads. */
   if (st == IRIS_OK && p.connect != IRIS_CONNECT_OFF && it.guide.opening && lights.tri_count > 0) {
     iris_vcache_params vp;
+    memset(&vp, 0, sizeof vp);
     float size = 0.0f, share = 0.0f;
     if (it.guide.opening(it.guide.ctx, &vp.o, &vp.n, &size, &share) &&
         (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE) && size > 0.0f) {
@@ -270,6 +271,34 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
         it.vcache = vcache;
         iris_infof("connections: to a light-vertex cache behind the opening at (%.3g, %.3g, %.3g) kept by %.0f%% of "
                    "the caches, %u light paths per sample index",
+                   vp.o.x, vp.o.y, vp.o.z, 100.0 * share, vp.paths);
+      }
+    }
+  }
+  /* ... else where the sky is seen through a window most caches draw from:
+   * light vertices the sky lit through it (vcache.h, `sky`). */
+  if (st == IRIS_OK && !vcache && p.connect != IRIS_CONNECT_OFF && it.guide.sky_window && lights.envmap) {
+    iris_vcache_params vp;
+    memset(&vp, 0, sizeof vp);
+    float share = 0.0f;
+    if (it.guide.sky_window(it.guide.ctx, &vp.o, &vp.u, &vp.v, &share) &&
+        (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE)) {
+      const float size = 2.0f * fmaxf(iris_length(vp.u), iris_length(vp.v));
+      const iris_vec3 nn = iris_cross(vp.u, vp.v);
+      const float nl = iris_length(nn);
+      const uint64_t frame = (uint64_t)res->camera.width * (uint64_t)res->camera.height / 8u;
+      vp.sky = true;
+      vp.n = iris_scale(nn, 1.0f / nl);
+      vp.eps = 1e-4f * size;
+      vp.min_d2 = iris_sqr(IRIS_CONNECT_SKY_MIN_DISTANCE * size);
+      vp.paths = (uint32_t)(frame < 256 ? 256 : frame > 2048 ? 2048 : frame);
+      vp.seed = p.seed;
+      vp.threads = p.threads;
+      if (nl > 0.0f && isfinite(nl) && size > 0.0f) st = iris_vcache_create(&vcache, &vp, &it, err);
+      if (st == IRIS_OK && vcache) {
+        it.vcache = vcache;
+        iris_infof("connections: to light vertices the sky lit through the window at (%.3g, %.3g, %.3g), drawn from "
+                   "by %.0f%% of the caches, %u light paths per sample index",
                    vp.o.x, vp.o.y, vp.o.z, 100.0 * share, vp.paths);
       }
     }

@@ -36,6 +36,12 @@ extern "C" {
  * at the door: closer connections' 1/d^2 stays with the camera). */
 #define IRIS_CONNECT_MIN_SHARE 0.15f
 #define IRIS_CONNECT_MIN_DISTANCE 0.15f
+/* With the sky through a window (no opening to a lit room): on where the
+ * window is drawn from by at least IRIS_CONNECT_MIN_SHARE of the caches
+ * (sky-room 0.37), not between points closer than this times the window's
+ * longer side (1.2 m on sky-room: of 0.15, 0.5, 1 and 1.5, 1 measured best,
+ * docs/guiding.md). */
+#define IRIS_CONNECT_SKY_MIN_DISTANCE 1.0f
 
 /* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
 typedef struct iris_pixel_bounds {

@@ -77,6 +77,38 @@ static bool push(iris_vcache_pool *pool, uint32_t *cap, const iris_vcache_vertex
   return true;
 }
 
+/* With the sky: light path i from a point on the window in a direction of
+ * the map's own sampling, seen through it (cos > 0 along the outward normal),
+ * carrying L cos area / pdf; its first hit inside, if plain, is kept. */
+static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *pool, uint32_t *cap, uint64_t *rays) {
+  const iris_integrator *it = vc->it;
+  const iris_vcache_params *p = &vc->p;
+  float u[4];
+  for (uint32_t d = 0; d < 4; ++d) u[d] = iris_sampler_get(r, d);
+  iris_vec3 d, Le;
+  float pdf;
+  if (!iris_envmap_sample(it->lights->envmap, u[2], u[3], &d, &pdf, &Le) || !(pdf > 0.0f)) return true;
+  const float cw = iris_dot(d, p->n);
+  if (!(cw > 0.0f) || !(iris_max3(Le) > 0.0f)) return true;
+  const iris_vec3 q = iris_add(p->o, iris_add(iris_scale(p->u, 2.0f * u[0] - 1.0f), iris_scale(p->v, 2.0f * u[1] - 1.0f)));
+  const float area = 4.0f * iris_length(iris_cross(p->u, p->v));
+  iris_ray out = {q, 0.0f, d, INFINITY};
+  *rays += 2;
+  if (iris_accel_occluded(it->accel, &out)) return true; /* the sky is not seen from there */
+  iris_ray in = {q, 0.0f, iris_neg(d), INFINITY};
+  iris_hit h;
+  if (!iris_accel_intersect(it->accel, &in, &h)) return true;
+  iris_interaction si;
+  iris_accel_interaction(it->accel, in.d, &h, &si);
+  iris_shading_point sp;
+  iris_integrator_shade(it, &si, d, 1, &sp);
+  if (!iris_vcache_plain(&sp, si.ng) || !iris_vcache_in_a(p, si.p, d)) return true;
+  const iris_vec3 n = iris_dot(si.ng, d) < 0.0f ? iris_neg(si.ng) : si.ng;
+  const iris_vec3 power = iris_scale(Le, cw * area / pdf);
+  const iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), 0};
+  return push(pool, cap, &z);
+}
+
 /* The pool of sample index s: light path i draws from its own stream of
  * (seed, s, i), so the pool does not depend on who builds it. */
 static bool build_pool(const iris_vcache *vc, uint64_t s, iris_vcache_pool *pool, uint64_t *rays_out) {
@@ -87,6 +119,10 @@ static bool build_pool(const iris_vcache *vc, uint64_t s, iris_vcache_pool *pool
   bool ok = true;
   for (uint32_t i = 0; i < vc->p.paths && ok; ++i) {
     iris_sampler r = iris_sampler_start(key, s, i);
+    if (vc->p.sky) {
+      ok = sky_path(vc, &r, pool, &cap, &rays);
+      continue;
+    }
     float u[5];
     for (uint32_t d = 0; d < 5; ++d) u[d] = iris_sampler_get(&r, d);
     iris_photon_emission e;

@@ -18,7 +18,22 @@
  * the triangles its rays hit): a partition of path space, each path made by
  * exactly one strategy, so no MIS weight is needed and the sum is unbiased for
  * any plane. Pools are functions of (seed, s) alone: the image does not depend
- * on the thread count or on how the samples are partitioned. */
+ * on the thread count or on how the samples are partitioned.
+ *
+ * The sky through a window (`sky`): region B is the outside and the light
+ * the environment map seen through the window (a rectangle, sky visibility's,
+ * skyvis.h). Light paths leave a point uniform on it in a direction from the
+ * map's own sampling, seen through it, and keep the first vertex z they hit
+ * inside (m = 0), if plain. A camera vertex connects to one z as above; the
+ * paths so made,
+ *   camera, x_1 .. x_{k-1} in A (k >= 2, x_{k-1} not delta), z = x_k plain,
+ *   |x_{k-1} - x_k| > d_min, then the map's light through the window,
+ * are left out of the camera estimator: at such an x_k its light samples of
+ * the map whose direction leaves through the window (not traced) and its
+ * escapes through it. The camera goes on from x_k as before (its further
+ * bounces are its own), and a connection whose unoccluded value is small
+ * against the pixel's estimate is traced only with probability value /
+ * (IRIS_VCACHE_SKY_RR x estimate), weighted back. */
 #ifndef IRIS_RENDERER_VCACHE_H
 #define IRIS_RENDERER_VCACHE_H
 
@@ -48,8 +63,14 @@ typedef struct iris_vcache_pool {
   iris_vcache_vertex *v;
 } iris_vcache_pool;
 
+/* The connections' roulette against the pixel's estimate with the sky
+ * (measured on sky-room: 0.5 best of 0.5, 1 and 2, docs/guiding.md). */
+#define IRIS_VCACHE_SKY_RR 0.5f
+
 typedef struct iris_vcache_params {
   iris_vec3 o, n;   /* the plane: region A is its negative side */
+  bool sky;         /* the sky through the window (o its centre, u and v its half-axes) */
+  iris_vec3 u, v;
   float eps;        /* a point within eps of the plane belongs to the side it is seen from */
   float min_d2;     /* the shortest connection, squared */
   uint32_t paths;   /* light paths per sample index */
@@ -75,6 +96,15 @@ uint64_t iris_vcache_rays(const iris_vcache *vc);
 static inline bool iris_vcache_in_a(const iris_vcache_params *p, iris_vec3 x, iris_vec3 wo) {
   float d = iris_dot(iris_sub(x, p->o), p->n);
   return d < -p->eps || (d <= p->eps && iris_dot(wo, p->n) < 0.0f);
+}
+/* With the sky: whether the ray from x along w leaves through the window. */
+static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x, iris_vec3 w) {
+  const float dn = iris_dot(w, p->n);
+  if (!(dn > 0.0f)) return false;
+  const float t = iris_dot(iris_sub(p->o, x), p->n) / dn;
+  if (!(t > 0.0f)) return false;
+  const iris_vec3 q = iris_sub(iris_madd(x, w, t), p->o);
+  return fabsf(iris_dot(q, p->u)) <= iris_dot(p->u, p->u) && fabsf(iris_dot(q, p->v)) <= iris_dot(p->v, p->v);
 }
 /* A plain vertex: a Lambertian reflector (no other lobe) with flat shading. */
 bool iris_vcache_plain(const struct iris_shading_point *sp, iris_vec3 ng);

@@ -45,9 +45,36 @@ static float guided_environment_scale(void *ctx, const iris_envmap *env, const i
   return iris_skyvis_scale(&g->sky, env, v->ids, v->m, v->p, wi, s, t, add);
 }
 
+/* The window the most caches draw from, turned to face away from them. */
+static bool guided_sky_window(void *ctx, iris_vec3 *o, iris_vec3 *u, iris_vec3 *v, float *share) {
+  const iris_guiding *g = ctx;
+  const iris_skyvis *sv = &g->sky;
+  if (!sv->built || sv->window_count <= 0 || !sv->cache_window || g->cache_count == 0) return false;
+  size_t count[IRIS_SKYVIS_WINDOWS] = {0};
+  int side[IRIS_SKYVIS_WINDOWS] = {0};
+  for (size_t i = 0; i < g->cache_count; ++i) {
+    const uint8_t w = sv->cache_window[i];
+    if (w == 0xff) continue;
+    count[w]++;
+    const iris_portal *p = &sv->window[w];
+    side[w] += iris_dot(iris_sub(g->caches[i].p, p->o), iris_cross(p->u, p->v)) < 0.0f ? 1 : -1;
+  }
+  int best = 0;
+  for (int j = 1; j < sv->window_count; ++j)
+    if (count[j] > count[best]) best = j;
+  if (count[best] == 0) return false;
+  const iris_portal *p = &sv->window[best];
+  *o = p->o;
+  *u = side[best] >= 0 ? p->u : iris_neg(p->u);
+  *v = p->v;
+  *share = (float)count[best] / (float)g->cache_count;
+  return true;
+}
+
 void iris_guiding_sky_hooks(iris_guiding *g, iris_direction_sampler *s) {
   if (g->sky.built) {
     s->sample_environment = guided_sample_environment;
     s->environment_scale = guided_environment_scale;
+    s->sky_window = guided_sky_window;
   }
 }
