@@ -183,6 +183,9 @@ static void build_task(void *vctx, uint64_t begin, uint64_t end, int thread) {
 const iris_vcache_pool *iris_vcache_get(iris_vcache *vc, uint64_t s) {
   const uint64_t c = s / CHUNK;
   if (c >= MAX_CHUNKS) return NULL;
+  /* with the sky, the pools' memory budget (deterministic: by index alone) */
+  if (vc->p.sky && (c + 1) * CHUNK * (uint64_t)vc->p.paths * sizeof(iris_vcache_vertex) > IRIS_VCACHE_SKY_BUDGET)
+    return NULL;
   chunk *ch = atomic_load_explicit(&vc->chunks[c], memory_order_acquire);
   if (!ch) {
     pthread_mutex_lock(&vc->lock);
