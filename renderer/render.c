@@ -83,6 +83,19 @@ static iris_status enter_phase(const iris_render_params *p, iris_status st, cons
   return IRIS_OK;
 }
 
+/* What both kinds of connections share: the side tolerance and shortest
+ * connection from the opening's size, pixels/8 light paths per sample index
+ * (256-2048, of the whole frame: the same for any window or part), the seed. */
+static void connect_settings(iris_vcache_params *vp, float size, float min_distance, const iris_pinhole *cam,
+                             const iris_render_params *p) {
+  const uint64_t frame = (uint64_t)cam->width * (uint64_t)cam->height / 8u;
+  vp->eps = 1e-4f * size;
+  vp->min_d2 = iris_sqr(min_distance * size);
+  vp->paths = (uint32_t)(frame < 256 ? 256 : frame > 2048 ? 2048 : frame);
+  vp->seed = p->seed;
+  vp->threads = p->threads;
+}
+
 static iris_status render(const iris_scene *scene, const iris_render_params *params_in,
                           iris_render_result *res, iris_error *err);
 
@@ -260,12 +273,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     float size = 0.0f, share = 0.0f;
     if (it.guide.opening(it.guide.ctx, &vp.o, &vp.n, &size, &share) &&
         (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE) && size > 0.0f) {
-      const uint64_t frame = (uint64_t)res->camera.width * (uint64_t)res->camera.height / 8u;
-      vp.eps = 1e-4f * size;
-      vp.min_d2 = iris_sqr(IRIS_CONNECT_MIN_DISTANCE * size);
-      vp.paths = (uint32_t)(frame < 256 ? 256 : frame > 2048 ? 2048 : frame);
-      vp.seed = p.seed;
-      vp.threads = p.threads;
+      connect_settings(&vp, size, IRIS_CONNECT_MIN_DISTANCE, &res->camera, &p);
       st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK) {
         it.vcache = vcache;
@@ -286,14 +294,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       const float size = 2.0f * fmaxf(iris_length(vp.u), iris_length(vp.v));
       const iris_vec3 nn = iris_cross(vp.u, vp.v);
       const float nl = iris_length(nn);
-      const uint64_t frame = (uint64_t)res->camera.width * (uint64_t)res->camera.height / 8u;
       vp.sky = true;
       vp.n = iris_scale(nn, 1.0f / nl);
-      vp.eps = 1e-4f * size;
-      vp.min_d2 = iris_sqr(IRIS_CONNECT_SKY_MIN_DISTANCE * size);
-      vp.paths = (uint32_t)(frame < 256 ? 256 : frame > 2048 ? 2048 : frame);
-      vp.seed = p.seed;
-      vp.threads = p.threads;
+      connect_settings(&vp, size, IRIS_CONNECT_SKY_MIN_DISTANCE, &res->camera, &p);
       if (nl > 0.0f && isfinite(nl) && size > 0.0f) st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {
         it.vcache = vcache;
