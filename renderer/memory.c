@@ -11,6 +11,7 @@
 #include "renderer/guiding/guiding.h"
 #include "renderer/guiding/photons.h"
 #include "renderer/lights.h"
+#include "renderer/vcache.h"
 
 /* Measured costs (docs/performance.md, "Memory estimate"; Embree 3.13 with
  * ROBUST and HIGH quality, from its memory monitor and peak RSS). */
@@ -136,6 +137,13 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
     /* learned light selection: with more than one light to choose from */
     if (emissive_tris + (double)punctual > 1) out->light_select = (uint64_t)(caches * LIGHT_SELECT_BYTES);
     out->guide = (uint64_t)(caches * CACHE_BYTES + paths * PATH_BYTES) + out->light_select;
+    /* connections with the sky through a window (vcache.h): pools of at most
+     * one vertex per light path, kept within their budget; the door's kind
+     * keeps a few vertices per sample index (door, 1024 spp: 0.15 MB) */
+    if (s->has_environment && s->environment_map.path) {
+      out->connect = (uint64_t)IRIS_VCACHE_SKY_BUDGET;
+      out->guide += out->connect;
+    }
     for (size_t m = 0; m < s->material_count; m++)
       if (may_be_smooth(&s->materials[m])) { /* glints: at most one set of 65536 paths */
         out->guide += (uint64_t)GLINT_BYTES;

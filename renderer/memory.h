@@ -25,6 +25,7 @@ typedef struct iris_memory_estimate {
   uint64_t lights;   /* emissive triangle tables */
   uint64_t guide;    /* photons and caches (guided methods and auto), light_select included */
   uint64_t light_select; /* the caches' learned light tables (--light-sampler learned) */
+  uint64_t connect;  /* with a map: the light vertices of connections through a window, at most (part of guide) */
   uint64_t film;     /* film sums and the output images */
   uint64_t base;     /* the process itself (code, libraries, thread stacks) */
   uint64_t total;

@@ -106,6 +106,7 @@ static void estimate_memory(const iris_scene *s, iris_memory_estimate *est, int 
   iris_memory_estimate_scene(s, *w, *h, true, &guided);
   est->guide = guided.guide; /* reported beside the total, which is without it */
   est->light_select = guided.light_select;
+  est->connect = guided.connect;
 }
 
 static void print_json(const char *path, const iris_scene *s, const scene_stats *st) {
@@ -204,6 +205,7 @@ static void print_json(const char *path, const iris_scene *s, const scene_stats 
     cJSON_AddNumberToObject(mem, "light_bytes", (double)est.lights);
     cJSON_AddNumberToObject(mem, "guide_bytes", (double)est.guide); /* not in estimate_bytes */
     cJSON_AddNumberToObject(mem, "light_select_bytes", (double)est.light_select); /* part of guide_bytes */
+    cJSON_AddNumberToObject(mem, "connect_bytes", (double)est.connect);           /* part of guide_bytes */
     cJSON_AddNumberToObject(mem, "film_bytes", (double)est.film);
     cJSON_AddNumberToObject(mem, "process_bytes", (double)est.base);
     cJSON_AddNumberToObject(mem, "unique_triangles", (double)est.unique_triangles);
@@ -290,8 +292,9 @@ static void print_text(const char *path, const iris_scene *s, const scene_stats 
   uint64_t guide = est.guide;
   est.guide = 0;
   iris_memory_format(&est, line, sizeof line);
-  printf("render mem   %dx%d: %s; guided methods add about %.3f GB (learned light tables %.3f GB of it)\n", w, h,
-         line, (double)guide / 1e9, (double)est.light_select / 1e9);
+  printf("render mem   %dx%d: %s; guided methods add about %.3f GB (learned light tables %.3f GB, connections' light "
+         "vertices up to %.3f GB of it)\n",
+         w, h, line, (double)guide / 1e9, (double)est.light_select / 1e9, (double)est.connect / 1e9);
 }
 
 int iris_cmd_info(int argc, char **argv) {

@@ -27,6 +27,7 @@
 #include "check.h"
 #include "renderer/accel.h"
 #include "renderer/memory.h"
+#include "renderer/vcache.h"
 #include "scene/scene.h"
 
 static const char *iris_bin, *assets;
@@ -233,6 +234,36 @@ static void test_light_groups(void) {
   CHECK(guide[5] > guide[1]);       /* a lit one: a group more */
 }
 
+/* Connections with the sky through a window keep their light vertices for
+ * the whole render, within IRIS_VCACHE_SKY_BUDGET (renderer/vcache.h): a
+ * guided estimate of a scene lit by a map holds that bound, a constant sky
+ * (no window connections: they sample the map) and the methods without a
+ * guide do not. */
+static void test_sky_connections(void) {
+  iris_memory_estimate est[3];
+  for (int c = 0; c < 3; c++) {
+    iris_scene *s = iris_scene_create();
+    iris_material mat = iris_material_default(IRIS_MATERIAL_DIFFUSE);
+    mat.name = iris_strdup("wall");
+    iris_mesh m = lumpy(4);
+    m.material = iris_scene_add_material(s, &mat);
+    iris_instance in = {(uint32_t)iris_scene_add_mesh(s, &m), iris_mat4_identity()};
+    iris_scene_add_instance(s, &in);
+    s->has_environment = true;
+    s->environment[0] = s->environment[1] = s->environment[2] = 1.0f;
+    if (c != 1) CHECK(iris_scene_set_environment_map(s, "sky.hdr", 1.0f, 0.0f));
+    iris_memory_estimate_scene(s, 640, 480, c != 2, &est[c]);
+    iris_scene_destroy(s);
+  }
+  printf("sky connections: %.1f MB of a %.1f MB guide (constant sky: guide %.1f MB)\n", (double)est[0].connect / 1e6,
+         (double)est[0].guide / 1e6, (double)est[1].guide / 1e6);
+  CHECK_EQ_INT(est[0].connect, IRIS_VCACHE_SKY_BUDGET);
+  CHECK_EQ_INT(est[0].guide - est[1].guide, IRIS_VCACHE_SKY_BUDGET); /* both a sky group */
+  CHECK_EQ_INT(est[1].connect, 0);
+  CHECK_EQ_INT(est[2].connect, 0);
+  CHECK_EQ_INT(est[2].guide, 0);
+}
+
 static void test_refused(void) {
   char out[700], errf[700], exr[700], flat[700];
   snprintf(out, sizeof out, "%s/out.txt", dir);
@@ -316,6 +347,7 @@ int main(int argc, char **argv) {
   assets = argv[2];
   if (iris_test_tmpdir(dir, sizeof dir, "memory") != 0) return TEST_SKIP("no temporary directory");
   test_light_groups();
+  test_sky_connections();
   test_embree_oom();
   test_refused();
   test_estimates();
