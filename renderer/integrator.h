@@ -165,12 +165,14 @@ typedef struct iris_direction_sampler {
    * the opening's longer side, and the share of all caches that keep it.
    * false: none. */
   bool (*opening)(void *ctx, iris_vec3 *o, iris_vec3 *n, float *size, float *share);
-  /* Optional: the window the sky is seen through that most caches draw from
-   * (sky visibility's) for connections to light vertices the sky lit
-   * through it (vcache.h): its centre o, half-axes u and v (u x v pointing
-   * away from those caches' side) and the share of all caches that draw
-   * from it. false: none. */
-  bool (*sky_window)(void *ctx, iris_vec3 *o, iris_vec3 *u, iris_vec3 *v, float *share);
+  /* Optional: a window the sky is seen through (sky visibility's) for
+   * connections to light vertices the sky lit through it (vcache.h): of
+   * those at least min_share of the caches draw from, the one the map's
+   * power enters the most through, else the one most caches draw from; its
+   * centre o, half-axes u and v (u x v pointing away from those caches'
+   * side) and the share of all caches that draw from it. false: none. */
+  bool (*sky_window)(void *ctx, const struct iris_envmap *env, float min_share, iris_vec3 *o, iris_vec3 *u,
+                     iris_vec3 *v, float *share);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

@@ -289,7 +289,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     iris_vcache_params vp;
     memset(&vp, 0, sizeof vp);
     float share = 0.0f;
-    if (it.guide.sky_window(it.guide.ctx, &vp.o, &vp.u, &vp.v, &share) &&
+    if (it.guide.sky_window(it.guide.ctx, lights.envmap,
+                            p.connect == IRIS_CONNECT_ON ? 0.0f : IRIS_CONNECT_MIN_SHARE, &vp.o, &vp.u, &vp.v, &share) &&
         (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE)) {
       const float size = 2.0f * fmaxf(iris_length(vp.u), iris_length(vp.v));
       const iris_vec3 nn = iris_cross(vp.u, vp.v);
