@@ -165,14 +165,14 @@ typedef struct iris_direction_sampler {
    * the opening's longer side, and the share of all caches that keep it.
    * false: none. */
   bool (*opening)(void *ctx, iris_vec3 *o, iris_vec3 *n, float *size, float *share);
-  /* Optional: a window the sky is seen through (sky visibility's) for
-   * connections to light vertices the sky lit through it (vcache.h): of
-   * those at least min_share of the caches draw from, the one the map's
-   * power enters the most through, else the one most caches draw from; its
-   * centre o, half-axes u and v (u x v pointing away from those caches'
-   * side) and the share of all caches that draw from it. false: none. */
-  bool (*sky_window)(void *ctx, const struct iris_envmap *env, float min_share, iris_vec3 *o, iris_vec3 *u,
-                     iris_vec3 *v, float *share);
+  /* Optional: the windows the sky is seen through (sky visibility's) for
+   * connections to light vertices the sky lit through them (vcache.h): of
+   * those caches draw from, at most max by the map's power entering through
+   * them (flux, descending), each one's centre o, half-axes u and v (u x v
+   * pointing away from its caches' side) and the share of all caches that
+   * draw from it. Returns how many (0: none). */
+  int (*sky_windows)(void *ctx, const struct iris_envmap *env, int max, iris_vec3 *o, iris_vec3 *u, iris_vec3 *v,
+                     float *flux, float *share);
 } iris_direction_sampler;
 
 /* Everything a path needs, shared read-only by all threads. */

@@ -283,27 +283,46 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       }
     }
   }
-  /* ... else where the sky is seen through a window most caches draw from:
-   * light vertices the sky lit through it (vcache.h, `sky`). */
-  if (st == IRIS_OK && !vcache && p.connect != IRIS_CONNECT_OFF && it.guide.sky_window && lights.envmap) {
+  /* ... else where the sky is seen through windows that together a share of
+   * the caches draw from: light vertices the sky lit through them (vcache.h,
+   * `sky`), the light paths shared among the windows by the power entering. */
+  if (st == IRIS_OK && !vcache && p.connect != IRIS_CONNECT_OFF && it.guide.sky_windows && lights.envmap) {
     iris_vcache_params vp;
     memset(&vp, 0, sizeof vp);
-    float share = 0.0f;
-    if (it.guide.sky_window(it.guide.ctx, lights.envmap,
-                            p.connect == IRIS_CONNECT_ON ? 0.0f : IRIS_CONNECT_MIN_SHARE, &vp.o, &vp.u, &vp.v, &share) &&
-        (p.connect == IRIS_CONNECT_ON || share >= IRIS_CONNECT_MIN_SHARE)) {
-      const float size = 2.0f * fmaxf(iris_length(vp.u), iris_length(vp.v));
-      const iris_vec3 nn = iris_cross(vp.u, vp.v);
+    enum { K = IRIS_VCACHE_SKY_WINDOWS };
+    iris_vec3 wo[K], wu[K], wv[K];
+    float flux[K], share[K];
+    const int k = it.guide.sky_windows(it.guide.ctx, lights.envmap, K, wo, wu, wv, flux, share);
+    double total = 0.0;
+    float size = 0.0f, shares = 0.0f;
+    for (int j = 0; j < k; ++j) shares += share[j];
+    bool ok = k > 0 && (p.connect == IRIS_CONNECT_ON || shares >= IRIS_CONNECT_MIN_SHARE);
+    for (int j = 0; j < k && ok; ++j) {
+      const iris_vec3 nn = iris_cross(wu[j], wv[j]);
       const float nl = iris_length(nn);
+      ok = nl > 0.0f && isfinite(nl) && flux[j] >= 0.0f && isfinite(flux[j]);
+      vp.window[j] = (iris_vcache_window){wo[j], iris_scale(nn, 1.0f / nl), wu[j], wv[j], 0.0f};
+      size = fmaxf(size, 2.0f * fmaxf(iris_length(wu[j]), iris_length(wv[j])));
+      total += flux[j];
+    }
+    if (ok && size > 0.0f) {
+      /* light paths start on each window in proportion to the power entering through it */
+      for (int j = 0; j < k; ++j) vp.window[j].prob = k == 1 ? 1.0f : (float)(total > 0.0 ? flux[j] / total : 1.0 / k);
+      vp.windows = k;
       vp.sky = true;
-      vp.n = iris_scale(nn, 1.0f / nl);
+      vp.o = vp.window[0].o, vp.n = vp.window[0].n, vp.u = vp.window[0].u, vp.v = vp.window[0].v;
       connect_settings(&vp, size, IRIS_CONNECT_SKY_MIN_DISTANCE, &res->camera, &p);
-      if (nl > 0.0f && isfinite(nl) && size > 0.0f) st = iris_vcache_create(&vcache, &vp, &it, err);
+      st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {
         it.vcache = vcache;
-        iris_infof("connections: to light vertices the sky lit through the window at (%.3g, %.3g, %.3g), drawn from "
-                   "by %.0f%% of the caches, %u light paths per sample index",
-                   vp.o.x, vp.o.y, vp.o.z, 100.0 * share, vp.paths);
+        char where[200];
+        int n = 0;
+        for (int j = 0; j < k && n >= 0 && (size_t)n < sizeof where; ++j)
+          n += snprintf(where + n, sizeof where - (size_t)n, "%s(%.3g, %.3g, %.3g) drawn from by %.0f%% of the caches",
+                        j ? ", " : "", vp.window[j].o.x, vp.window[j].o.y, vp.window[j].o.z, 100.0 * share[j]);
+        iris_infof("connections: to light vertices the sky lit through %s at %s, %u light paths per sample index",
+                   k == 1 ? "the window" : k == 2 ? "two windows" : k == 3 ? "three windows" : "four windows", where,
+                   vp.paths);
       }
     }
   }

@@ -77,21 +77,38 @@ static bool push(iris_vcache_pool *pool, uint32_t *cap, const iris_vcache_vertex
   return true;
 }
 
-/* With the sky: light path i from a point on the window in a direction of
- * the map's own sampling, seen through it (cos > 0 along the outward normal),
- * carrying L cos area / pdf; its first hit inside, if plain, is kept. */
+/* With the sky: light path i from a point on a window (drawn with its
+ * probability, dimension 4, where there are several) in a direction of the
+ * map's own sampling, seen through it (cos > 0 along its outward normal),
+ * carrying L cos area / (pdf prob); its first hit inside, if plain, is kept,
+ * unless the ray from there back out leaves through another window first
+ * (that window's light paths make the path: each once). */
 static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *pool, uint32_t *cap, uint64_t *rays) {
   const iris_integrator *it = vc->it;
   const iris_vcache_params *p = &vc->p;
   float u[4];
   for (uint32_t d = 0; d < 4; ++d) u[d] = iris_sampler_get(r, d);
+  int j = 0;
+  float prob = 1.0f;
+  iris_vec3 wo = p->o, wn = p->n, wu = p->u, wv = p->v;
+  if (p->windows > 1) {
+    const float uw = iris_sampler_get(r, 4);
+    float acc = 0.0f;
+    for (j = 0; j < p->windows - 1; ++j) {
+      acc += p->window[j].prob;
+      if (uw < acc) break;
+    }
+    const iris_vcache_window *w = &p->window[j];
+    wo = w->o, wn = w->n, wu = w->u, wv = w->v, prob = w->prob;
+    if (!(prob > 0.0f)) return true;
+  }
   iris_vec3 d, Le;
   float pdf;
   if (!iris_envmap_sample(it->lights->envmap, u[2], u[3], &d, &pdf, &Le) || !(pdf > 0.0f)) return true;
-  const float cw = iris_dot(d, p->n);
+  const float cw = iris_dot(d, wn);
   if (!(cw > 0.0f) || !(iris_max3(Le) > 0.0f)) return true;
-  const iris_vec3 q = iris_add(p->o, iris_add(iris_scale(p->u, 2.0f * u[0] - 1.0f), iris_scale(p->v, 2.0f * u[1] - 1.0f)));
-  const float area = 4.0f * iris_length(iris_cross(p->u, p->v));
+  const iris_vec3 q = iris_add(wo, iris_add(iris_scale(wu, 2.0f * u[0] - 1.0f), iris_scale(wv, 2.0f * u[1] - 1.0f)));
+  const float area = 4.0f * iris_length(iris_cross(wu, wv));
   iris_ray out = {q, 0.0f, d, INFINITY};
   *rays += 2;
   if (iris_accel_occluded(it->accel, &out)) return true; /* the sky is not seen from there */
@@ -103,8 +120,13 @@ static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *p
   iris_shading_point sp;
   iris_integrator_shade(it, &si, d, 1, &sp);
   if (!iris_vcache_plain(&sp, si.ng) || !iris_vcache_in_a(p, si.p, d)) return true;
+  for (int i = 0; i < p->windows; ++i) { /* from z back out along d: is window j the first one crossed? */
+    float t;
+    const iris_vcache_window *w = &p->window[i];
+    if (i != j && iris_vcache_through_one_(w->o, w->n, w->u, w->v, si.p, d, &t) && t < h.t) return true;
+  }
   const iris_vec3 n = iris_dot(si.ng, d) < 0.0f ? iris_neg(si.ng) : si.ng;
-  const iris_vec3 power = iris_scale(Le, cw * area / pdf);
+  const iris_vec3 power = iris_scale(Le, cw * area / (pdf * prob));
   const iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), 0};
   return push(pool, cap, &z);
 }

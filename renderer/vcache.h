@@ -72,10 +72,25 @@ typedef struct iris_vcache_pool {
  * 1080); later ones neither connect nor leave anything out (unbiased). */
 #define IRIS_VCACHE_SKY_BUDGET (64u << 20)
 
+/* With the sky: at most this many windows (sky visibility's, render.c). */
+#define IRIS_VCACHE_SKY_WINDOWS 4
+
+/* A window of the sky: centre o, outward unit normal n, half-axes u and v,
+ * and the probability that a light path starts on it. */
+typedef struct iris_vcache_window {
+  iris_vec3 o, n, u, v;
+  float prob;
+} iris_vcache_window;
+
 typedef struct iris_vcache_params {
   iris_vec3 o, n;   /* the plane: region A is its negative side */
   bool sky;         /* the sky through the window (o its centre, u and v its half-axes) */
   iris_vec3 u, v;
+  /* with the sky and more than one window: all of them (window[0] is o, n,
+   * u, v), region A the negative side of every plane; windows 0 or 1: o, n,
+   * u, v alone */
+  int windows;
+  iris_vcache_window window[IRIS_VCACHE_SKY_WINDOWS];
   float eps;        /* a point within eps of the plane belongs to the side it is seen from */
   float min_d2;     /* the shortest connection, squared */
   uint32_t paths;   /* light paths per sample index */
@@ -97,19 +112,38 @@ const iris_vcache_params *iris_vcache_settings(const iris_vcache *vc);
 /* Rays the light paths traced so far. */
 uint64_t iris_vcache_rays(const iris_vcache *vc);
 
+static inline bool iris_vcache_in_half_(iris_vec3 o, iris_vec3 n, float eps, iris_vec3 x, iris_vec3 wo) {
+  float d = iris_dot(iris_sub(x, o), n);
+  return d < -eps || (d <= eps && iris_dot(wo, n) < 0.0f);
+}
 /* Whether x, reached along a ray whose reverse is wo, lies in region A. */
 static inline bool iris_vcache_in_a(const iris_vcache_params *p, iris_vec3 x, iris_vec3 wo) {
-  float d = iris_dot(iris_sub(x, p->o), p->n);
-  return d < -p->eps || (d <= p->eps && iris_dot(wo, p->n) < 0.0f);
+  if (p->windows <= 1) return iris_vcache_in_half_(p->o, p->n, p->eps, x, wo);
+  for (int j = 0; j < p->windows; ++j)
+    if (!iris_vcache_in_half_(p->window[j].o, p->window[j].n, p->eps, x, wo)) return false;
+  return true;
 }
-/* With the sky: whether the ray from x along w leaves through the window. */
-static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x, iris_vec3 w) {
-  const float dn = iris_dot(w, p->n);
+/* Whether the ray from x along w leaves through the rectangle (o, n, u, v),
+ * and where (*t, along w). */
+static inline bool iris_vcache_through_one_(iris_vec3 o, iris_vec3 n, iris_vec3 u, iris_vec3 v, iris_vec3 x,
+                                            iris_vec3 w, float *t_out) {
+  const float dn = iris_dot(w, n);
   if (!(dn > 0.0f)) return false;
-  const float t = iris_dot(iris_sub(p->o, x), p->n) / dn;
+  const float t = iris_dot(iris_sub(o, x), n) / dn;
   if (!(t > 0.0f)) return false;
-  const iris_vec3 q = iris_sub(iris_madd(x, w, t), p->o);
-  return fabsf(iris_dot(q, p->u)) <= iris_dot(p->u, p->u) && fabsf(iris_dot(q, p->v)) <= iris_dot(p->v, p->v);
+  const iris_vec3 q = iris_sub(iris_madd(x, w, t), o);
+  *t_out = t;
+  return fabsf(iris_dot(q, u)) <= iris_dot(u, u) && fabsf(iris_dot(q, v)) <= iris_dot(v, v);
+}
+/* With the sky: whether the ray from x along w leaves through a window. */
+static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x, iris_vec3 w) {
+  float t;
+  if (p->windows <= 1) return iris_vcache_through_one_(p->o, p->n, p->u, p->v, x, w, &t);
+  for (int j = 0; j < p->windows; ++j) {
+    const iris_vcache_window *q = &p->window[j];
+    if (iris_vcache_through_one_(q->o, q->n, q->u, q->v, x, w, &t)) return true;
+  }
+  return false;
 }
 /* A plain vertex: a Lambertian reflector (no other lobe) with flat shading. */
 bool iris_vcache_plain(const struct iris_shading_point *sp, iris_vec3 ng);

@@ -18,7 +18,7 @@ static const char *const NAMES[] = {"cornell-box", "veach-mis", "door", "door-sh
                                     "stress-thin-walls", "stress-small-dim", "stress-closed-box",
                                     "stress-firefly", "stress-glossy-room",
                                     /* lit by the HDR sky of ../shared (scenes/sky.h) */
-                                    "env-objects", "env-spheres", "sky-room",
+                                    "env-objects", "env-spheres", "sky-room", "sky-room-corner",
                                     /* light through glass (scenes/glazing.h) */
                                     "sky-room-glazed", "sky-room-pane", "lamp-shade",
                                     /* 400 ceiling lamps (scenes/office.h) */
@@ -358,6 +358,8 @@ iris_status iris_builtin_create(const char *name, iris_scene **out, iris_error *
     st = iris_sky_spheres_build(s);
   else if (strcmp(name, "sky-room") == 0)
     st = iris_sky_room_build(s);
+  else if (strcmp(name, "sky-room-corner") == 0)
+    st = iris_sky_room_corner_build(s);
   else if (strcmp(name, "sky-room-glazed") == 0)
     st = iris_sky_room_glazed_build(s);
   else if (strcmp(name, "sky-room-pane") == 0)

@@ -81,7 +81,16 @@ iris_status iris_sky_spheres_build(iris_scene *s) {
  * map's sun (direction (0.66, 0.58, 0.48) at rotation 0), which falls through
  * it onto the floor; the camera in a corner by the window looks into the room
  * and does not see the sky. */
-iris_status iris_sky_room_build(iris_scene *s) {
+static iris_status sky_room(iris_scene *s, bool corner);
+
+iris_status iris_sky_room_build(iris_scene *s) { return sky_room(s, false); }
+
+/* sky-room with a second 1 x 1 m window, in the +z wall (x in [-0.5, 0.5],
+ * y in [1, 2]), which the sun also shines through: connections with the sky
+ * through two windows (docs/guiding.md). */
+iris_status iris_sky_room_corner_build(iris_scene *s) { return sky_room(s, true); }
+
+static iris_status sky_room(iris_scene *s, bool corner) {
   int32_t wall = material(s, "wall", IRIS_MATERIAL_DIFFUSE, 0.75f, 0.75f, 0.72f, 0.0f);
   int32_t floor_m = material(s, "floor", IRIS_MATERIAL_DIFFUSE, 0.6f, 0.45f, 0.3f, 0.0f);
   int32_t gloss = material(s, "glossy", IRIS_MATERIAL_GLOSSY, 0.8f, 0.8f, 0.8f, 0.25f);
@@ -94,7 +103,17 @@ iris_status iris_sky_room_build(iris_scene *s) {
   ok = ok && iris_builtin_add_quad(s, iris_v3(0, Y, 0), iris_v3(X, 0, 0), iris_v3(0, 0, Z), 4, wall, "ceiling") >= 0;
   ok = ok && iris_builtin_add_quad(s, iris_v3(-X, Y / 2, 0), iris_v3(0, Y / 2, 0), iris_v3(0, 0, Z), 4, wall, "back") >= 0;
   ok = ok && iris_builtin_add_quad(s, iris_v3(0, Y / 2, -Z), iris_v3(X, 0, 0), iris_v3(0, Y / 2, 0), 4, wall, "left") >= 0;
-  ok = ok && iris_builtin_add_quad(s, iris_v3(0, Y / 2, Z), iris_v3(0, Y / 2, 0), iris_v3(X, 0, 0), 4, wall, "right") >= 0;
+  if (!corner) {
+    ok = ok && iris_builtin_add_quad(s, iris_v3(0, Y / 2, Z), iris_v3(0, Y / 2, 0), iris_v3(X, 0, 0), 4, wall, "right") >= 0;
+  } else { /* around the +z window x in [-0.5, 0.5], y in [1, 2] */
+    ok = ok && iris_builtin_add_quad(s, iris_v3(0, 0.5f, Z), iris_v3(0, 0.5f, 0), iris_v3(X, 0, 0), 2, wall, "right-below") >= 0;
+    ok = ok && iris_builtin_add_quad(s, iris_v3(0, (2.0f + Y) / 2, Z), iris_v3(0, (Y - 2.0f) / 2, 0), iris_v3(X, 0, 0), 2,
+                                     wall, "right-above") >= 0;
+    ok = ok && iris_builtin_add_quad(s, iris_v3(-1.25f, 1.5f, Z), iris_v3(0, 0.5f, 0), iris_v3(0.75f, 0, 0), 2, wall,
+                                     "right-left") >= 0;
+    ok = ok && iris_builtin_add_quad(s, iris_v3(1.25f, 1.5f, Z), iris_v3(0, 0.5f, 0), iris_v3(0.75f, 0, 0), 2, wall,
+                                     "right-right") >= 0;
+  }
   /* the +x wall around the window y in [1, 2], z in [-0.6, 0.6] */
   const float y0 = 1.0f, y1 = 2.0f, z0 = -0.6f, z1 = 0.6f;
   ok = ok && iris_builtin_add_quad(s, iris_v3(X, y0 / 2, 0), iris_v3(0, 0, Z), iris_v3(0, y0 / 2, 0), 2, wall, "window-below") >= 0;

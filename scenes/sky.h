@@ -22,6 +22,7 @@ const char *iris_sky_map_path(void);
 iris_status iris_sky_objects_build(iris_scene *scene);
 iris_status iris_sky_spheres_build(iris_scene *scene);
 iris_status iris_sky_room_build(iris_scene *scene);
+iris_status iris_sky_room_corner_build(iris_scene *scene);
 
 #ifdef __cplusplus
 }

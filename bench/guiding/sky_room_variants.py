@@ -10,6 +10,8 @@ openings:
                in the -z wall
   skylight     no wall window; a 1 x 1 m opening in the ceiling
   open-wall    the +x wall open over 3 x 1.8 m
+  two-sunny    two 1 x 1 m windows side by side in the +x wall (the sun's)
+  corner-sunny 1 x 1 m windows in the +x and the +z wall, both facing the sun
 
 Writes OUTDIR/VARIANT.obj, .mtl and .json (imported by IRIS with the map and
 a camera in the corner by the +x wall, looking in).
@@ -30,6 +32,8 @@ VARIANTS = {
     "two-windows": {"+x": [(-0.6, 0.6, 1.0, 2.0)], "-z": [(-0.5, 0.5, 1.0, 2.0)]},
     "skylight": {"ceiling": [(-0.5, 0.5, -0.5, 0.5)]},
     "open-wall": {"+x": [(-1.5, 1.5, 0.3, 2.1)]},
+    "two-sunny": {"+x": [(-1.5, -0.5, 1.0, 2.0), (0.5, 1.5, 1.0, 2.0)]},
+    "corner-sunny": {"+x": [(0.5, 1.5, 1.0, 2.0)], "+z": [(-1.5, -0.5, 1.0, 2.0)]},
 }
 
 

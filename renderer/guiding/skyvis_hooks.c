@@ -64,15 +64,14 @@ static double window_flux(const iris_envmap *env, const iris_portal *p, iris_vec
   return sum / (G * G) * 4.0 * iris_length(iris_cross(p->u, p->v));
 }
 
-/* Of the windows at least min_share of the caches draw from, the one the
- * most sky's power enters through (a window facing away from the sun lights
- * the room less: two-windows, docs/guiding.md), turned to face away from its
- * caches; where none has that share, the one most caches draw from. */
-static bool guided_sky_window(void *ctx, const iris_envmap *env, float min_share, iris_vec3 *o, iris_vec3 *u,
-                              iris_vec3 *v, float *share) {
+/* The windows caches draw from, by the sky's power entering through them
+ * (a window facing away from the sun lights the room less), at most max,
+ * each turned to face away from its caches. */
+static int guided_sky_windows(void *ctx, const iris_envmap *env, int max, iris_vec3 *o, iris_vec3 *u, iris_vec3 *v,
+                              float *flux, float *share) {
   const iris_guiding *g = ctx;
   const iris_skyvis *sv = &g->sky;
-  if (!sv->built || sv->window_count <= 0 || !sv->cache_window || g->cache_count == 0) return false;
+  if (!sv->built || sv->window_count <= 0 || !sv->cache_window || g->cache_count == 0 || max <= 0) return 0;
   size_t count[IRIS_SKYVIS_WINDOWS] = {0};
   int side[IRIS_SKYVIS_WINDOWS] = {0};
   for (size_t i = 0; i < g->cache_count; ++i) {
@@ -82,30 +81,27 @@ static bool guided_sky_window(void *ctx, const iris_envmap *env, float min_share
     const iris_portal *p = &sv->window[w];
     side[w] += iris_dot(iris_sub(g->caches[i].p, p->o), iris_cross(p->u, p->v)) < 0.0f ? 1 : -1;
   }
-  int best = 0;
-  for (int j = 1; j < sv->window_count; ++j)
-    if (count[j] > count[best]) best = j;
-  if (count[best] == 0) return false;
-  double best_flux = -1.0;
+  int n = 0;
   for (int j = 0; j < sv->window_count; ++j) {
-    if (count[j] == 0 || (double)count[j] < (double)min_share * (double)g->cache_count) continue;
+    if (count[j] == 0) continue;
     const iris_portal *p = &sv->window[j];
-    const iris_vec3 n = iris_normalize(iris_cross(side[j] >= 0 ? p->u : iris_neg(p->u), p->v));
-    const double f = window_flux(env, p, n);
-    if (f > best_flux) best_flux = f, best = j;
+    const iris_vec3 uj = side[j] >= 0 ? p->u : iris_neg(p->u);
+    const float f = (float)window_flux(env, p, iris_normalize(iris_cross(uj, p->v)));
+    /* insertion by flux, descending; the last place goes to a larger one */
+    int k = n < max ? n++ : max;
+    while (k > 0 && flux[k - 1] < f) {
+      if (k < max) o[k] = o[k - 1], u[k] = u[k - 1], v[k] = v[k - 1], flux[k] = flux[k - 1], share[k] = share[k - 1];
+      --k;
+    }
+    if (k < max) o[k] = p->o, u[k] = uj, v[k] = p->v, flux[k] = f, share[k] = (float)count[j] / (float)g->cache_count;
   }
-  const iris_portal *p = &sv->window[best];
-  *o = p->o;
-  *u = side[best] >= 0 ? p->u : iris_neg(p->u);
-  *v = p->v;
-  *share = (float)count[best] / (float)g->cache_count;
-  return true;
+  return n;
 }
 
 void iris_guiding_sky_hooks(iris_guiding *g, iris_direction_sampler *s) {
   if (g->sky.built) {
     s->sample_environment = guided_sample_environment;
     s->environment_scale = guided_environment_scale;
-    s->sky_window = guided_sky_window;
+    s->sky_windows = guided_sky_windows;
   }
 }
