@@ -66,7 +66,7 @@ static const iris_option RENDER_ROWS[] = {
     CHOICE("light-sampler", "S", iris_render_options, light_sampler, LIGHT_SAMPLER_CHOICES,
            "NEE's light choice: tree (default: the light tree) | power"),
     CHOICE("connect", "M", iris_render_options, connect, CONNECT_CHOICES,
-           "guided methods: connections to light paths kept behind the\nopening the guide found, or of the sky through its window:\nauto (default: where enough of the caches' light came\nthrough it) | off | on"),
+           "guided methods: connections to light paths kept behind the\nopening the guide found, or of the sky through its windows:\nauto (default: where enough of the caches' light came\nthrough them) | off | on"),
     OPT("max-depth", 0, IRIS_OPT_INT, "B", 0, 1000000, iris_render_options, max_depth,
         "bounces as Cycles counts them, 0 = direct light (default 64)"),
     OPT("threads", 0, IRIS_OPT_INT, "N", 1, 4096, iris_render_options, threads,
