@@ -292,7 +292,11 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     enum { K = IRIS_VCACHE_SKY_WINDOWS };
     iris_vec3 wo[K], wu[K], wv[K];
     float flux[K], share[K];
-    const int k = it.guide.sky_windows(it.guide.ctx, lights.envmap, K, wo, wu, wv, flux, share);
+    int k = it.guide.sky_windows(it.guide.ctx, lights.envmap, K, wo, wu, wv, flux, share);
+    /* a window of little power (none found, or a small share of the
+     * brightest's) starts no light paths: the camera keeps its light, where
+     * the few light paths it would get would weigh much (the list is by flux) */
+    while (k > 1 && !(flux[k - 1] > IRIS_CONNECT_SKY_MIN_FLUX * flux[0])) --k;
     double total = 0.0;
     float size = 0.0f, shares = 0.0f;
     for (int j = 0; j < k; ++j) shares += share[j];
@@ -307,7 +311,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     }
     if (ok && size > 0.0f) {
       /* light paths start on each window in proportion to the power entering through it */
-      for (int j = 0; j < k; ++j) vp.window[j].prob = k == 1 ? 1.0f : (float)(total > 0.0 ? flux[j] / total : 1.0 / k);
+      for (int j = 0; j < k; ++j) vp.window[j].prob = k == 1 ? 1.0f : (float)(flux[j] / total);
       vp.windows = k;
       vp.sky = true;
       vp.o = vp.window[0].o, vp.n = vp.window[0].n, vp.u = vp.window[0].u, vp.v = vp.window[0].v;

@@ -36,12 +36,15 @@ extern "C" {
  * at the door: closer connections' 1/d^2 stays with the camera). */
 #define IRIS_CONNECT_MIN_SHARE 0.15f
 #define IRIS_CONNECT_MIN_DISTANCE 0.15f
-/* With the sky through a window (no opening to a lit room): on where the
- * window is drawn from by at least IRIS_CONNECT_MIN_SHARE of the caches
- * (sky-room 0.37), not between points closer than this times the window's
- * longer side (1.2 m on sky-room: of 0.15, 0.5, 1 and 1.5, 1 measured best,
- * docs/guiding.md). */
+/* With the sky through windows (no opening to a lit room): on where the
+ * windows together are drawn from by at least IRIS_CONNECT_MIN_SHARE of the
+ * caches (sky-room 0.37), not between points closer than this times the
+ * longest window's longer side (1.2 m on sky-room: of 0.15, 0.5, 1 and 1.5, 1
+ * measured best, docs/guiding.md). */
 #define IRIS_CONNECT_SKY_MIN_DISTANCE 1.0f
+/* With the sky: a window whose entering power is below this share of the
+ * brightest window's is left to the camera (render.c). */
+#define IRIS_CONNECT_SKY_MIN_FLUX 0.01f
 
 /* A window of the frame in pixels, half-open: x0 <= x < x1, y0 <= y < y1. */
 typedef struct iris_pixel_bounds {
