@@ -257,6 +257,31 @@ static void test_built_from_scene(void) {
              roof_seeing, back, back_seeing, back_wrong);
       CHECK(roof > 0 && roof_seeing == roof);
       CHECK(back > 0 && back_seeing > 0 && back_wrong == 0);
+      /* The connections' windows (the hook sky_windows): the one window,
+       * turned to face out (+x), and the power entering through it against a
+       * quadrature over the map's texels, sum L max(0, cos) dw times its area. */
+      iris_direction_sampler ds = iris_guiding_sampler(g[0]);
+      iris_vec3 wo[4], wu[4], wv[4];
+      float flux[4], share[4];
+      const int k = ds.sky_windows ? ds.sky_windows(ds.ctx, &env, 4, wo, wu, wv, flux, share) : 0;
+      if (CHECK(k == 1)) {
+        const iris_vec3 n = iris_normalize(iris_cross(wu[0], wv[0]));
+        double ref = 0.0;
+        for (int y = 0; y < env.height; y++)
+          for (int x = 0; x < env.width; x++) {
+            const float sx = ((float)x + 0.5f) / (float)env.width, ty = ((float)y + 0.5f) / (float)env.height;
+            const float c = iris_dot(iris_envmap_st_to_dir(&env, sx, ty), n);
+            if (c > 0.0f)
+              ref += (double)iris_avg3(iris_envmap_radiance_st(&env, sx, ty)) * c * sin(IRIS_PI * ty) *
+                     (2.0 * IRIS_PI / env.width) * (IRIS_PI / env.height);
+          }
+        ref *= 4.0 * iris_length(iris_cross(wu[0], wv[0]));
+        printf("connections' window: normal (%.3f, %.3f, %.3f), %.0f%% of the caches, flux %.4f against %.4f by "
+               "quadrature\n",
+               (double)n.x, (double)n.y, (double)n.z, 100.0 * share[0], (double)flux[0], ref);
+        CHECK(n.x > 0.99f && share[0] > 0.15f);
+        CHECK(fabs(flux[0] / ref - 1.0) < 0.03);
+      }
       iris_envmap_destroy(&env);
     }
     /* The window: the caches that see part of the sky find it and join their
