@@ -319,7 +319,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {
         it.vcache = vcache;
-        char where[200];
+        char where[4 * 80]; /* up to four windows */
         int n = 0;
         for (int j = 0; j < k && n >= 0 && (size_t)n < sizeof where; ++j)
           n += snprintf(where + n, sizeof where - (size_t)n, "%s(%.3g, %.3g, %.3g) drawn from by %.0f%% of the caches",
