@@ -314,7 +314,6 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       for (int j = 0; j < k; ++j) vp.window[j].prob = k == 1 ? 1.0f : (float)(flux[j] / total);
       vp.windows = k;
       vp.sky = true;
-      vp.o = vp.window[0].o, vp.n = vp.window[0].n, vp.u = vp.window[0].u, vp.v = vp.window[0].v;
       connect_settings(&vp, size, IRIS_CONNECT_SKY_MIN_DISTANCE, &res->camera, &p);
       st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {

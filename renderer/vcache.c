@@ -89,19 +89,17 @@ static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *p
   float u[4];
   for (uint32_t d = 0; d < 4; ++d) u[d] = iris_sampler_get(r, d);
   int j = 0;
-  float prob = 1.0f;
-  iris_vec3 wo = p->o, wn = p->n, wu = p->u, wv = p->v;
-  if (p->windows > 1) {
+  if (p->windows > 1) { /* one window: dimension 4 is not drawn */
     const float uw = iris_sampler_get(r, 4);
     float acc = 0.0f;
     for (j = 0; j < p->windows - 1; ++j) {
       acc += p->window[j].prob;
       if (uw < acc) break;
     }
-    const iris_vcache_window *w = &p->window[j];
-    wo = w->o, wn = w->n, wu = w->u, wv = w->v, prob = w->prob;
-    if (!(prob > 0.0f)) return true;
   }
+  const iris_vec3 wo = p->window[j].o, wn = p->window[j].n, wu = p->window[j].u, wv = p->window[j].v;
+  const float prob = p->window[j].prob;
+  if (!(prob > 0.0f)) return true;
   iris_vec3 d, Le;
   float pdf;
   if (!iris_envmap_sample(it->lights->envmap, u[2], u[3], &d, &pdf, &Le) || !(pdf > 0.0f)) return true;

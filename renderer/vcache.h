@@ -83,12 +83,8 @@ typedef struct iris_vcache_window {
 } iris_vcache_window;
 
 typedef struct iris_vcache_params {
-  iris_vec3 o, n;   /* the plane: region A is its negative side */
-  bool sky;         /* the sky through the window (o its centre, u and v its half-axes) */
-  iris_vec3 u, v;
-  /* with the sky and more than one window: all of them (window[0] is o, n,
-   * u, v), region A the negative side of every plane; windows 0 or 1: o, n,
-   * u, v alone */
+  iris_vec3 o, n;   /* without the sky, the opening's plane: region A is its negative side */
+  bool sky;         /* the sky through windows: region A the negative side of every one's plane */
   int windows;
   iris_vcache_window window[IRIS_VCACHE_SKY_WINDOWS];
   float eps;        /* a point within eps of the plane belongs to the side it is seen from */
@@ -118,7 +114,7 @@ static inline bool iris_vcache_in_half_(iris_vec3 o, iris_vec3 n, float eps, iri
 }
 /* Whether x, reached along a ray whose reverse is wo, lies in region A. */
 static inline bool iris_vcache_in_a(const iris_vcache_params *p, iris_vec3 x, iris_vec3 wo) {
-  if (p->windows <= 1) return iris_vcache_in_half_(p->o, p->n, p->eps, x, wo);
+  if (!p->sky) return iris_vcache_in_half_(p->o, p->n, p->eps, x, wo);
   for (int j = 0; j < p->windows; ++j)
     if (!iris_vcache_in_half_(p->window[j].o, p->window[j].n, p->eps, x, wo)) return false;
   return true;
@@ -138,7 +134,6 @@ static inline bool iris_vcache_through_one_(iris_vec3 o, iris_vec3 n, iris_vec3 
 /* With the sky: whether the ray from x along w leaves through a window. */
 static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x, iris_vec3 w) {
   float t;
-  if (p->windows <= 1) return iris_vcache_through_one_(p->o, p->n, p->u, p->v, x, w, &t);
   for (int j = 0; j < p->windows; ++j) {
     const iris_vcache_window *q = &p->window[j];
     if (iris_vcache_through_one_(q->o, q->n, q->u, q->v, x, w, &t)) return true;
