@@ -541,6 +541,19 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         vc_made = false; /* back in A, or a vertex no light path walks: the camera's again */
       }
     }
+    /* The connection's vertex is drawn now, with the number it is drawn
+     * with below, so that its line of the pool (one pool per sample index,
+     * out of cache) loads while the guide prepares and the light is sampled. */
+    const bool connect = vpool && vc_phase == 0 && !sp.delta && vpool->count > 0;
+    float vc_u = 0.0f;
+    uint32_t vc_j = 0;
+    if (connect) {
+      vc_u = iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count;
+      vc_j = (uint32_t)vc_u;
+      if (vc_j >= vpool->count) vc_j = vpool->count - 1;
+      __builtin_prefetch(&vpool->v[vc_j]);
+      __builtin_prefetch((const char *)&vpool->v[vc_j] + sizeof vpool->v[0] - 1);
+    }
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the guide prepares. */
     iris_light_choice choice = {0, 0.0f, false};
@@ -560,12 +573,11 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
           L = iris_add(L, dl);
       }
     }
-    if (vpool && vc_phase == 0 && !sp.delta && vpool->count > 0) {
-      /* connect to one z of the pool, drawn uniformly; the pool holds what
-       * vp->paths light paths left, so each counts count / paths */
-      const float uc = iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count;
-      uint32_t j = (uint32_t)uc;
-      if (j >= vpool->count) j = vpool->count - 1;
+    if (connect) {
+      /* connect to one z of the pool, drawn uniformly (above); the pool
+       * holds what vp->paths light paths left, so each counts count / paths */
+      const float uc = vc_u;
+      const uint32_t j = vc_j;
       const iris_vcache_vertex *z = &vpool->v[j];
       const iris_vec3 d = iris_sub(z->p, sp.si.p);
       const float d2 = iris_dot(d, d);
