@@ -545,14 +545,13 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
      * with below, so that its line of the pool (one pool per sample index,
      * out of cache) loads while the guide prepares and the light is sampled. */
     const bool connect = vpool && vc_phase == 0 && !sp.delta && vpool->count > 0;
-    float vc_u = 0.0f;
-    uint32_t vc_j = 0;
+    float vc_u = 0.0f; /* the pool number: its whole part the vertex, its fraction the roulette's */
+    const iris_vcache_vertex *z = NULL;
     if (connect) {
       vc_u = iris_sampler_slot(rng, IRIS_SLOT_CONNECT) * (float)vpool->count;
-      vc_j = (uint32_t)vc_u;
-      if (vc_j >= vpool->count) vc_j = vpool->count - 1;
-      __builtin_prefetch(&vpool->v[vc_j]);
-      __builtin_prefetch((const char *)&vpool->v[vc_j] + sizeof vpool->v[0] - 1);
+      z = &vpool->v[(uint32_t)vc_u < vpool->count ? (uint32_t)vc_u : vpool->count - 1];
+      __builtin_prefetch(z);
+      __builtin_prefetch((const char *)z + sizeof *z - 1);
     }
     /* Choose the light for NEE now, with the number sample_direct will draw,
      * so that the emitter's record loads while the guide prepares. */
@@ -574,11 +573,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       }
     }
     if (connect) {
-      /* connect to one z of the pool, drawn uniformly (above); the pool
+      /* connect to z, drawn uniformly from the pool (above); the pool
        * holds what vp->paths light paths left, so each counts count / paths */
-      const float uc = vc_u;
-      const uint32_t j = vc_j;
-      const iris_vcache_vertex *z = &vpool->v[j];
       const iris_vec3 d = iris_sub(z->p, sp.si.p);
       const float d2 = iris_dot(d, d);
       if (d2 > vp->min_d2 && bounce + 2 + z->m <= it->max_depth + 1) {
@@ -594,7 +590,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
           float q = 1.0f;
           if (vp->sky && pixel_estimate > 0.0f)
             q = iris_fminf(1.0f, iris_avg3(c) / (IRIS_VCACHE_SKY_RR * pixel_estimate));
-          if (q >= 1.0f || uc - (float)j < q) {
+          if (q >= 1.0f || vc_u - (float)(z - vpool->v) < q) {
             iris_ray sh = iris_spawn_ray_to(sp.si.p, sp.si.ng, z->p, z->n);
             stats->shadow_rays++;
             if (!iris_accel_occluded(it->accel, &sh)) L_connect = iris_add(L_connect, iris_scale(c, 1.0f / q));
