@@ -384,7 +384,7 @@ static float power_heuristic(float pa, float pb) {
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, const iris_sampler *rng, bool mis,
                                float p_light, iris_path_stats *stats, int8_t *outcome, float *value,
-                               const iris_vcache_params *sky_made) {
+                               const iris_vcache_params *sky_made, float sky_g) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -400,10 +400,20 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   }
   if (guided < 0 && !iris_lights_sample_choice_lazy(it->lights, sp->si.p, choice, u0, u1, &ls))
     return iris_v3(0, 0, 0);
-  /* the map's light through the window at a vertex the connections reach: theirs (vcache.h) */
-  if (sky_made && !isfinite(ls.dist) && iris_lights_choice_is_environment_map(it->lights, choice) &&
-      iris_vcache_through(sky_made, sp->si.p, ls.wi))
-    return iris_v3(0, 0, 0);
+  /* the map's light through a window at a vertex the connections reach:
+   * shared with them by MIS (vcache.h), the camera's weight `keep` */
+  float keep = 1.0f;
+  if (sky_made && !isfinite(ls.dist) && iris_lights_choice_is_environment_map(it->lights, choice)) {
+    const float factor = iris_vcache_sky_factor(sky_made, sp->si.p, ls.wi, sp->si.ng);
+    if (factor > 0.0f) keep = 1.0f - iris_vcache_sky_weight(sky_made, factor * sky_g);
+    /* a small share is traced only sometimes, weighted back (no shadow ray
+     * where the connections carry nearly all of it) */
+    if (keep < IRIS_VCACHE_SKY_KEEP) {
+      if (!(keep > 0.0f) || iris_sampler_slot(rng, IRIS_SLOT_SKY_SHARE) * IRIS_VCACHE_SKY_KEEP >= keep)
+        return iris_v3(0, 0, 0);
+      keep = IRIS_VCACHE_SKY_KEEP;
+    }
+  }
   iris_vec3 f = bsdf_eval(sp, ls.wi);
   if (f.x <= 0.0f && f.y <= 0.0f && f.z <= 0.0f) return iris_v3(0, 0, 0);
   iris_vec3 wl = iris_frame_to_local(&sp->frame, ls.wi);
@@ -426,7 +436,7 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   *value = iris_avg3(fl) * fabsf(wl.z) / pdf;
   float w = 1.0f;
   if (mis && !ls.delta) w = power_heuristic(pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
-  return iris_scale(fl, fabsf(wl.z) * w / pdf);
+  return iris_scale(fl, fabsf(wl.z) * w * keep / pdf);
 }
 
 static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sampler *rng,
@@ -460,9 +470,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_vec3 vc_prev = {0, 0, 0}, vc_last = {0, 0, 0}; /* x_{k-1}, x_k */
   bool vc_prev_nd = false, vc_last_nd = false, vc_last_plain = false;
   bool vc_made = false;       /* phase 1 and a path the connections make */
-  /* with the sky: whether the map's light through the window at this vertex,
-   * and at the one the ray left, is the connections' */
+  /* with the sky: whether the map's light through a window at this vertex,
+   * and at the one the ray left, is shared with the connections, and the
+   * camera's part of their MIS ratio there (d^2 / (p_dir |cos_in|), vcache.h) */
   bool sky_made = false, prev_sky_made = false;
+  float sky_g = 0.0f, prev_sky_g = 0.0f;
+  iris_vec3 prev_sky_ng = {0, 0, 0};
   iris_vec3 L_connect = iris_v3(0, 0, 0);
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -476,7 +489,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_hit hit;
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
-      if (prev_sky_made && iris_vcache_through(vp, prev_p, ray.d)) break; /* the connections' */
+      float sky_keep = 1.0f; /* the camera's MIS weight against the connections (vcache.h) */
+      if (prev_sky_made) {
+        const float factor = iris_vcache_sky_factor(vp, prev_p, ray.d, prev_sky_ng);
+        if (factor > 0.0f) sky_keep = 1.0f - iris_vcache_sky_weight(vp, factor * prev_sky_g);
+        if (!(sky_keep > 0.0f)) break;
+      }
       float env_pdf = 0.0f, st[2];
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
                                                  !prev_delta && mis ? &env_pdf : NULL, st);
@@ -491,7 +509,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         env_pdf *= prev_light;
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
-        L = iris_add(L, iris_scale(iris_mul(beta, le), w));
+        L = iris_add(L, iris_scale(iris_mul(beta, le), w * sky_keep));
         if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }
       break;
@@ -521,9 +539,12 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         vc_k++;
         vc_prev = vc_last, vc_prev_nd = vc_last_nd;
         vc_last = si.p, vc_last_nd = !sp.delta, vc_last_plain = plain;
-        if (vp->sky) {
+        if (vp->sky) { /* x_{k-1} connected (not delta, and the ray not a delta lobe's) */
           const iris_vec3 d = iris_sub(vc_last, vc_prev);
-          sky_made = vc_k >= 2 && vc_prev_nd && plain && iris_dot(d, d) > vp->min_d2;
+          const float d2 = iris_dot(d, d), cos_in = fabsf(iris_dot(d, si.ng));
+          sky_made = vc_k >= 2 && vc_prev_nd && !prev_delta && plain && vpool->count > 0 && prev_pdf > 0.0f &&
+                     cos_in > 0.0f;
+          if (sky_made) sky_g = d2 * sqrtf(d2) / (prev_pdf * cos_in);
         }
       } else if (vc_phase == 0 && vp->sky) {
         vc_phase = 2; /* outside: no more connections, nothing left out */
@@ -567,7 +588,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
       {
         const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
-                                                          &light_outcome, &light_value, sky_made ? vp : NULL));
+                                                          &light_outcome, &light_value, sky_made ? vp : NULL,
+                                                          sky_g));
         if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
           L = iris_add(L, dl);
       }
@@ -577,13 +599,17 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
        * holds what vp->paths light paths left, so each counts count / paths */
       const iris_vec3 d = iris_sub(z->p, sp.si.p);
       const float d2 = iris_dot(d, d);
-      if (d2 > vp->min_d2 && bounce + 2 + z->m <= it->max_depth + 1) {
+      if ((vp->sky || d2 > vp->min_d2) && bounce + 2 + z->m <= it->max_depth + 1) {
         const iris_vec3 w = iris_scale(d, 1.0f / sqrtf(d2));
         const float cos_z = -iris_dot(w, z->n);
         const iris_vec3 fx = iris_integrator_bsdf_eval(&sp, w);
         if (cos_z > 0.0f && iris_max3(fx) > 0.0f) {
+          /* with the sky, the MIS weight against the camera's own (vcache.h) */
+          const float wc = vp->sky ? iris_vcache_sky_weight(vp, z->mis * d2 / (iris_integrator_direction_pdf(it, &sp, w) *
+                                                                             cos_z))
+                                   : 1.0f;
           const iris_vec3 c = iris_scale(iris_mul(iris_mul(beta, fx), z->f_power),
-                                         fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count /
+                                         wc * fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count /
                                              (float)vp->paths);
           /* with the sky, small ones against the pixel's estimate only
            * sometimes (weighted back): the rest of the pool number decides */
@@ -629,6 +655,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     }
     prev_delta = ds.delta;
     prev_sky_made = sky_made;
+    prev_sky_g = sky_g;
+    prev_sky_ng = sp.si.ng;
     sky_made = false;
     prev_pdf = ds.pdf;
     prev_light = p_light;

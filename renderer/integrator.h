@@ -56,6 +56,8 @@ enum {
   IRIS_DIM_PIXEL = 0,          /* 2D: position in the pixel */
   IRIS_DIM_BOUNCE0 = 2,
   IRIS_SLOT_LIGHT_CHOICE = 0,  /* NEE: which light */
+  IRIS_SLOT_SKY_SHARE = 1,     /* NEE of the map through a window: whether a small MIS share of it
+                                  (vcache.h) is traced (the light choice's pair) */
   IRIS_SLOT_LOBE = 2,          /* BSDF: which lobe */
   IRIS_SLOT_LIGHT_SKIP = 3,    /* light sampling at a vertex where the guide makes it optional
                                   (the lobe's pair: two independent 1D decisions) */

@@ -305,7 +305,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       const iris_vec3 nn = iris_cross(wu[j], wv[j]);
       const float nl = iris_length(nn);
       ok = nl > 0.0f && isfinite(nl) && flux[j] >= 0.0f && isfinite(flux[j]);
-      vp.window[j] = (iris_vcache_window){wo[j], iris_scale(nn, 1.0f / nl), wu[j], wv[j], 0.0f};
+      vp.window[j] = (iris_vcache_window){wo[j], iris_scale(nn, 1.0f / nl), wu[j], wv[j], 4.0f * nl, 0.0f};
       size = fmaxf(size, 2.0f * fmaxf(iris_length(wu[j]), iris_length(wv[j])));
       total += flux[j];
     }
@@ -314,7 +314,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       for (int j = 0; j < k; ++j) vp.window[j].prob = k == 1 ? 1.0f : (float)(flux[j] / total);
       vp.windows = k;
       vp.sky = true;
-      connect_settings(&vp, size, IRIS_CONNECT_SKY_MIN_DISTANCE, &res->camera, &p);
+      connect_settings(&vp, size, 0.0f, &res->camera, &p);
+      vp.mis_c = IRIS_CONNECT_SKY_MIS_C;
       st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {
         it.vcache = vcache;

@@ -38,10 +38,11 @@ extern "C" {
 #define IRIS_CONNECT_MIN_DISTANCE 0.15f
 /* With the sky through windows (no opening to a lit room): on where the
  * windows together are drawn from by at least IRIS_CONNECT_MIN_SHARE of the
- * caches (sky-room 0.37), not between points closer than this times the
- * longest window's longer side (1.2 m on sky-room: of 0.15, 0.5, 1 and 1.5, 1
- * measured best, docs/guiding.md). */
-#define IRIS_CONNECT_SKY_MIN_DISTANCE 1.0f
+ * caches (sky-room 0.37); the camera and the connections share the map's
+ * light by MIS with this constant (vcache.h, iris_vcache_sky_weight; of 0.5,
+ * 1, 2, 4 and 8, 2 measured best per sample on sky-room and the corner,
+ * docs/guiding.md). */
+#define IRIS_CONNECT_SKY_MIS_C 2.0f
 /* With the sky: a window whose entering power is below this share of the
  * brightest window's is left to the camera (render.c). */
 #define IRIS_CONNECT_SKY_MIN_FLUX 0.01f

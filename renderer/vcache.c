@@ -106,7 +106,7 @@ static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *p
   const float cw = iris_dot(d, wn);
   if (!(cw > 0.0f) || !(iris_max3(Le) > 0.0f)) return true;
   const iris_vec3 q = iris_add(wo, iris_add(iris_scale(wu, 2.0f * u[0] - 1.0f), iris_scale(wv, 2.0f * u[1] - 1.0f)));
-  const float area = 4.0f * iris_length(iris_cross(wu, wv));
+  const float area = p->window[j].area;
   iris_ray out = {q, 0.0f, d, INFINITY};
   *rays += 2;
   if (iris_accel_occluded(it->accel, &out)) return true; /* the sky is not seen from there */
@@ -125,7 +125,8 @@ static bool sky_path(const iris_vcache *vc, iris_sampler *r, iris_vcache_pool *p
   }
   const iris_vec3 n = iris_dot(si.ng, d) < 0.0f ? iris_neg(si.ng) : si.ng;
   const iris_vec3 power = iris_scale(Le, cw * area / (pdf * prob));
-  const iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), 0};
+  const iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), 0,
+                                prob * fabsf(iris_dot(d, n)) / (area * cw)};
   return push(pool, cap, &z);
 }
 
@@ -164,7 +165,7 @@ static bool build_pool(const iris_vcache *vc, uint64_t s, iris_vcache_pool *pool
       iris_vec3 n = iris_dot(si.ng, wo) < 0.0f ? iris_neg(si.ng) : si.ng;
       if (iris_vcache_in_a(&vc->p, si.p, wo)) {
         if (m >= 1) {
-          iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), m};
+          iris_vcache_vertex z = {si.p, n, iris_mul(iris_integrator_bsdf_eval(&sp, n), power), m, 0.0f};
           ok = push(pool, &cap, &z);
         }
         break;

@@ -24,16 +24,20 @@
  * the environment map seen through the window (a rectangle, sky visibility's,
  * skyvis.h). Light paths leave a point uniform on it in a direction from the
  * map's own sampling, seen through it, and keep the first vertex z they hit
- * inside (m = 0), if plain. A camera vertex connects to one z as above; the
- * paths so made,
- *   camera, x_1 .. x_{k-1} in A (k >= 2, x_{k-1} not delta), z = x_k plain,
- *   |x_{k-1} - x_k| > d_min, then the map's light through the window,
- * are left out of the camera estimator: at such an x_k its light samples of
- * the map whose direction leaves through the window (not traced) and its
- * escapes through it. The camera goes on from x_k as before (its further
- * bounces are its own), and a connection whose unoccluded value is small
- * against the pixel's estimate is traced only with probability value /
- * (IRIS_VCACHE_SKY_RR x estimate), weighted back. */
+ * inside (m = 0), if plain. A camera vertex connects to one z as above, at
+ * any distance; the paths so made,
+ *   camera, x_1 .. x_{k-1} in A (k >= 2, x_{k-1} not delta and left along a
+ *   lobe that is not), z = x_k plain, then the map's light through a window,
+ * the camera makes too: at such an x_k its light samples of the map whose
+ * direction leaves through a window and its escapes through one. The two
+ * share them by MIS (iris_vcache_sky_weight below): a short connection's
+ * 1/d^2 goes to the camera, a long one's light mostly to the connections.
+ * The camera goes on from x_k as before (its further bounces are its own). A
+ * connection whose weighted unoccluded value is small against the pixel's
+ * estimate is traced only with probability value / (IRIS_VCACHE_SKY_RR x
+ * estimate), and a camera light sample whose share is below
+ * IRIS_VCACHE_SKY_KEEP with probability share / IRIS_VCACHE_SKY_KEEP, each
+ * weighted back. */
 #ifndef IRIS_RENDERER_VCACHE_H
 #define IRIS_RENDERER_VCACHE_H
 
@@ -52,10 +56,12 @@ struct iris_shading_point;
 
 /* A stored vertex z: its position, its geometric normal on the side the
  * light arrived from, the light's throughput there times z's BSDF (f power),
- * and the number m of region-B vertices before it. */
+ * the number m of region-B vertices before it, and with the sky the light
+ * path's density's factor for the MIS weight (iris_vcache_sky_factor). */
 typedef struct iris_vcache_vertex {
   iris_vec3 p, n, f_power;
   int32_t m;
+  float mis;
 } iris_vcache_vertex;
 
 typedef struct iris_vcache_pool {
@@ -72,14 +78,20 @@ typedef struct iris_vcache_pool {
  * 1080); later ones neither connect nor leave anything out (unbiased). */
 #define IRIS_VCACHE_SKY_BUDGET (64u << 20)
 
+/* With the sky: the camera's light sample of the map through a window whose
+ * MIS share is below this is traced with probability share / this, weighted
+ * back (sky-room and the corner, 64 spp: 0.1, 0.25 and 0.5 the same error per
+ * sample, 0.5 the fewest rays; without it 9% more rays per sample). */
+#define IRIS_VCACHE_SKY_KEEP 0.5f
+
 /* With the sky: at most this many windows (sky visibility's, render.c). */
 #define IRIS_VCACHE_SKY_WINDOWS 4
 
 /* A window of the sky: centre o, outward unit normal n, half-axes u and v,
- * and the probability that a light path starts on it. */
+ * its area (4 |u x v|) and the probability that a light path starts on it. */
 typedef struct iris_vcache_window {
   iris_vec3 o, n, u, v;
-  float prob;
+  float area, prob;
 } iris_vcache_window;
 
 typedef struct iris_vcache_params {
@@ -88,7 +100,8 @@ typedef struct iris_vcache_params {
   int windows;
   iris_vcache_window window[IRIS_VCACHE_SKY_WINDOWS];
   float eps;        /* a point within eps of the plane belongs to the side it is seen from */
-  float min_d2;     /* the shortest connection, squared */
+  float min_d2;     /* without the sky, the shortest connection, squared */
+  float mis_c;      /* with the sky, the MIS weight's constant (iris_vcache_sky_weight) */
   uint32_t paths;   /* light paths per sample index */
   uint64_t seed;
   int threads;
@@ -139,6 +152,36 @@ static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x,
     if (iris_vcache_through_one_(q->o, q->n, q->u, q->v, x, w, &t)) return true;
   }
   return false;
+}
+/* With the sky, connections and the camera share the map's light at a
+ * plain vertex z = x_k through MIS (docs/guiding.md, "Connections with the
+ * sky through a window"). A light path makes (z, w), w the direction to the
+ * sky, with density P_j |w.n_z| p_map(w) / (A_j (w.n_j)) over z's area and
+ * w's solid angle (j the first window crossed from z along w, n_j its
+ * outward normal, P_j its probability, A_j its area); the camera reaches z
+ * from x_{k-1} with density p_dir |cos_in| / d^2 over z's area, and its
+ * density of w at z stands in as mis_c p_map(w), so that the ratio of the
+ * two is
+ *   rho = factor d^2 / (p_dir |cos_in|),  factor = P_j |w.n_z| / (A_j (w.n_j))
+ * and the connection's weight is rho^2 / (rho^2 + mis_c^2) (the power
+ * heuristic), the camera's one minus that. Any weights that sum to one are
+ * unbiased; the stand-in only decides how well the two share. The factor,
+ * 0 where w leaves through no window: */
+static inline float iris_vcache_sky_factor(const iris_vcache_params *p, iris_vec3 z, iris_vec3 w, iris_vec3 ng) {
+  float best = INFINITY, factor = 0.0f, t;
+  for (int j = 0; j < p->windows; ++j) {
+    const iris_vcache_window *q = &p->window[j];
+    if (iris_vcache_through_one_(q->o, q->n, q->u, q->v, z, w, &t) && t < best) {
+      best = t;
+      factor = q->prob * fabsf(iris_dot(w, ng)) / (q->area * iris_dot(w, q->n));
+    }
+  }
+  return factor;
+}
+static inline float iris_vcache_sky_weight(const iris_vcache_params *p, float rho) {
+  if (!(rho < INFINITY)) return 1.0f;
+  const float a = rho * rho;
+  return a / (a + p->mis_c * p->mis_c);
 }
 /* A plain vertex: a Lambertian reflector (no other lobe) with flat shading. */
 bool iris_vcache_plain(const struct iris_shading_point *sp, iris_vec3 ng);
