@@ -463,7 +463,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   stats->paths++;
   /* Connections to a light-vertex cache (vcache.h): only image paths (not
    * training's); the state says whether the path so far is one the
-   * connections make, whose light the camera then leaves out. */
+   * connections make, whose light the camera then leaves out (the door's)
+   * or shares with them by MIS (the sky's). */
   const iris_vcache_pool *vpool = it->vcache && !rec ? iris_vcache_get(it->vcache, rng->sample) : NULL;
   const iris_vcache_params *vp = vpool ? iris_vcache_settings(it->vcache) : NULL;
   int vc_phase = 0, vc_k = 0; /* 0: every vertex so far in region A; 1: k >= 1 there, then only B; 2: other */
@@ -547,7 +548,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
           if (sky_made) sky_g = d2 * sqrtf(d2) / (prev_pdf * cos_in);
         }
       } else if (vc_phase == 0 && vp->sky) {
-        vc_phase = 2; /* outside: no more connections, nothing left out */
+        vc_phase = 2; /* outside: no more connections, nothing shared */
       } else if (vc_phase == 0) {
         vc_phase = vc_k >= 1 ? 1 : 2;
         const iris_vec3 d = iris_sub(vc_last, vc_prev);

@@ -1,6 +1,6 @@
 /* Connections to a light-vertex cache: the pools of light vertices; vcache.h
  * and docs/guiding.md, "Connections to a light-vertex cache". The camera side
- * (what connects, what is left out) is in integrator.c. */
+ * (what connects, what is left out or shared) is in integrator.c. */
 #include "renderer/vcache.h"
 
 #include <pthread.h>

@@ -72,10 +72,10 @@ typedef struct iris_vcache_pool {
 /* The connections' roulette against the pixel's estimate with the sky
  * (measured on sky-room: 0.5 best of 0.5, 1 and 2, docs/guiding.md). */
 #define IRIS_VCACHE_SKY_RR 0.5f
-/* With the sky nearly every light path keeps a vertex (40 bytes), and pools
+/* With the sky nearly every light path keeps a vertex (44 bytes), and pools
  * are kept for the whole render: only the sample indices below this budget
- * over paths x 40 bytes have pools (about 1700 at 108 x 72, 800 at 1920 x
- * 1080); later ones neither connect nor leave anything out (unbiased). */
+ * over paths x 44 bytes have pools (about 1560 at 108 x 72, 730 at 1920 x
+ * 1080); later ones neither connect nor share anything (unbiased). */
 #define IRIS_VCACHE_SKY_BUDGET (64u << 20)
 
 /* With the sky: the camera's light sample of the map through a window whose
@@ -115,7 +115,7 @@ iris_status iris_vcache_create(iris_vcache **out, const iris_vcache_params *p, c
 void iris_vcache_destroy(iris_vcache *vc);
 /* The pool of sample index s, built on first use (with the next 31 indices,
  * in parallel; thread-safe). NULL where s is past the cache's reach or memory
- * ran out: then the path neither connects nor leaves anything out. */
+ * ran out: then the path neither connects nor shares anything. */
 const iris_vcache_pool *iris_vcache_get(iris_vcache *vc, uint64_t s);
 const iris_vcache_params *iris_vcache_settings(const iris_vcache *vc);
 /* Rays the light paths traced so far. */
