@@ -458,6 +458,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   /* light sampling made optional by the guide (iris_direction_sampler.light_probability) */
   const bool light_optional = nee && iris_method_uses_guiding(it->method) && it->guide.light_probability;
   float prev_light = 1.0f; /* the probability with which the vertex the ray left sampled a light */
+  float prev_env_q = 1.0f;  /* ... and, at a vertex that shares the sky with the connections, the map */
   float prev_pdf = 0.0f;
   iris_vec3 prev_p = ray.o, prev_n = iris_v3(0, 0, 0);
   stats->paths++;
@@ -507,7 +508,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
           if (add > 0.0f) /* the sky's windows: their density times the map's choice */
             env_pdf += add * iris_lights_select_pmf_at(it->lights, prev_p, prev_n, (uint32_t)it->lights->environment);
         }
-        env_pdf *= prev_light;
+        env_pdf *= prev_light * prev_env_q;
         float w = 1.0f;
         if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w * sky_keep));
@@ -583,12 +584,21 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_integrator_prepare_direction(it, &sp);
     int8_t light_outcome = -1; /* for the recorded vertex: -1 no shadow ray, 0 blocked, 1 lit */
     float light_value = 0.0f;  /* ... and what it brought before the MIS weight */
-    float p_light = 1.0f;
+    float p_light = 1.0f, env_q = 1.0f;
     if (nee && !sp.delta) {
       if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
-      if (p_light >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_light)
+      /* where the connections carry most of the map's light here (its share
+       * toward every window's centre small), the camera samples the map only
+       * with probability env_q, which its density counts (vcache.h) */
+      if (sky_made && iris_lights_choice_is_environment_map(it->lights, &choice))
+        env_q = vp->map_q > 0.0f ? iris_fminf(vp->map_q, 1.0f)
+                                 : iris_clampf(iris_vcache_sky_keep_centres(vp, sp.si.p, sp.si.ng, sky_g) /
+                                                   IRIS_VCACHE_SKY_KEEP,
+                                               IRIS_VCACHE_SKY_MAP_MIN, 1.0f);
+      const float p_eff = p_light * env_q;
+      if (p_eff >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_eff)
       {
-        const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_light, stats,
+        const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_eff, stats,
                                                           &light_outcome, &light_value, sky_made ? vp : NULL,
                                                           sky_g));
         if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
@@ -661,6 +671,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     sky_made = false;
     prev_pdf = ds.pdf;
     prev_light = p_light;
+    prev_env_q = env_q;
     prev_p = sp.si.p;
     prev_n = light_normal(&sp);
     if (env_guided) prev_guide = sp.guide;

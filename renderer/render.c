@@ -164,6 +164,8 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_sampler, 0x7ee11ULL, 2);
     /* connections asked for or refused: parts must agree (the default keeps the hash) */
     if (p.connect != IRIS_CONNECT_AUTO) res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.connect, 0xc0ecULL, 3);
+    if (p.connect_sky_map_q > 0.0f)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)(p.connect_sky_map_q * 1e9), 0xc0ecULL, 4);
   }
   /* What the render will need against what the machine has, before any of it
    * is built (docs/performance.md, "Memory estimate"). Logged (with the
@@ -316,6 +318,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       vp.sky = true;
       connect_settings(&vp, size, 0.0f, &res->camera, &p);
       vp.mis_c = IRIS_CONNECT_SKY_MIS_C;
+      vp.map_q = p.connect_sky_map_q;
       st = iris_vcache_create(&vcache, &vp, &it, err);
       if (st == IRIS_OK && vcache) {
         it.vcache = vcache;

@@ -144,6 +144,11 @@ typedef struct iris_render_params {
    * IRIS_CONNECT_AUTO where the guide's opening is kept by at least
    * IRIS_CONNECT_MIN_SHARE of the caches, ON wherever the guide found one. */
   enum { IRIS_CONNECT_AUTO = 0, IRIS_CONNECT_OFF, IRIS_CONNECT_ON } connect;
+  /* With the sky's connections: the probability with which a camera vertex
+   * that shares the map's light with them samples the map, in place of the
+   * one from its share (0, the default); tests set it to make that branch,
+   * and its density, weigh. */
+  float connect_sky_map_q;
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
   /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..

@@ -83,6 +83,12 @@ typedef struct iris_vcache_pool {
  * back (sky-room and the corner, 64 spp: 0.1, 0.25 and 0.5 the same error per
  * sample, 0.5 the fewest rays; without it 9% more rays per sample). */
 #define IRIS_VCACHE_SKY_KEEP 0.5f
+/* ... and where its share toward every window's centre is below that, it
+ * samples the map at all only with probability share / IRIS_VCACHE_SKY_KEEP,
+ * at least this (iris_vcache_sky_keep_centres; the density counts it; 0.1
+ * with 0.5 above: 1.13-1.14x at equal time on sky-room and the corner, 0.05
+ * with 1 the same per unit of work, docs/guiding.md). */
+#define IRIS_VCACHE_SKY_MAP_MIN 0.1f
 
 /* With the sky: at most this many windows (sky visibility's, render.c). */
 #define IRIS_VCACHE_SKY_WINDOWS 4
@@ -102,6 +108,8 @@ typedef struct iris_vcache_params {
   float eps;        /* a point within eps of the plane belongs to the side it is seen from */
   float min_d2;     /* without the sky, the shortest connection, squared */
   float mis_c;      /* with the sky, the MIS weight's constant (iris_vcache_sky_weight) */
+  float map_q;      /* with the sky, > 0: the camera's probability of sampling the map where it
+                       shares it (iris_render_params.connect_sky_map_q), instead of by its share */
   uint32_t paths;   /* light paths per sample index */
   uint64_t seed;
   int threads;
@@ -182,6 +190,21 @@ static inline float iris_vcache_sky_weight(const iris_vcache_params *p, float rh
   if (!(rho < INFINITY)) return 1.0f;
   const float a = rho * rho;
   return a / (a + p->mis_c * p->mis_c);
+}
+/* With the sky: the camera's largest share at z (geometric normal ng) over
+ * the directions to the windows' centres that leave through them, for the
+ * ratio's camera part g (0 where no window's outside faces z). */
+static inline float iris_vcache_sky_keep_centres(const iris_vcache_params *p, iris_vec3 z, iris_vec3 ng, float g) {
+  float keep = 0.0f;
+  for (int j = 0; j < p->windows; ++j) {
+    const iris_vcache_window *q = &p->window[j];
+    const iris_vec3 d = iris_sub(q->o, z);
+    const float dn = iris_dot(d, q->n);
+    if (!(dn > 0.0f)) continue;
+    const float factor = q->prob * fabsf(iris_dot(d, ng)) / (q->area * dn);
+    keep = iris_fmaxf(keep, 1.0f - iris_vcache_sky_weight(p, factor * g));
+  }
+  return keep;
 }
 /* A plain vertex: a Lambertian reflector (no other lobe) with flat shading. */
 bool iris_vcache_plain(const struct iris_shading_point *sp, iris_vec3 ng);
