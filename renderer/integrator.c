@@ -589,13 +589,15 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (light_optional) p_light = it->guide.light_probability(it->guide.ctx, &sp);
       /* where the connections carry most of the map's light here (its share
        * toward every window's centre small), the camera samples the map only
-       * with probability env_q, which its density counts (vcache.h) */
-      if (sky_made && iris_lights_choice_is_environment_map(it->lights, &choice))
+       * with probability env_q, which its density counts (vcache.h); known
+       * whichever light was chosen, since the escapes' weight needs it */
+      if (sky_made)
         env_q = vp->map_q > 0.0f ? iris_fminf(vp->map_q, 1.0f)
                                  : iris_clampf(iris_vcache_sky_keep_centres(vp, sp.si.p, sp.si.ng, sky_g) /
                                                    IRIS_VCACHE_SKY_KEEP,
                                                IRIS_VCACHE_SKY_MAP_MIN, 1.0f);
-      const float p_eff = p_light * env_q;
+      const float p_eff =
+          env_q < 1.0f && iris_lights_choice_is_environment_map(it->lights, &choice) ? p_light * env_q : p_light;
       if (p_eff >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_eff)
       {
         const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_eff, stats,
