@@ -152,15 +152,6 @@ static inline bool iris_vcache_through_one_(iris_vec3 o, iris_vec3 n, iris_vec3 
   *t_out = t;
   return fabsf(iris_dot(q, u)) <= iris_dot(u, u) && fabsf(iris_dot(q, v)) <= iris_dot(v, v);
 }
-/* With the sky: whether the ray from x along w leaves through a window. */
-static inline bool iris_vcache_through(const iris_vcache_params *p, iris_vec3 x, iris_vec3 w) {
-  float t;
-  for (int j = 0; j < p->windows; ++j) {
-    const iris_vcache_window *q = &p->window[j];
-    if (iris_vcache_through_one_(q->o, q->n, q->u, q->v, x, w, &t)) return true;
-  }
-  return false;
-}
 /* With the sky, connections and the camera share the map's light at a
  * plain vertex z = x_k through MIS (docs/guiding.md, "Connections with the
  * sky through a window"). A light path makes (z, w), w the direction to the
@@ -187,8 +178,8 @@ static inline float iris_vcache_sky_factor(const iris_vcache_params *p, iris_vec
   return factor;
 }
 static inline float iris_vcache_sky_weight(const iris_vcache_params *p, float rho) {
-  if (!(rho < INFINITY)) return 1.0f;
   const float a = rho * rho;
+  if (!(a < INFINITY)) return 1.0f; /* rho infinite (the camera cannot make the path), past range, or NaN */
   return a / (a + p->mis_c * p->mis_c);
 }
 /* With the sky: the camera's largest share at z (geometric normal ng) over
