@@ -384,7 +384,7 @@ static float power_heuristic(float pa, float pb) {
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, const iris_sampler *rng, bool mis,
                                float p_light, iris_path_stats *stats, int8_t *outcome, float *value,
-                               const iris_vcache_params *sky_made, float sky_g) {
+                               const iris_vcache_params *vp, float sky_g) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -403,9 +403,8 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   /* the map's light through a window at a vertex the connections reach:
    * shared with them by MIS (vcache.h), the camera's weight `keep` */
   float keep = 1.0f;
-  if (sky_made && !isfinite(ls.dist) && iris_lights_choice_is_environment_map(it->lights, choice)) {
-    const float factor = iris_vcache_sky_factor(sky_made, sp->si.p, ls.wi, sp->si.ng);
-    if (factor > 0.0f) keep = 1.0f - iris_vcache_sky_weight(sky_made, factor * sky_g);
+  if (sky_g > 0.0f && !isfinite(ls.dist) && iris_lights_choice_is_environment_map(it->lights, choice)) {
+    keep = iris_vcache_sky_keep(vp, sp->si.p, ls.wi, sp->si.ng, sky_g);
     /* a small share is traced only sometimes, weighted back (no shadow ray
      * where the connections carry nearly all of it) */
     if (keep < IRIS_VCACHE_SKY_KEEP) {
@@ -472,12 +471,11 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_vec3 vc_prev = {0, 0, 0}, vc_last = {0, 0, 0}; /* x_{k-1}, x_k */
   bool vc_prev_nd = false, vc_last_nd = false, vc_last_plain = false;
   bool vc_made = false;       /* phase 1 and a path the connections make */
-  /* with the sky: whether the map's light through a window at this vertex,
-   * and at the one the ray left, is shared with the connections, and the
-   * camera's part of their MIS ratio there (d^2 / (p_dir |cos_in|), vcache.h) */
-  bool sky_made = false, prev_sky_made = false;
+  /* with the sky: at this vertex, and at the one the ray left, the camera's
+   * part of the MIS ratio with the connections (d^2 / (p_dir |cos_in|),
+   * vcache.h) where it shares the map's light through a window with them,
+   * 0 where it does not */
   float sky_g = 0.0f, prev_sky_g = 0.0f;
-  iris_vec3 prev_sky_ng = {0, 0, 0};
   iris_vec3 L_connect = iris_v3(0, 0, 0);
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
@@ -492,9 +490,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     stats->rays++;
     if (!iris_accel_intersect(it->accel, &ray, &hit)) {
       float sky_keep = 1.0f; /* the camera's MIS weight against the connections (vcache.h) */
-      if (prev_sky_made) {
-        const float factor = iris_vcache_sky_factor(vp, prev_p, ray.d, prev_sky_ng);
-        if (factor > 0.0f) sky_keep = 1.0f - iris_vcache_sky_weight(vp, factor * prev_sky_g);
+      if (prev_sky_g > 0.0f) { /* prev_n: a plain vertex's geometric normal */
+        sky_keep = iris_vcache_sky_keep(vp, prev_p, ray.d, prev_n, prev_sky_g);
         if (!(sky_keep > 0.0f)) break;
       }
       float env_pdf = 0.0f, st[2];
@@ -544,9 +541,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         if (vp->sky) { /* x_{k-1} connected (not delta, and the ray not a delta lobe's) */
           const iris_vec3 d = iris_sub(vc_last, vc_prev);
           const float d2 = iris_dot(d, d), cos_in = fabsf(iris_dot(d, si.ng));
-          sky_made = vc_k >= 2 && vc_prev_nd && !prev_delta && plain && vpool->count > 0 && prev_pdf > 0.0f &&
-                     cos_in > 0.0f;
-          if (sky_made) sky_g = d2 * sqrtf(d2) / (prev_pdf * cos_in);
+          if (vc_k >= 2 && vc_prev_nd && !prev_delta && plain && vpool->count > 0 && prev_pdf > 0.0f && cos_in > 0.0f)
+            sky_g = d2 * sqrtf(d2) / (prev_pdf * cos_in);
         }
       } else if (vc_phase == 0 && vp->sky) {
         vc_phase = 2; /* outside: no more connections, nothing shared */
@@ -591,7 +587,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
        * toward every window's centre small), the camera samples the map only
        * with probability env_q, which its density counts (vcache.h); known
        * whichever light was chosen, since the escapes' weight needs it */
-      if (sky_made)
+      if (sky_g > 0.0f)
         env_q = vp->map_q > 0.0f ? iris_fminf(vp->map_q, 1.0f)
                                  : iris_clampf(iris_vcache_sky_keep_centres(vp, sp.si.p, sp.si.ng, sky_g) /
                                                    IRIS_VCACHE_SKY_KEEP,
@@ -601,8 +597,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (p_eff >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_eff)
       {
         const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_eff, stats,
-                                                          &light_outcome, &light_value, sky_made ? vp : NULL,
-                                                          sky_g));
+                                                          &light_outcome, &light_value, vp, sky_g));
         if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
           L = iris_add(L, dl);
       }
@@ -667,10 +662,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->light_value = light_value;
     }
     prev_delta = ds.delta;
-    prev_sky_made = sky_made;
     prev_sky_g = sky_g;
-    prev_sky_ng = sp.si.ng;
-    sky_made = false;
+    sky_g = 0.0f;
     prev_pdf = ds.pdf;
     prev_light = p_light;
     prev_env_q = env_q;

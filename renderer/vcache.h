@@ -182,6 +182,13 @@ static inline float iris_vcache_sky_weight(const iris_vcache_params *p, float rh
   if (!(a < INFINITY)) return 1.0f; /* rho infinite (the camera cannot make the path), past range, or NaN */
   return a / (a + p->mis_c * p->mis_c);
 }
+/* With the sky: the camera's share of the map's light arriving at z
+ * (geometric normal ng) from w, for the ratio's camera part g (1 where w
+ * leaves through no window). */
+static inline float iris_vcache_sky_keep(const iris_vcache_params *p, iris_vec3 z, iris_vec3 w, iris_vec3 ng, float g) {
+  const float factor = iris_vcache_sky_factor(p, z, w, ng);
+  return factor > 0.0f ? 1.0f - iris_vcache_sky_weight(p, factor * g) : 1.0f;
+}
 /* With the sky: the camera's largest share at z (geometric normal ng) over
  * the directions to the windows' centres that leave through them, for the
  * ratio's camera part g (0 where no window's outside faces z). */
