@@ -611,20 +611,29 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         const iris_vec3 w = iris_scale(d, 1.0f / sqrtf(d2));
         const float cos_z = -iris_dot(w, z->n);
         const iris_vec3 fx = iris_integrator_bsdf_eval(&sp, w);
-        if (cos_z > 0.0f && iris_max3(fx) > 0.0f) {
+        /* the connection before its MIS weight, and with the sky the rest
+         * of the pool number, which its roulette compares below */
+        const float k = fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count / (float)vp->paths;
+        const iris_vec3 bf = iris_mul(iris_mul(beta, fx), z->f_power);
+        const float u_rr = vc_u - (float)(z - vpool->v);
+        const bool rr = vp->sky && pixel_estimate > 0.0f;
+        /* The weight is at most 1, so a number the roulette of the unweighted
+         * value already refuses (with a margin for rounding) refuses the
+         * weighted one too: the guide's density, the weight's cost, is looked
+         * up only for the others; the same connections are traced. */
+        if (cos_z > 0.0f && iris_max3(fx) > 0.0f &&
+            !(rr && u_rr >= 1.001f * iris_avg3(bf) * k / (IRIS_VCACHE_SKY_RR * pixel_estimate))) {
           /* with the sky, the MIS weight against the camera's own (vcache.h) */
           const float wc = vp->sky ? iris_vcache_sky_weight(vp, z->mis * d2 / (iris_integrator_direction_pdf(it, &sp, w) *
                                                                              cos_z))
                                    : 1.0f;
-          const iris_vec3 c = iris_scale(iris_mul(iris_mul(beta, fx), z->f_power),
-                                         wc * fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count /
-                                             (float)vp->paths);
+          const iris_vec3 c = iris_scale(bf, wc * fabsf(iris_dot(w, sp.si.ns)) * cos_z / d2 * (float)vpool->count /
+                                                 (float)vp->paths);
           /* with the sky, small ones against the pixel's estimate only
            * sometimes (weighted back): the rest of the pool number decides */
           float q = 1.0f;
-          if (vp->sky && pixel_estimate > 0.0f)
-            q = iris_fminf(1.0f, iris_avg3(c) / (IRIS_VCACHE_SKY_RR * pixel_estimate));
-          if (q >= 1.0f || vc_u - (float)(z - vpool->v) < q) {
+          if (rr) q = iris_fminf(1.0f, iris_avg3(c) / (IRIS_VCACHE_SKY_RR * pixel_estimate));
+          if (q >= 1.0f || u_rr < q) {
             iris_ray sh = iris_spawn_ray_to(sp.si.p, sp.si.ng, z->p, z->n);
             stats->shadow_rays++;
             if (!iris_accel_occluded(it->accel, &sh)) L_connect = iris_add(L_connect, iris_scale(c, 1.0f / q));
