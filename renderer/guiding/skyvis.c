@@ -26,9 +26,11 @@ static void drop_tables(iris_skyvis *sv) {
   free(sv->cdf);
   free(sv->sees);
   free(sv->cache_window);
+  free(sv->window_reach);
   sv->cdf = NULL;
   sv->sees = NULL;
   sv->cache_window = NULL;
+  sv->window_reach = NULL;
   sv->window_count = 0;
   sv->region_count = 0;
   sv->memory_bytes = 0;
@@ -169,6 +171,26 @@ static void extend_windows(void *ctx, uint64_t begin, uint64_t end, int thread_i
   }
 }
 
+/* With several windows, which ones each cache with a window reaches (the
+ * same probes as extend_windows: at least half get there), its own always. */
+static void reach_windows(void *ctx, uint64_t begin, uint64_t end, int thread_index) {
+  (void)thread_index;
+  const extend_ctx *c = ctx;
+  iris_skyvis *sv = c->sv;
+  for (uint64_t i = begin; i < end; ++i) {
+    if (sv->cache_window[i] == 0xff) continue;
+    uint16_t bits = (uint16_t)(1u << sv->cache_window[i]);
+    for (int j = 0; j < sv->window_count; ++j) {
+      if (j == sv->cache_window[i] || !iris_portal_present(&sv->window[j])) continue;
+      float reach;
+      iris_portal_share(c->accel, &sv->window[j], c->caches[i].p, c->caches[i].frame.n,
+                        iris_hash4(c->seed, WINDOW_STREAM, i, 1 + (uint64_t)j), no_density, NULL, &reach);
+      if (reach >= 0.5f) bits |= (uint16_t)(1u << j);
+    }
+    sv->window_reach[i] = bits;
+  }
+}
+
 iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, size_t cache_count, const iris_accel *accel,
                               const iris_envmap *env, const iris_skyvis_params *p, uint64_t seed, int threads,
                               iris_error *err) {
@@ -245,6 +267,11 @@ iris_status iris_skyvis_build(iris_skyvis *sv, const struct iris_cache *caches, 
     }
     for (size_t i = 0; i < cache_count; ++i) sv->window_caches += sv->cache_window[i] != 0xff;
     sv->memory_bytes += cache_count;
+    if (sv->window_count > 1 && (sv->window_reach = calloc(cache_count, sizeof *sv->window_reach)) != NULL) {
+      extend_ctx e = {sv, caches, accel, seed};
+      iris_parallel_for(cache_count, 16, nt, reach_windows, &e);
+      sv->memory_bytes += cache_count * sizeof *sv->window_reach;
+    }
   } else { /* no windows: the regions alone */
     free(sv->cache_window);
     sv->cache_window = NULL;
@@ -297,6 +324,43 @@ static inline const iris_portal *cache_window(const iris_skyvis *sv, uint32_t id
   return sv->cache_window && sv->cache_window[id] != 0xff ? &sv->window[sv->cache_window[id]] : NULL;
 }
 
+/* The windows cache `id` reaches (bit j: window j). */
+static inline uint32_t cache_reach(const iris_skyvis *sv, uint32_t id) {
+  return sv->window_reach ? sv->window_reach[id] : 0xffffu;
+}
+
+/* The probabilities at x of the windows a cache draws from, whose own window
+ * is `own` and which reaches `reach` (skyvis.h): its own with
+ * IRIS_SKYVIS_OWN_WINDOW, the rest among those it reaches by each one's solid
+ * angle from x, area |cos| / (d^2 + area) (finite at the window itself); all
+ * its own where it reaches no other or x sees none. */
+static void window_probabilities(const iris_skyvis *sv, const iris_portal *own, uint32_t reach, iris_vec3 x,
+                                 float *prob) {
+  const int n = sv->window_count, o = (int)(own - sv->window);
+  float tot = 0.0f;
+  for (int j = 0; j < n; ++j) {
+    const iris_portal *p = &sv->window[j];
+    const iris_vec3 nrm = iris_cross(p->u, p->v), d = iris_sub(x, p->o);
+    const float area = 4.0f * iris_length(nrm), d2 = iris_dot(d, d), dn = sqrtf(d2) * iris_length(nrm);
+    prob[j] = (reach >> j & 1u) && dn > 0.0f ? area * (fabsf(iris_dot(d, nrm)) / dn) / (d2 + area) : 0.0f;
+    tot += prob[j];
+  }
+  if (reach == (1u << o)) tot = 0.0f; /* its own alone */
+  const float a = tot > 0.0f && isfinite(tot) ? 1.0f - IRIS_SKYVIS_OWN_WINDOW : 0.0f;
+  for (int j = 0; j < n; ++j) prob[j] = (j == o ? 1.0f - a : 0.0f) + (a > 0.0f ? a * prob[j] / tot : 0.0f);
+}
+
+/* The density at x of the windows' draws for a cache whose own window is
+ * `own` and which reaches `reach`: sum_j P_j iris_portal_pdf(window j). */
+static float windows_pdf(const iris_skyvis *sv, const iris_portal *own, uint32_t reach, iris_vec3 x, iris_vec3 d) {
+  if (sv->window_count == 1) return iris_portal_pdf(own, x, d);
+  float prob[IRIS_SKYVIS_WINDOWS], pdf = 0.0f;
+  window_probabilities(sv, own, reach, x, prob);
+  for (int j = 0; j < sv->window_count; ++j)
+    if (prob[j] > 0.0f) pdf += prob[j] * iris_portal_pdf(&sv->window[j], x, d);
+  return pdf;
+}
+
 float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uint32_t *ids, int m, iris_vec3 x,
                         iris_vec3 d, float s, float t, float *window) {
   *window = 0.0f;
@@ -310,6 +374,7 @@ float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uin
   const int region = iris_envmap_region_of(env, &sv->regions, s, t);
   float sum = 0.0f, through = 0.0f, last_pdf = 0.0f;
   const iris_portal *last = NULL;
+  uint32_t last_reach = 0;
   for (int i = 0; i < m; ++i) {
     if (sv->sees[ids[i]] != IRIS_SKYVIS_PART) {
       sum += 1.0f;
@@ -320,7 +385,9 @@ float iris_skyvis_scale(const iris_skyvis *sv, const iris_envmap *env, const uin
     const iris_portal *w = cache_window(sv, ids[i]);
     if (w) {
       sum += (1.0f - IRIS_SKYVIS_WINDOW_SHARE) * own;
-      if (w != last) last = w, last_pdf = iris_portal_pdf(w, x, d); /* tied caches mostly share one */
+      const uint32_t reach = cache_reach(sv, ids[i]);
+      if (w != last || reach != last_reach) /* tied caches mostly share them */
+        last = w, last_reach = reach, last_pdf = windows_pdf(sv, w, reach, x, d);
       through += IRIS_SKYVIS_WINDOW_SHARE * last_pdf;
     } else {
       sum += own;
@@ -376,8 +443,22 @@ bool iris_skyvis_sample(const iris_skyvis *sv, const iris_envmap *env, const uin
   const uint32_t id = ids[j];
   float pdf_map;
   const iris_portal *w = cache_window(sv, id);
-  if (w && ub < IRIS_SKYVIS_WINDOW_SHARE) { /* a point on its window (u0 across, the rest of u1 along) */
-    *d = iris_portal_sample(w, x, u0, iris_rescale_unit(ub, 0.0f, IRIS_SKYVIS_WINDOW_SHARE));
+  if (w && ub < IRIS_SKYVIS_WINDOW_SHARE) { /* a point on a window (u0 across, the rest of u1 along) */
+    float uw = iris_rescale_unit(ub, 0.0f, IRIS_SKYVIS_WINDOW_SHARE);
+    if (sv->window_count > 1) { /* which window: from uw too, the rest of it along */
+      float prob[IRIS_SKYVIS_WINDOWS], lo = 0.0f, at = 0.0f;
+      window_probabilities(sv, w, cache_reach(sv, id), x, prob);
+      int wj = (int)(w - sv->window); /* its own has a probability: the last resort if rounding runs past */
+      for (int k = 0; k < sv->window_count; ++k) {
+        if (!(prob[k] > 0.0f)) continue;
+        wj = k, lo = at;
+        if (uw < at + prob[k]) break;
+        at += prob[k];
+      }
+      uw = iris_rescale_unit(uw, lo, lo + prob[wj]);
+      w = &sv->window[wj];
+    }
+    *d = iris_portal_sample(w, x, u0, uw);
     if (!(iris_portal_pdf(w, x, *d) > 0.0f)) return false; /* x lies in its plane */
     iris_envmap_dir_to_st(env, *d, s, t);
     pdf_map = iris_envmap_pdf_st(env, *s, *t);

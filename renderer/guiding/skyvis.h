@@ -19,9 +19,14 @@
  * sees it through (portal.h, into the cone of its escaping probes); the
  * caches' rectangles are joined into wholes, and a cache that has one (its
  * own, or the one it reaches best through) draws, with probability
- * IRIS_SKYVIS_WINDOW_SHARE, a point uniform on it (its other branches keep
- * the rest): the sky through a window that is smaller than a region, seen
- * from afar, which the regions' directions mostly miss. A vertex that no
+ * IRIS_SKYVIS_WINDOW_SHARE, a point uniform on a window (its other branches
+ * keep the rest): the sky through a window that is smaller than a region,
+ * seen from afar, which the regions' directions mostly miss. With several
+ * windows the window is its own with probability IRIS_SKYVIS_OWN_WINDOW,
+ * else any the cache reaches (half of its probes to points on it get
+ * there) by its solid angle from the vertex (area |cos| / (d^2 + area)): a
+ * vertex also sees windows its cache does not draw from (the back wall of a
+ * corner room sees the side window at a grazing angle). A vertex that no
  * cache covers (walls the camera does not see, where few photons land) draws
  * from the windows as a whole with that probability, else from the map. The
  * windows' density, distance^2 / (area |cos|) through a rectangle, adds to
@@ -52,6 +57,9 @@ enum { IRIS_SKYVIS_NONE = 0, IRIS_SKYVIS_PART = 1, IRIS_SKYVIS_OPEN = 2 };
  * "Sky visibility": measured on sky-room), and at most this many windows. */
 #define IRIS_SKYVIS_WINDOW_SHARE 0.25f
 #define IRIS_SKYVIS_WINDOWS 16
+/* With several windows, the probability of the cache's own among them
+ * (docs/guiding.md, "Sky visibility": measured on sky-room-corner). */
+#define IRIS_SKYVIS_OWN_WINDOW 0.5f
 
 /* Built from one map, used with it: the guide keeps no pointer to the map
  * (the lights own it and may be built again around a guide that is kept);
@@ -74,6 +82,9 @@ typedef struct iris_skyvis {
   iris_portal window[IRIS_SKYVIS_WINDOWS]; /* the openings the sky is seen through (joined) */
   int window_count;
   uint8_t *cache_window;        /* per cache: its window, 0xff none (only "part" caches have one) */
+  uint16_t *window_reach;       /* with several windows, per cache with one: bit j where at least half
+                                   of its probes to points on window j get there (its own always);
+                                   NULL: every window */
   size_t window_caches;         /* caches with a window */
   double seconds;
   size_t memory_bytes;

@@ -169,10 +169,12 @@ static void test_regions_and_mixture(const char *path) {
   }
   /* Windows: cache 0 draws from a window 2 m away (a 1 x 0.6 m rectangle,
    * seen obliquely), cache 2 from one the vertex sees edge-on from its plane
-   * (no direction: its draws are lost, its density 0), cache 1 from none; the
-   * vertex at the origin and, for the second case, behind the first window
-   * (its back: directions through it still count, as a ray crosses it either
-   * way). */
+   * (no direction: its draws there are lost, its density 0), cache 1 from
+   * none; each also from the other window by solid angle (skyvis.h), which
+   * from the origin gives the edge-on window nothing; the vertex at the
+   * origin and, for the second case, behind the first window (its back:
+   * directions through it still count, as a ray crosses it either way),
+   * where both windows have a solid angle and each cache draws from both. */
   sv.cache_window = malloc(3);
   sv.window_count = 2;
   sv.window[0] = (iris_portal){{0.3f, 0.4f, 2.0f}, {0.5f, 0.0f, 0.1f}, {0.0f, 0.3f, 0.0f}};
@@ -185,9 +187,9 @@ static void test_regions_and_mixture(const char *path) {
     mix_ctx mc = {&sv, &env, ids_a, 4, xs[k]};
     chi2_result r = chi2_run(&wdom, mix_sample, mix_pdf, &mc, 200000, 0.01, N_TESTS);
     iris_check_record(r.passed, __FILE__, __LINE__, "mixture with windows, vertex %d: %s", k, r.message);
-    /* cache 2's window draws nothing from the origin, in its plane: that
-     * share is lost, and the density integrates to 1 less it */
-    const double lost_share = k == 0 ? 0.25 * IRIS_SKYVIS_WINDOW_SHARE : 0.0;
+    /* cache 2's own window draws nothing from the origin, in its plane:
+     * that share is lost, and the density integrates to 1 less it */
+    const double lost_share = k == 0 ? 0.25 * IRIS_SKYVIS_WINDOW_SHARE * IRIS_SKYVIS_OWN_WINDOW : 0.0;
     CHECK_NEAR(r.pdf_integral, 1.0 - lost_share, 3e-3);
     printf("mixture with windows (vertex %d) over %d caches: p = %.3g, pdf integral %.5f, lost %zu\n", k, mc.m, r.p_value,
            r.pdf_integral, r.lost);
@@ -327,6 +329,49 @@ static void test_built_from_scene(void) {
   iris_scene_destroy(s);
 }
 
+/* Two windows (sky-room-corner: the +x wall's and the +z wall's): the
+ * caches with a window also know which others they reach, the same for 1
+ * and 2 threads; every one reaches its own, and the back wall's (x = -2,
+ * facing +x), whose own is the +x window, reach the +z one too, which they
+ * see at a grazing angle. */
+static void test_window_reach(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("sky-room-corner", &s, &err) == IRIS_OK)) return;
+  iris_guiding *g[2] = {NULL, NULL};
+  for (int t = 0; t < 2; t++) {
+    iris_guiding_params gp = iris_guiding_params_default();
+    gp.train_spp = 0;
+    g[t] = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
+  }
+  if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built) && CHECK(g[0]->sky.window_count == 2) &&
+      CHECK(g[0]->sky.window_reach && g[1]->sky.window_reach)) {
+    const iris_skyvis *a = &g[0]->sky;
+    CHECK(memcmp(a->window_reach, g[1]->sky.window_reach, sizeof *a->window_reach * a->cache_count) == 0);
+    size_t own = 0, with = 0, both = 0, back = 0, back_both = 0;
+    const int xw = fabsf(a->window[0].o.x - 2.0f) < 0.01f ? 0 : 1; /* the +x wall's */
+    for (size_t i = 0; i < a->cache_count; i++) {
+      if (a->cache_window[i] == 0xff) {
+        CHECK(a->window_reach[i] == 0);
+        continue;
+      }
+      with++;
+      own += (a->window_reach[i] >> a->cache_window[i]) & 1u;
+      both += a->window_reach[i] == 3u;
+      const iris_cache *c = &g[0]->caches[i];
+      if (c->p.x < -1.99f && c->frame.n.x > 0.99f && a->cache_window[i] == xw)
+        back++, back_both += a->window_reach[i] == 3u;
+    }
+    printf("sky-room-corner: %zu caches with a window, %zu reach both; on the back wall %zu of %zu\n", with, both,
+           back_both, back);
+    CHECK(own == with);
+    CHECK(back > 0 && back_both * 10 >= back * 8);
+  }
+  iris_guiding_destroy(g[0]);
+  iris_guiding_destroy(g[1]);
+  iris_scene_destroy(s);
+}
+
 int main(void) {
   char dir[1024], path[1100];
   if (iris_test_tmpdir(dir, sizeof dir, "skyvis") != 0) return TEST_SKIP("no temporary folder");
@@ -334,5 +379,6 @@ int main(void) {
   iris_test_write_sun_map(path, 61, 29, 0.2f, 2, 300.0f);
   test_regions_and_mixture(path);
   test_built_from_scene();
+  test_window_reach();
   return iris_check_summary("guiding.skyvis");
 }
