@@ -337,15 +337,16 @@ static inline uint32_t cache_reach(const iris_skyvis *sv, uint32_t id) {
 static void window_probabilities(const iris_skyvis *sv, const iris_portal *own, uint32_t reach, iris_vec3 x,
                                  float *prob) {
   const int n = sv->window_count, o = (int)(own - sv->window);
+  for (int j = 0; j < n; ++j) prob[j] = j == o ? 1.0f : 0.0f;
+  if (reach == (1u << o)) return; /* its own alone */
   float tot = 0.0f;
   for (int j = 0; j < n; ++j) {
     const iris_portal *p = &sv->window[j];
     const iris_vec3 nrm = iris_cross(p->u, p->v), d = iris_sub(x, p->o);
-    const float area = 4.0f * iris_length(nrm), d2 = iris_dot(d, d), dn = sqrtf(d2) * iris_length(nrm);
+    const float len = iris_length(nrm), area = 4.0f * len, d2 = iris_dot(d, d), dn = sqrtf(d2) * len;
     prob[j] = (reach >> j & 1u) && dn > 0.0f ? area * (fabsf(iris_dot(d, nrm)) / dn) / (d2 + area) : 0.0f;
     tot += prob[j];
   }
-  if (reach == (1u << o)) tot = 0.0f; /* its own alone */
   const float a = tot > 0.0f && isfinite(tot) ? 1.0f - IRIS_SKYVIS_OWN_WINDOW : 0.0f;
   for (int j = 0; j < n; ++j) prob[j] = (j == o ? 1.0f - a : 0.0f) + (a > 0.0f ? a * prob[j] / tot : 0.0f);
 }

@@ -209,16 +209,21 @@ static void test_regions_and_mixture(const char *path) {
   iris_envmap_destroy(&env);
 }
 
-static void test_built_from_scene(void) {
-  iris_scene *s = NULL;
-  iris_error err;
-  if (!CHECK(iris_builtin_create("sky-room", &s, &err) == IRIS_OK)) return;
-  iris_guiding *g[2] = {NULL, NULL};
+/* The guide of s without training, built with 1 and with 2 threads. */
+static void build_1_and_2_threads(const iris_scene *s, iris_guiding *g[2]) {
   for (int t = 0; t < 2; t++) {
     iris_guiding_params gp = iris_guiding_params_default();
     gp.train_spp = 0;
     g[t] = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
   }
+}
+
+static void test_built_from_scene(void) {
+  iris_scene *s = NULL;
+  iris_error err;
+  if (!CHECK(iris_builtin_create("sky-room", &s, &err) == IRIS_OK)) return;
+  iris_guiding *g[2];
+  build_1_and_2_threads(s, g);
   if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built)) {
     const iris_skyvis *a = &g[0]->sky, *b = &g[1]->sky;
     printf("sky-room: %zu caches, %llu probes, %.1f%% escaped, %.3f s\n", a->cache_count,
@@ -338,12 +343,8 @@ static void test_window_reach(void) {
   iris_scene *s = NULL;
   iris_error err;
   if (!CHECK(iris_builtin_create("sky-room-corner", &s, &err) == IRIS_OK)) return;
-  iris_guiding *g[2] = {NULL, NULL};
-  for (int t = 0; t < 2; t++) {
-    iris_guiding_params gp = iris_guiding_params_default();
-    gp.train_spp = 0;
-    g[t] = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
-  }
+  iris_guiding *g[2];
+  build_1_and_2_threads(s, g);
   if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built) && CHECK(g[0]->sky.window_count == 2) &&
       CHECK(g[0]->sky.window_reach && g[1]->sky.window_reach)) {
     const iris_skyvis *a = &g[0]->sky;
