@@ -381,5 +381,6 @@ int main(void) {
   test_regions_and_mixture(path);
   test_built_from_scene();
   test_window_reach();
+  iris_test_rmtree(dir);
   return iris_check_summary("guiding.skyvis");
 }

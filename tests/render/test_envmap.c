@@ -377,5 +377,6 @@ int main(void) {
   test_furnace(uniform);
   test_determinism(patterned);
   test_odd_sizes();
+  iris_test_rmtree(g_dir);
   return TEST_SUMMARY();
 }
