@@ -1,4 +1,4 @@
-# Sourced by the prototype benchmarks (connect_ab.sh, last_vertices_split.sh,
+# Sourced by the prototype benchmarks (connect_ab.sh, last_vertices_split.sh, path_split.sh,
 # light_trace_ab.sh, sky_connect_ab.sh, variance_aware_ab.sh,
 # vertex_cache_ab.sh): scratch_build PATCH builds a throw-away copy of HEAD
 # (or of SCRATCH_BASE, the commit a patch was made against) with
