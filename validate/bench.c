@@ -269,6 +269,7 @@ static void fill_metrics(const iris_image *img, const iris_image *ref, iris_benc
   iris_metric_channel_means(ref, 0, rm);
   row->energy_ratio = iris_metric_energy_ratio(tm, rm);
   row->relmse = iris_metric_relmse(img, 0, ref, 0, IRIS_METRIC_EPS, IRIS_METRIC_DROP);
+  row->relmse_full = iris_metric_relmse(img, 0, ref, 0, IRIS_METRIC_EPS, 0.0);
   row->mape = iris_metric_mape(img, 0, ref, 0, IRIS_METRIC_EPS, IRIS_METRIC_DROP);
   uint64_t nans = 0, infs = 0;
   iris_metric_count_nonfinite(img, 0, 3, &nans, &infs);

@@ -116,6 +116,7 @@ typedef struct iris_bench_row {
   double setup_seconds;  /* of which setup (accel, lights, guide); Cycles: scene build */
   int spp;
   double relmse, mape, energy_ratio;
+  double relmse_full;    /* relMSE over every pixel: what relmse's dropped 0.1% (fireflies) adds */
   uint64_t nonfinite;    /* NaN/Inf pixel values in the image */
 } iris_bench_row;
 
@@ -158,7 +159,8 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
                            iris_error *err);
 void iris_bench_result_destroy(iris_bench_result *result);
 
-/* DIR/results.csv: header scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved. */
+/* DIR/results.csv: header scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,
+ * relmse_net,relmse_full. */
 iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res, iris_error *err);
 /* DIR/results.json: machine, parameters, scenes (reference, images), rows, tables and charts. */
 iris_status iris_bench_write_json(const char *path, const iris_bench_params *params,

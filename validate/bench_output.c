@@ -37,7 +37,7 @@ iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res,
   iris_atomic_file f;
   iris_status st = iris_atomic_open(&f, path, err);
   if (st != IRIS_OK) return st;
-  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net\n");
+  fprintf(f.fp, "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net,relmse_full\n");
   for (size_t i = 0; i < res->row_count; i++) {
     const iris_bench_row *r = &res->rows[i];
     fprintf(f.fp, "%s,%s,%llu,%g,%.4f,%d,%.6g,%.6g,%.6g,%s,", r->scene, r->method,
@@ -45,7 +45,7 @@ iris_status iris_bench_write_csv(const char *path, const iris_bench_result *res,
             r->energy_ratio, r->resolved[0] ? r->resolved : r->method);
     const double net = relmse_net(res, r);
     if (isfinite(net)) fprintf(f.fp, "%.6g", net); /* empty where the reference's own is unknown */
-    fputc('\n', f.fp);
+    fprintf(f.fp, ",%.6g\n", r->relmse_full);
   }
   if (ferror(f.fp)) {
     iris_atomic_abort(&f);
@@ -148,6 +148,7 @@ iris_status iris_bench_write_json(const char *path, const iris_bench_params *p,
     cJSON_AddNumberToObject(j, "spp", r->spp);
     iris_json_add_number(j, "relmse", r->relmse);
     iris_json_add_number(j, "relmse_net", relmse_net(res, r));
+    iris_json_add_number(j, "relmse_full", r->relmse_full);
     iris_json_add_number(j, "mape", r->mape);
     iris_json_add_number(j, "energy_ratio", r->energy_ratio);
     cJSON_AddNumberToObject(j, "nonfinite", (double)r->nonfinite);

@@ -60,7 +60,7 @@ def main(argv):
     # results.csv
     with open(os.path.join(out, "results.csv"), newline="") as f:
         lines = f.read().splitlines()
-    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net",
+    check(lines[0] == "scene,method,seed,budget_s,seconds,spp,relmse,mape,energy_ratio,resolved,relmse_net,relmse_full",
           "CSV header: " + lines[0])
     rows = list(csv.DictReader(lines))
     check(len(rows) == 4, f"4 rows (2 methods x 2 budgets x 1 seed), got {len(rows)}")
@@ -100,6 +100,12 @@ def main(argv):
     for jr, cr in zip(js["rows"], rows):
         check(jr["method"] == cr["method"] and abs(jr["relmse"] - float(cr["relmse"])) <=
               1e-5 * jr["relmse"], f"JSON row {jr} vs CSV {cr}")
+        # over every pixel: above the mean without the worst 0.1% (here 1 of 1024 pixels),
+        # the same in the CSV and the JSON
+        full = float(cr["relmse_full"])
+        check(full > float(cr["relmse"]), f"relmse_full {full} above relmse {cr['relmse']} (the dropped pixel)")
+        check(isinstance(jr.get("relmse_full"), float) and abs(jr["relmse_full"] - full) <= 1e-5 * full,
+              f"JSON relmse_full {jr.get('relmse_full')} vs CSV {full}")
     sc = js["scenes"][0]
     check(sc["name"] == "cornell-box" and sc["height"] == 32 and sc["width"] == 32,
           f"scene size from --height and the aspect: {sc}")
