@@ -12,7 +12,9 @@
 # against the reference less its mean over the seeds (what the image's error
 # would be if that light were free of noise), and alone against its own mean.
 # With the guided methods training learns from the same split light, so their
-# guide differs a little. The whole image's line comes with PAT "-".
+# guide differs a little; the light of the connections (--connect: the door,
+# the sky rooms) is not split, it stays in every render. The whole image's
+# line comes with PAT "-".
 # REF: a reference of the same size, e.g.
 #   iris render env-spheres --method mis --sampler independent --spp 32768 \
 #     --width 108 --height 72 --seed 999 --variance -o REF.exr
