@@ -12,9 +12,10 @@
 # against the reference less its mean over the seeds (what the image's error
 # would be if that light were free of noise), and alone against its own mean.
 # With the guided methods training learns from the same split light, so their
-# guide differs a little; the light of the connections (--connect: the door,
-# the sky rooms) is not split, it stays in every render. The whole image's
-# line comes with PAT "-".
+# guide differs a little. The renders run with --connect off: the connections'
+# light (the door, the sky rooms) carries no letters, and left in every
+# render it would be counted twice against the reference less the part
+# alone. The whole image's line comes with PAT "-".
 # REF: a reference of the same size, e.g.
 #   iris render env-spheres --method mis --sampler independent --spp 32768 \
 #     --width 108 --height 72 --seed 999 --variance -o REF.exr
@@ -34,7 +35,7 @@ scratch_build path_split.patch
 render() { # PAT MODE TAG
   s=1
   while [ "$s" -le "$SEEDS" ]; do
-    IRIS_CAT=$1 IRIS_CAT_MODE=$2 "$SCRATCH/build/tools/iris" render "$SCENE" --method "$M" --force-guiding \
+    IRIS_CAT=$1 IRIS_CAT_MODE=$2 "$SCRATCH/build/tools/iris" render "$SCENE" --method "$M" --force-guiding --connect off \
       --spp "$SPP" --width 108 --height 72 --seed "$s" --threads 2 --quiet -o "$W/$3_$s.exr"
     s=$((s + 1))
   done
