@@ -209,22 +209,33 @@ static void test_regions_and_mixture(const char *path) {
   iris_envmap_destroy(&env);
 }
 
-/* The guide of s without training, built with 1 and with 2 threads. */
-static void build_1_and_2_threads(const iris_scene *s, iris_guiding *g[2]) {
+/* The built-in scene `name` and its guide without training, built with 1
+ * and with 2 threads; true when both have sky visibility (*s and g[] are
+ * set either way: free them with close_scene). */
+static bool open_scene(const char *name, iris_scene **s, iris_guiding *g[2]) {
+  iris_error err;
+  g[0] = g[1] = NULL;
+  *s = NULL;
+  if (!CHECK(iris_builtin_create(name, s, &err) == IRIS_OK)) return false;
   for (int t = 0; t < 2; t++) {
     iris_guiding_params gp = iris_guiding_params_default();
     gp.train_spp = 0;
-    g[t] = test_guide_build(s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
+    g[t] = test_guide_build(*s, IRIS_METHOD_GUIDED_NEE, gp, 3, t + 1, 16);
   }
+  return CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built);
+}
+
+static void close_scene(iris_scene *s, iris_guiding *g[2]) {
+  iris_guiding_destroy(g[0]);
+  iris_guiding_destroy(g[1]);
+  iris_scene_destroy(s);
 }
 
 static void test_built_from_scene(void) {
-  iris_scene *s = NULL;
+  iris_scene *s;
   iris_error err;
-  if (!CHECK(iris_builtin_create("sky-room", &s, &err) == IRIS_OK)) return;
   iris_guiding *g[2];
-  build_1_and_2_threads(s, g);
-  if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built)) {
+  if (open_scene("sky-room", &s, g)) {
     const iris_skyvis *a = &g[0]->sky, *b = &g[1]->sky;
     printf("sky-room: %zu caches, %llu probes, %.1f%% escaped, %.3f s\n", a->cache_count,
            (unsigned long long)a->probes, 100.0 * (double)a->escaped / (double)a->probes, a->seconds);
@@ -311,9 +322,7 @@ static void test_built_from_scene(void) {
     CHECK(memcmp(a->sees, b->sees, a->cache_count) == 0);
     CHECK(memcmp(a->cdf, b->cdf, sizeof(float) * a->cache_count * (size_t)a->region_count) == 0);
   }
-  iris_guiding_destroy(g[0]);
-  iris_guiding_destroy(g[1]);
-  iris_scene_destroy(s);
+  close_scene(s, g);
   /* Under the open sky nearly every cache sees most of it: the map's own
    * sampling is kept (probed, not built). */
   s = NULL;
@@ -340,12 +349,9 @@ static void test_built_from_scene(void) {
  * facing +x), whose own is the +x window, reach the +z one too, which they
  * see at a grazing angle. */
 static void test_window_reach(void) {
-  iris_scene *s = NULL;
-  iris_error err;
-  if (!CHECK(iris_builtin_create("sky-room-corner", &s, &err) == IRIS_OK)) return;
+  iris_scene *s;
   iris_guiding *g[2];
-  build_1_and_2_threads(s, g);
-  if (CHECK(g[0] && g[1]) && CHECK(g[0]->sky.built && g[1]->sky.built) && CHECK(g[0]->sky.window_count == 2) &&
+  if (open_scene("sky-room-corner", &s, g) && CHECK(g[0]->sky.window_count == 2) &&
       CHECK(g[0]->sky.window_reach && g[1]->sky.window_reach)) {
     const iris_skyvis *a = &g[0]->sky;
     CHECK(memcmp(a->window_reach, g[1]->sky.window_reach, sizeof *a->window_reach * a->cache_count) == 0);
@@ -368,9 +374,7 @@ static void test_window_reach(void) {
     CHECK(own == with);
     CHECK(back > 0 && back_both * 10 >= back * 8);
   }
-  iris_guiding_destroy(g[0]);
-  iris_guiding_destroy(g[1]);
-  iris_scene_destroy(s);
+  close_scene(s, g);
 }
 
 int main(void) {
