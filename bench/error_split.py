@@ -16,10 +16,10 @@ import tempfile
 import numpy as np
 
 
-def read_exr(path, tmp):
-    """R, G, B of an EXR as float64 (through oiiotool's FITS writer), row 0 at the top."""
+def read_exr(path, tmp, channels="R,G,B"):
+    """Channels (default R, G, B) of an EXR as float64 (through oiiotool's FITS writer), row 0 at the top."""
     out = os.path.join(tmp, "x.fits")
-    subprocess.run(["oiiotool", path, "-ch", "R,G,B", "-d", "float", "-o", out], check=True)
+    subprocess.run(["oiiotool", path, "-ch", channels, "-d", "float", "-o", out], check=True)
     data = open(out, "rb").read()
     head, i, dims = {}, 0, []
     while data[i:i + 8] != b"END     ":
