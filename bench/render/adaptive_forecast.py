@@ -81,8 +81,11 @@ def main():
             if os.path.exists(scene):
                 scene = os.path.abspath(scene)
             pa, pb = os.path.join(tmp, "a.exr"), os.path.join(tmp, "b.exr")
-            render(iris, scene, method, SPP_A, seeds[0], pa)
-            render(iris, scene, method, SPP_B, seeds[1], pb)
+            try:
+                render(iris, scene, method, SPP_A, seeds[0], pa)
+                render(iris, scene, method, SPP_B, seeds[1], pb)
+            except (subprocess.CalledProcessError, OSError) as e:
+                sys.exit(f"adaptive_forecast.py: rendering {spec} failed ({e})")
             a, b = read_exr(pa, tmp), read_exr(pb, tmp)
             va, vb = read_exr(pa, tmp, "var.R,var.G,var.B"), read_exr(pb, tmp, "var.R,var.G,var.B")
             cv, cv_drop, pooled, unpooled = forecasts(a, va, b, vb)
