@@ -15,6 +15,11 @@ import tempfile
 
 import numpy as np
 
+# bench's relMSE (validate/metrics.h): per pixel (t - r)^2 / (r^2 + EPS), the
+# DROP share of the pixels with the largest error left out.
+EPS = 0.01
+DROP = 0.001
+
 
 def read_exr(path, tmp, channels="R,G,B"):
     """Channels (default R, G, B) of an EXR as float64 (through oiiotool's FITS writer), row 0 at the top."""
@@ -37,11 +42,11 @@ def main():
     bands = [a for a in sys.argv[1:] if a.startswith("--rows")]
     with tempfile.TemporaryDirectory() as tmp:
         ref = read_exr(args[0], tmp)
-        err = np.mean([((read_exr(p, tmp) - ref) ** 2 / (ref ** 2 + 0.01)).mean(axis=2) for p in args[1:]],
+        err = np.mean([((read_exr(p, tmp) - ref) ** 2 / (ref ** 2 + EPS)).mean(axis=2) for p in args[1:]],
                       axis=0)
     h = err.shape[0]
     flat = np.sort(err.ravel())[::-1]
-    drop = int(len(flat) * 0.001)
+    drop = int(len(flat) * DROP)
     kept = flat[drop:]
     total = kept.sum()
     print("relMSE (top 0.1%% dropped) %.5f over %d image(s)" % (kept.mean(), len(args) - 1))

@@ -15,7 +15,7 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from error_split import read_exr  # noqa: E402
+from error_split import DROP, EPS, read_exr  # noqa: E402
 
 ap = argparse.ArgumentParser()
 ap.add_argument("ref")
@@ -32,8 +32,8 @@ with tempfile.TemporaryDirectory() as t:
         label, _, files = g.partition("=")
         rows = []
         for f in files.split(","):
-            e = ((read_exr(f, t) - ref) ** 2 / (ref ** 2 + 0.01)).mean(axis=-1)
-            keep = e <= np.quantile(e, 0.999)
+            e = ((read_exr(f, t) - ref) ** 2 / (ref ** 2 + EPS)).mean(axis=-1)
+            keep = e <= np.quantile(e, 1.0 - DROP)
             rows.append((e[keep].mean(), e[keep & bright].mean(), e[keep & ~bright].mean()))
         m = np.mean(rows, axis=0)
         print(f"| {label} ({len(rows)}) | {m[0]:.5f} | {m[1]:.5f} | {m[2]:.5f} |")

@@ -24,9 +24,8 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from error_split import read_exr  # noqa: E402
+from error_split import DROP, EPS, read_exr  # noqa: E402
 
-DROP = 0.001
 
 
 def kept_mean(err):
@@ -39,7 +38,7 @@ def main():
         sys.exit(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         ref = read_exr(sys.argv[1], tmp)
-        den = ref ** 2 + 0.01
+        den = ref ** 2 + EPS
         for arg in sys.argv[2:]:
             pattern, _, minus = arg.partition(":")
             files = sorted(glob.glob(pattern))

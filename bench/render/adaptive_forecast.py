@@ -30,10 +30,9 @@ import tempfile
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from error_split import read_exr  # noqa: E402
+from error_split import DROP, EPS, read_exr  # noqa: E402
 
 SPP_A, SPP_B = 8, 16
-DROP = 0.001
 
 
 def pool(x):
@@ -49,15 +48,18 @@ def render(iris, scene, method, spp, seed, out):
 
 def forecasts(a, va, b, vb):
     m = pool((SPP_A * a + SPP_B * b).mean(axis=2) / (SPP_A + SPP_B))
-    den = m ** 2 + 0.01
+    den = m ** 2 + EPS
     ra, rb = va.mean(axis=2) / den, vb.mean(axis=2) / den  # relative variance of each mean
     w = np.sqrt(pool(ra))
     w = np.maximum(w, 1e-3 * w.mean())  # no pixel without samples (the rule's floor is its scouts)
-    cv = rb.mean() / ((rb / w).mean() * w.mean())
+
+    def judged(keep):  # samples spread over every pixel by w, the error counted where keep
+        return rb[keep].mean() / ((rb[keep] / w[keep]).mean() * w.mean())
+
     k = max(1, int(rb.size * DROP))
-    keep = rb < np.sort(rb.ravel())[-k]
-    cv_drop = rb[keep].mean() / ((rb[keep] / w[keep]).mean() * w.mean())
-    pooled = pool(rb).mean() / np.sqrt(pool(rb)).mean() ** 2
+    cv, cv_drop = judged(np.ones_like(rb, bool)), judged(rb < np.sort(rb.ravel())[-k])
+    prb = pool(rb)
+    pooled = prb.mean() / np.sqrt(prb).mean() ** 2
     unpooled = rb.mean() / np.sqrt(rb).mean() ** 2
     return cv, cv_drop, pooled, unpooled
 
@@ -86,9 +88,9 @@ def main():
                 render(iris, scene, method, SPP_B, seeds[1], pb)
             except (subprocess.CalledProcessError, OSError) as e:
                 sys.exit(f"adaptive_forecast.py: rendering {spec} failed ({e})")
-            a, b = read_exr(pa, tmp), read_exr(pb, tmp)
-            va, vb = read_exr(pa, tmp, "var.R,var.G,var.B"), read_exr(pb, tmp, "var.R,var.G,var.B")
-            cv, cv_drop, pooled, unpooled = forecasts(a, va, b, vb)
+            channels = "R,G,B,var.R,var.G,var.B"  # one read of each image
+            a, b = read_exr(pa, tmp, channels), read_exr(pb, tmp, channels)
+            cv, cv_drop, pooled, unpooled = forecasts(a[..., :3], a[..., 3:], b[..., :3], b[..., 3:])
             name = os.path.basename(scene)
             print(f"| {name} | {method} | {cv:.2f} | {cv_drop:.2f} | {pooled:.2f} | {unpooled:.2f} |", flush=True)
 
