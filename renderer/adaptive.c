@@ -26,6 +26,11 @@
 #define SCOUT_SALT 0x5c0a75ULL
 /* The first rounds: at least this many paths each, so that threads keep busy. */
 #define ROUND_PATHS (1u << 17)
+/* Deciding from the neighbours: the frame's pixels get ranks 0..RANKS-1 on a
+ * 3x3 lattice, and a pixel's count comes from the image samples of the
+ * pixels of higher rank within RANK_REACH of it (renderer/adaptive.h). */
+#define RANKS 9
+#define RANK_REACH 2
 
 static const char *const RULE_NAMES[IRIS_ADAPTIVE_RULE_COUNT] = {"off", "freeze", "relmse"};
 
@@ -156,12 +161,32 @@ typedef struct state {
   double *target;   /* per image pixel: this round's target count */
   uint32_t train;   /* training samples every film pixel held at the start */
   int min_spp;
+  bool neighbours;  /* decide from higher-ranked pixels' image samples, no scouts */
+  uint32_t *order;  /* deciding from the neighbours: image pixels by rank, */
+  size_t rank_start[RANKS + 1]; /* rank r at order[rank_start[r] .. rank_start[r + 1]) */
 } state;
 
-/* The statistics the decisions are made from: the scouts' (or, for the
- * biased test variant, the image's own samples). */
+/* Rank of full-frame pixel (x, y): its place on a 3x3 lattice. */
+static int rank_of(int x, int y) { return x % 3 + 3 * (y % 3); }
+
+/* The statistics the decisions are made from at scout-window pixel (hx, hy):
+ * the scouts', or the image's (deciding from the neighbours; pixels of the
+ * halo outside the window have none, n = 0), or, for the biased test variant,
+ * the image's own samples. */
 static void decision_stats(const state *s, int hx, int hy, double mean[3], double var[3], double *n) {
   const iris_adaptive_job *j = s->job;
+  if (s->neighbours) {
+    int x = hx + s->hx0 - j->x0, y = hy + s->hy0 - j->y0;
+    if (x < 0 || y < 0 || x >= s->W || y >= s->H) {
+      for (int c = 0; c < 3; c++) mean[c] = var[c] = 0.0;
+      *n = 0.0;
+      return;
+    }
+    size_t i = (size_t)y * (size_t)s->W + (size_t)x;
+    pixel_stats(j->film, i, mean, var);
+    *n = j->film->count[i];
+    return;
+  }
   if (j->params.decide_on_image) {
     int x = hx + s->hx0 - j->x0, y = hy + s->hy0 - j->y0;
     if (x < 0) x = 0;
@@ -204,16 +229,25 @@ static void per_pixel_needs(state *s) {
     }
 }
 
-/* A scout-pixel field over the 3x3 neighbourhood (inside the scout window)
- * of image pixel (x, y): its maximum, or its root mean square (`rms`). */
+/* A scout-pixel field pooled around image pixel (x, y): its maximum, or its
+ * root mean square (`rms`), over the 3x3 neighbourhood inside the scout
+ * window. Deciding from the neighbours: over the image pixels of higher rank
+ * within RANK_REACH inside the window (never the pixel itself, nor a pixel
+ * whose count depends on its samples); -1 where there are none (the top
+ * rank, or a tiny window). */
 static double pool3(const state *s, const double *f, int x, int y, bool rms) {
   int hx = x + s->job->x0 - s->hx0, hy = y + s->job->y0 - s->hy0;
+  const int reach = s->neighbours ? RANK_REACH : 1;
+  const int rank = rank_of(x + s->job->x0, y + s->job->y0);
   double m = 0.0;
   int k = 0;
-  for (int dy = -1; dy <= 1; dy++)
-    for (int dx = -1; dx <= 1; dx++) {
+  for (int dy = -reach; dy <= reach; dy++)
+    for (int dx = -reach; dx <= reach; dx++) {
       int qx = hx + dx, qy = hy + dy;
       if (qx < 0 || qy < 0 || qx >= s->HW || qy >= s->HH) continue;
+      if (s->neighbours && (x + dx < 0 || y + dy < 0 || x + dx >= s->W || y + dy >= s->H ||
+                            rank_of(x + dx + s->job->x0, y + dy + s->job->y0) <= rank))
+        continue;
       double v = f[(size_t)qy * (size_t)s->HW + (size_t)qx];
       if (rms)
         m += v * v;
@@ -221,16 +255,20 @@ static double pool3(const state *s, const double *f, int x, int y, bool rms) {
         m = v;
       k++;
     }
+  if (s->neighbours && k == 0) return -1.0;
   return !rms ? m : k ? sqrt(m / k) : 0.0;
 }
 
-/* Sum over pixels of what targets C * weight (clamped) would add. */
-static double relmse_added(const state *s, double C, const double *cap_need) {
+/* Sum over the pixels of `rank` (-1: all) of what targets C * weight
+ * (clamped) would add. */
+static double relmse_added(const state *s, double C, const double *cap_need, int rank) {
   const iris_adaptive_job *j = s->job;
   double add = 0.0;
   size_t n = (size_t)s->W * (size_t)s->H;
-  for (size_t i = 0; i < n; i++) {
-    double t = C * s->target[i]; /* target[] holds the 3x3 weight here */
+  size_t a = rank >= 0 ? s->rank_start[rank] : 0, b = rank >= 0 ? s->rank_start[rank + 1] : n;
+  for (size_t k = a; k < b; k++) {
+    size_t i = rank >= 0 ? s->order[k] : k;
+    double t = C * s->target[i]; /* target[] holds the pooled weight here */
     if (t < s->min_spp) t = s->min_spp;
     if (cap_need && t > cap_need[i]) t = cap_need[i];
     if (t > j->spp_cap) t = j->spp_cap;
@@ -255,6 +293,7 @@ static double plan_round(state *s, double budget, double *cmul) {
     for (int y = 0; y < s->H; y++)
       for (int x = 0; x < s->W; x++) {
         double t = pool3(s, s->need, x, y, false);
+        if (t < 0.0) t = INFINITY; /* nothing to decide from: no cap but spp_cap */
         need3[(size_t)y * (size_t)s->W + (size_t)x] = t < s->min_spp ? s->min_spp : ceil(t);
       }
   }
@@ -263,23 +302,43 @@ static double plan_round(state *s, double budget, double *cmul) {
   } else {
     for (int y = 0; y < s->H; y++)
       for (int x = 0; x < s->W; x++) s->target[(size_t)y * (size_t)s->W + (size_t)x] = pool3(s, s->weight, x, y, true);
-    /* the largest C whose targets fit the budget (bisection in log C) */
-    double lo = 0.0, hi = 1.0;
-    if (budget > 0.0) {
-      while (relmse_added(s, hi, need3) < budget && hi < 1e30) hi *= 4.0;
+    /* Deciding from the neighbours, a pixel with nothing to decide from (the
+     * top rank: uniform) takes its rank's mean weight, and each rank has its
+     * own share of the budget and its own C: one C over all pixels would hang
+     * a pixel's count on its own samples through the other ranks' targets. */
+    const int ranks = s->neighbours ? RANKS : 1;
+    for (int r = 0; r < ranks && s->neighbours; r++) {
+      double sum = 0.0;
+      size_t k = 0;
+      for (size_t q = s->rank_start[r]; q < s->rank_start[r + 1]; q++)
+        if (s->target[s->order[q]] >= 0.0) sum += s->target[s->order[q]], k++;
+      const double fill = k && sum > 0.0 ? sum / (double)k : 1.0;
+      for (size_t q = s->rank_start[r]; q < s->rank_start[r + 1]; q++)
+        if (s->target[s->order[q]] < 0.0) s->target[s->order[q]] = fill;
+    }
+    /* the largest C whose targets fit the budget (bisection) */
+    double cs[RANKS];
+    for (int r = 0; r < RANKS; r++) cs[r] = 1e30; /* no budget: the threshold alone caps */
+    for (int r = 0; r < ranks && budget > 0.0; r++) {
+      const int which = s->neighbours ? r : -1;
+      const double members = which < 0 ? (double)n : (double)(s->rank_start[r + 1] - s->rank_start[r]);
+      const double b = budget * members / (double)n;
+      if (!(members > 0)) continue;
+      double lo = 0.0, hi = 1.0;
+      while (relmse_added(s, hi, need3, which) < b && hi < 1e30) hi *= 4.0;
       for (int it = 0; it < 60; it++) {
         double mid = 0.5 * (lo + hi);
-        if (relmse_added(s, mid, need3) <= budget)
+        if (relmse_added(s, mid, need3, which) <= b)
           lo = mid;
         else
           hi = mid;
       }
-    } else {
-      lo = 1e30; /* no budget: the threshold alone caps */
+      cs[r] = lo;
     }
-    *cmul = lo;
+    *cmul = cs[0];
     for (size_t i = 0; i < n; i++) {
-      double t = lo * s->target[i];
+      const int r = s->neighbours ? rank_of((int)(i % (size_t)s->W) + j->x0, (int)(i / (size_t)s->W) + j->y0) : 0;
+      double t = cs[r] * s->target[i];
       if (t < s->min_spp) t = s->min_spp;
       if (need3 && t > need3[i]) t = need3[i];
       s->target[i] = t;
@@ -385,6 +444,7 @@ static void state_free(state *s) {
   free(s->need);
   free(s->weight);
   free(s->target);
+  free(s->order);
 }
 
 iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome *out, iris_error *err) {
@@ -402,15 +462,20 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
   s.HW = s.hx1 - s.hx0;
   s.HH = s.hy1 - s.hy0;
   s.train = j->film->count[0];
+  /* relmse under a budget (a time or a target error): decisions from the
+   * image samples of the other colour, no scouts (renderer/adaptive.h) */
+  s.neighbours = p->rule == IRIS_ADAPTIVE_RELMSE && !p->decide_on_image && (j->budget > 0.0 || p->target_error > 0.0);
   /* Cycles' automatic minimum with a threshold; without one (a target error
-   * or a time budget deciding) the scouts decide from the start */
+   * or a time budget deciding) the decisions start after it */
   s.min_spp = p->min_spp > 0                ? p->min_spp
               : p->noise_threshold > 0.0    ? iris_adaptive_auto_min_spp(p->noise_threshold)
                                             : IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD;
   if (s.min_spp > j->spp_cap) s.min_spp = j->spp_cap;
   const size_t n = (size_t)s.W * (size_t)s.H, hn = (size_t)s.HW * (size_t)s.HH;
-  iris_status st = iris_film_create(&s.scout, s.HW, s.HH, err);
-  if (st != IRIS_OK) return st;
+  if (!s.neighbours) {
+    iris_status st = iris_film_create(&s.scout, s.HW, s.HH, err);
+    if (st != IRIS_OK) return st;
+  }
   s.scout_take = calloc(hn, sizeof *s.scout_take);
   s.scout_first = calloc(hn, sizeof *s.scout_first);
   s.take = calloc(n, sizeof *s.take);
@@ -418,14 +483,27 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
   s.need = calloc(hn, sizeof *s.need);
   s.weight = calloc(hn, sizeof *s.weight);
   s.target = calloc(n, sizeof *s.target);
-  if (!s.scout_take || !s.scout_first || !s.take || !s.first || !s.need || !s.weight || !s.target) {
+  if (s.neighbours && (s.order = malloc(n * sizeof *s.order)) != NULL) {
+    /* image pixels by rank (a counting sort) */
+    size_t count[RANKS] = {0};
+    for (int y = 0; y < s.H; y++)
+      for (int x = 0; x < s.W; x++) count[rank_of(x + j->x0, y + j->y0)]++;
+    s.rank_start[0] = 0;
+    for (int r = 0; r < RANKS; r++) s.rank_start[r + 1] = s.rank_start[r] + count[r];
+    size_t at[RANKS];
+    memcpy(at, s.rank_start, sizeof at);
+    for (int y = 0; y < s.H; y++)
+      for (int x = 0; x < s.W; x++) s.order[at[rank_of(x + j->x0, y + j->y0)]++] = (uint32_t)((size_t)y * (size_t)s.W + (size_t)x);
+  }
+  if (!s.scout_take || !s.scout_first || !s.take || !s.first || !s.need || !s.weight || !s.target ||
+      (s.neighbours && !s.order)) {
     state_free(&s);
     return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (adaptive sampling)");
   }
   const double t0 = iris_time_now();
   double sec_per_path = 0.0, cmul = 0.0;
   uint64_t scout_paths = 0, image_paths = 0;
-  double error = -1.0;
+  double error = -1.0, planned = 0.0;
   for (int round = 0;; round++) {
     if (iris_cancel_requested()) {
       out->interrupted = true;
@@ -433,12 +511,14 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
     }
     double elapsed = iris_time_now() - t0;
     /* this round's budget in paths: the first rounds fixed, then half of
-     * what was done, within what the time budget still allows */
-    double done = (double)image_paths;
-    double budget = done / 2.0 > ROUND_PATHS ? done / 2.0 : ROUND_PATHS;
+     * what was done (deciding from the neighbours, what was planned: what the
+     * rounds took depends on the samples), within what the time budget still
+     * allows */
+    double done = s.neighbours && round > 0 ? planned : (double)image_paths;
+    double budget = done / 2.0 > ROUND_PATHS || p->rounds > 0 ? done / 2.0 : ROUND_PATHS;
     if (j->budget > 0.0 && round > 0) {
       double left = j->budget - elapsed;
-      double fit = sec_per_path > 0.0 ? left / sec_per_path / (1.0 + 1.0 / SCOUT_SHARE) : budget;
+      double fit = sec_per_path > 0.0 ? left / sec_per_path / (s.neighbours ? 1.0 : 1.0 + 1.0 / SCOUT_SHARE) : budget;
       if (fit < 0.02 * budget + 1.0) break; /* the budget is spent */
       if (fit < budget) budget = fit;
     }
@@ -455,10 +535,10 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
         s.first[i] = have - s.train;
       }
       for (size_t i = 0; i < hn; i++) {
-        s.scout_take[i] = SCOUT_MIN;
+        s.scout_take[i] = s.neighbours ? 0 : SCOUT_MIN;
         s.scout_first[i] = 0;
       }
-      scout_n = (double)hn * SCOUT_MIN;
+      scout_n = s.neighbours ? 0.0 : (double)hn * SCOUT_MIN;
     } else {
       /* freeze and threshold-capped rounds: no path budget; relmse: the budget */
       bool budgeted = p->rule == IRIS_ADAPTIVE_RELMSE && !(p->noise_threshold > 0.0 && j->budget <= 0.0 &&
@@ -476,7 +556,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
         out->capped = capped_all && !(p->noise_threshold > 0.0);
         break;
       }
-      scout_n = plan_scouts(&s, cmul);
+      scout_n = s.neighbours ? 0.0 : plan_scouts(&s, cmul);
       if (j->budget > 0.0 && planned > budget * 1.05 && p->rule == IRIS_ADAPTIVE_FREEZE) {
         /* freeze under a time budget: scale every pixel's step down alike */
         double f = budget / planned;
@@ -491,6 +571,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
     uint64_t after = total_paths(j);
     image_paths += mid - before;
     scout_paths += after - mid;
+    planned = round == 0 ? (double)image_paths : planned + budget;
     double dt = iris_time_now() - tr;
     if (after > before) sec_per_path = dt / (double)(after - before);
     out->rounds = round + 1;
@@ -509,7 +590,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
       out->reached_target = true;
       break;
     }
-    if (spent) break;
+    if (spent || (p->rounds > 0 && round >= p->rounds)) break;
   }
   out->error_estimate = error >= 0.0 ? error : iris_adaptive_film_error(j->film);
   double spp = 0.0;
@@ -522,7 +603,7 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
   }
   out->spp_mean = spp / (double)n;
   double sc = 0.0;
-  for (size_t i = 0; i < hn; i++) sc += s.scout.count[i];
+  for (size_t i = 0; i < hn && s.scout.count; i++) sc += s.scout.count[i];
   out->scout_spp_mean = sc / (double)hn;
   out->paths = image_paths + scout_paths;
   out->scout_paths = scout_paths;

@@ -2,13 +2,29 @@
  * noise needs (docs/rendering.md, "Adaptive sampling").
  *
  * Rounds. Every round first decides each pixel's target sample count, then
- * renders the missing samples of the pixels below their target, then adds
- * scout samples. The decisions come only from *scout* samples: uniform
- * samples with a seed of their own that never enter the image. A pixel's
- * image sample count is therefore independent of its image samples, and its
- * mean stays an unbiased estimate (stopping a pixel on its own noisy estimate,
- * as Cycles does, is not: `decide_on_image` does that, for the tests that
- * show the bias).
+ * renders the missing samples of the pixels below their target. No pixel's
+ * count is decided from its own image samples, so its mean stays an unbiased
+ * estimate (stopping a pixel on its own noisy estimate, as Cycles does, is
+ * not: `decide_on_image` does that, for the tests that show the bias). The
+ * decisions come from one of two sources:
+ * - scouts (a noise threshold alone, or the freeze rule): uniform samples
+ *   with a seed of their own that never enter the image, taken after each
+ *   round over the window and a 1-pixel halo, about 1/9 of the samples; a
+ *   window then decides as the whole frame does;
+ * - the neighbours (relmse under a budget: a time or a target error): each
+ *   full-frame pixel has a rank 0..8, its place on a 3x3 lattice, and its
+ *   target comes from the image samples of the pixels of higher rank within
+ *   2 pixels inside the window; the top rank, with none above it, samples
+ *   uniformly. Counts then depend only on samples of higher ranks, whose
+ *   counts depend only on ranks higher still: never, through any chain of
+ *   rounds, on the pixel's own samples. (Two colours, each deciding from the
+ *   other, are biased: a firefly raises its neighbours' counts, their larger
+ *   counts raise its own in the next round, and the firefly is diluted;
+ *   render.adaptive measured it.) Each rank has its own share of each
+ *   round's budget and its own multiplier, and the rounds' budgets follow
+ *   what was planned, not what was taken. No scouts, and the decisions see
+ *   all the image samples (budgets are global, so a window never equalled
+ *   the whole frame there anyway).
  *
  * Two rules set the targets:
  * - freeze (Cycles' rule): a pixel needs the samples at which its predicted
@@ -16,10 +32,11 @@
  *   or one of its 8 neighbours needs more.
  * - relmse (iris's default): each round's samples go where one more sample
  *   lowers the image's relMSE most: targets proportional to the pixel's
- *   sqrt(sum_c var_c / (mean_c^2 + eps)) pooled over its 3x3 neighbourhood
- *   (root mean square: 9 pixels' scouts decide together), so that the
- *   image's estimated relMSE falls fastest; with a noise threshold, no pixel
- *   is taken past the count the threshold asks for. */
+ *   sqrt(sum_c var_c / (mean_c^2 + eps)) pooled (root mean square) over its
+ *   3x3 neighbourhood's scouts, or its higher-ranked neighbours' image
+ *   samples, so
+ *   that the image's estimated relMSE falls fastest; with a noise threshold,
+ *   no pixel is taken past the count the threshold asks for. */
 #ifndef IRIS_RENDERER_ADAPTIVE_H
 #define IRIS_RENDERER_ADAPTIVE_H
 
@@ -52,9 +69,10 @@ bool iris_adaptive_rule_parse(const char *s, iris_adaptive_rule *out);
 #define IRIS_ADAPTIVE_MIN_SPP_NO_THRESHOLD 16
 int iris_adaptive_auto_min_spp(double noise_threshold);
 
-/* Memory adaptive sampling adds per pixel of the window: the scout film
- * (sums, squares, count: 52 bytes) and the per-pixel plans (take, first,
- * need, weight, target, scouts' take and first: 44), for the memory estimate. */
+/* Memory adaptive sampling adds per pixel of the window, at most: the scout
+ * film (sums, squares, count: 52 bytes; none when deciding from the
+ * neighbours) and the per-pixel plans (take, first, need, weight, target,
+ * scouts' take and first: 44), for the memory estimate. */
 #define IRIS_ADAPTIVE_BYTES_PER_PIXEL 96.0
 
 /* The relMSE denominator offset and the share of largest per-pixel errors
@@ -68,6 +86,8 @@ typedef struct iris_adaptive_params {
   int min_spp;            /* image samples every pixel gets first; 0: automatic (above) */
   double target_error;    /* stop once the image's estimated relMSE is at most this; 0: none */
   bool decide_on_image;   /* tests only: decide from the image's own samples (biased) */
+  int rounds;             /* tests only: stop after this many rounds past the first, each
+                             adding half the samples so far (no floor of paths); 0: none */
 } iris_adaptive_params;
 
 /* Where a round stands, for the progress line. */

@@ -51,6 +51,8 @@ typedef struct unbiased_case {
   int w, h;
   double threshold;
   int min_spp, cap, ref_spp;
+  iris_adaptive_rule rule;
+  int rounds; /* relmse: rounds past the first under a target error never reached (the neighbours decide) */
 } unbiased_case;
 
 /* Returns the largest |z| over the image and its 8x8 blocks. */
@@ -71,10 +73,14 @@ static double seeds_against_reference(const unbiased_case *c, bool on_image, int
   for (int k = 0; k < seeds; k++) {
     iris_render_params p = base(c->w, c->h, c->method, 1000 + (uint64_t)k);
     p.spp = c->cap;
-    p.adaptive.rule = IRIS_ADAPTIVE_FREEZE;
+    p.adaptive.rule = c->rule;
     p.adaptive.noise_threshold = c->threshold;
     p.adaptive.min_spp = c->min_spp;
     p.adaptive.decide_on_image = on_image;
+    if (c->rounds > 0) {
+      p.adaptive.target_error = 1e-12;
+      p.adaptive.rounds = c->rounds;
+    }
     iris_render_result r;
     if (!CHECK(iris_test_render(s, &p, &r))) break;
     spp_mean += r.adaptive_outcome.spp_mean / seeds;
@@ -110,8 +116,9 @@ static double seeds_against_reference(const unbiased_case *c, bool on_image, int
                           mean, rm[ch], z);
     }
   }
-  printf("%s %s, %s: %.1f spp mean over %d seeds, image z = %+.2f, worst |z| = %.2f (limit %.2f)\n", c->scene,
-         iris_method_name(c->method), on_image ? "deciding on the image's own samples" : "deciding on scouts",
+  printf("%s %s, %s, %s: %.1f spp mean over %d seeds, image z = %+.2f, worst |z| = %.2f (limit %.2f)\n", c->scene,
+         iris_method_name(c->method), iris_adaptive_rule_name(c->rule),
+         on_image ? "deciding on the image's own samples" : c->rounds ? "deciding on the neighbours" : "deciding on scouts",
          spp_mean, seeds, image_z, worst, z_max);
   free(sum);
   free(sum2);
@@ -220,6 +227,29 @@ static void determinism(void) {
   iris_check_record(differ == 0, __FILE__, __LINE__, "%d pixels of the window differ from the whole frame's", differ);
   printf("determinism: %.1f spp mean, 1 and 2 threads and a window alike\n", r[0].adaptive_outcome.spp_mean);
   for (int k = 0; k < 3; k++) iris_render_result_destroy(&r[k]);
+  /* relmse deciding from the neighbours: the same for 1 and 2 threads, uneven
+   * counts, and no scouts */
+  for (int k = 0; k < 2; k++) {
+    iris_render_params p = base(40, 32, IRIS_METHOD_MIS, 9);
+    p.spp = 4096;
+    p.adaptive.rule = IRIS_ADAPTIVE_RELMSE;
+    p.adaptive.target_error = 1e-12;
+    p.adaptive.rounds = 4;
+    p.threads = k + 1;
+    if (!CHECK(iris_test_render(s, &p, &r[k]))) {
+      if (k) iris_render_result_destroy(&r[0]);
+      iris_scene_destroy(s);
+      return;
+    }
+  }
+  CHECK(memcmp(r[0].film.sum, r[1].film.sum, 3 * n * sizeof *a->sum) == 0);
+  CHECK(memcmp(r[0].film.count, r[1].film.count, n * sizeof *a->count) == 0);
+  const iris_adaptive_outcome *o = &r[0].adaptive_outcome;
+  CHECK(o->scout_paths == 0 && o->scout_spp_mean == 0.0);
+  CHECK(o->rounds == 5 && o->spp_min < o->spp_max);
+  printf("determinism, relmse from the neighbours: %.1f spp mean (%d..%d), 1 and 2 threads alike\n", o->spp_mean,
+         o->spp_min, o->spp_max);
+  for (int k = 0; k < 2; k++) iris_render_result_destroy(&r[k]);
   iris_scene_destroy(s);
 }
 
@@ -279,18 +309,26 @@ int main(void) {
   merge_parts();
   determinism();
   calibration();
-  static const unbiased_case cases[2] = {
-      {"cornell-box", IRIS_METHOD_BSDF, 24, 24, 0.1, 4, 512, 8192},
-      {"env-spheres", IRIS_METHOD_MIS, 24, 16, 0.02, 8, 256, 4096},
+  static const unbiased_case cases[4] = {
+      {"cornell-box", IRIS_METHOD_BSDF, 24, 24, 0.1, 4, 512, 8192, IRIS_ADAPTIVE_FREEZE, 0},
+      {"env-spheres", IRIS_METHOD_MIS, 24, 16, 0.02, 8, 256, 4096, IRIS_ADAPTIVE_FREEZE, 0},
+      /* relmse under a budget: 16 spp, then 4 rounds of half the samples so
+       * far (~81 spp), allotted from the neighbours' image samples */
+      {"cornell-box", IRIS_METHOD_BSDF, 24, 24, 0.0, 16, 4096, 8192, IRIS_ADAPTIVE_RELMSE, 4},
+      {"env-spheres", IRIS_METHOD_MIS, 24, 16, 0.0, 16, 4096, 4096, IRIS_ADAPTIVE_RELMSE, 4},
   };
   const int seeds = 32;
   int n_tests = 0;
-  for (int c = 0; c < 2; c++) n_tests += 3 * (1 + (cases[c].w / 8) * (cases[c].h / 8));
+  for (int c = 0; c < 4; c++) n_tests += 3 * (1 + (cases[c].w / 8) * (cases[c].h / 8));
   double z_max = z_for_alpha(1e-3 / n_tests);
-  for (int c = 0; c < 2; c++) seeds_against_reference(&cases[c], false, seeds, z_max, true);
-  /* the test can fail: deciding on the image's own samples is biased */
-  double biased = seeds_against_reference(&cases[0], true, seeds, z_max, false);
-  iris_check_record(biased > z_max, __FILE__, __LINE__, "deciding on the image's own samples: worst |z| %.2f, not above %.2f (no power)", biased,
-            z_max);
+  for (int c = 0; c < 4; c++) seeds_against_reference(&cases[c], false, seeds, z_max, true);
+  /* the test can fail: deciding on the image's own samples is biased, with
+   * either rule */
+  for (int c = 0; c < 4; c += 2) {
+    double biased = seeds_against_reference(&cases[c], true, seeds, z_max, false);
+    iris_check_record(biased > z_max, __FILE__, __LINE__,
+                      "%s, deciding on the image's own samples: worst |z| %.2f, not above %.2f (no power)",
+                      iris_adaptive_rule_name(cases[c].rule), biased, z_max);
+  }
   return iris_check_summary("render.adaptive");
 }
