@@ -26,6 +26,10 @@ extern "C" {
 /* Adaptive sampling's per-pixel cap when no --spp is given (Blender's default
  * Max Samples). */
 #define IRIS_RENDER_ADAPTIVE_DEFAULT_CAP 4096
+/* The per-pixel cap of adaptive sampling under a time budget by default
+ * (`iris render --time` without --spp): the budget decides, as it does for
+ * uniform passes, and iris bench's @adaptive uses the same. */
+#define IRIS_RENDER_BUDGET_ADAPTIVE_CAP (1 << 20)
 /* Whether the guide's training samples go into the image by default
  * (iris_render_params.keep_training; docs/guiding.md, "Training samples"). */
 #define IRIS_KEEP_TRAINING_DEFAULT true

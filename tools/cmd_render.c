@@ -75,11 +75,11 @@ static const iris_option ADAPTIVE_ROWS[] = {
     {"min-spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, offsetof(render_cli, min_spp),
      "samples every pixel gets first (default as Cycles:\nmax(4, ceil(16 / T^0.3)), 64 at T = 0.01; 16 without T)", NULL},
     {"adaptive", 0, IRIS_OPT_CHOICE, "RULE", 0, 0, offsetof(render_cli, adaptive),
-     "relmse (default with --noise-threshold/--target-error:\nsamples where they lower the image's "
-     "relMSE most) | freeze\n(Cycles' rule) | off (every pixel the same spp)", ADAPTIVE_CHOICES},
+     "relmse (default with --noise-threshold/--target-error and\nunder --time: samples where they lower the "
+     "image's relMSE\nmost) | freeze (Cycles' rule) | off (every pixel the\nsame spp)", ADAPTIVE_CHOICES},
 };
-static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (off unless one of these is given: --spp\n"
-                                                   "and --time then mean what they say; docs/rendering.md)",
+static const iris_option_group ADAPTIVE_OPTIONS = {"Adaptive sampling (on under --time without --spp, else off\n"
+                                                   "unless one of these is given; docs/rendering.md)",
                                                    ADAPTIVE_ROWS, sizeof ADAPTIVE_ROWS / sizeof ADAPTIVE_ROWS[0]};
 static const iris_option_group OUTPUT_OPTIONS = {"Output and reporting", OUTPUT_ROWS,
                                                  sizeof OUTPUT_ROWS / sizeof OUTPUT_ROWS[0]};
@@ -313,17 +313,21 @@ int iris_cmd_render(int argc, char **argv) {
                                      "0 <= x0 < x1 and 0 <= y0 < y1)", rc_opts.pixel_bounds);
   {
     /* adaptive sampling: on with a threshold or a target error (relmse unless
-     * --adaptive says otherwise), or with --adaptive freeze|relmse alone (then
-     * at Blender's threshold 0.01) */
+     * --adaptive says otherwise), with --adaptive freeze|relmse alone (then at
+     * Blender's threshold 0.01), and by default under --time without --spp
+     * or --sample-offset (relmse, the budget deciding: docs/rendering.md) */
     iris_adaptive_params *ap = &p.adaptive;
     ap->noise_threshold = rc_opts.noise_threshold;
     ap->target_error = rc_opts.target_error;
     ap->min_spp = rc_opts.min_spp;
     bool asked = ap->noise_threshold > 0.0 || ap->target_error > 0.0;
+    const bool by_budget = rc_opts.adaptive < 0 && !asked && p.time_budget > 0.0 && !have_spp &&
+                           !iris_options_seen(&bind[2], "sample-offset");
     ap->rule = rc_opts.adaptive >= 0 ? (iris_adaptive_rule)rc_opts.adaptive
-               : asked               ? IRIS_ADAPTIVE_RELMSE
+               : asked || by_budget  ? IRIS_ADAPTIVE_RELMSE
                                      : IRIS_ADAPTIVE_OFF;
-    if (ap->rule != IRIS_ADAPTIVE_OFF && !asked) ap->noise_threshold = 0.01;
+    if (by_budget) p.spp = IRIS_RENDER_BUDGET_ADAPTIVE_CAP; /* the budget decides, as the passes do without it */
+    if (ap->rule != IRIS_ADAPTIVE_OFF && !asked && !by_budget) ap->noise_threshold = 0.01;
     if (ap->rule == IRIS_ADAPTIVE_OFF && (asked || ap->min_spp > 0))
       return iris_cli_usage_error(CMD, "--noise-threshold, --target-error and --min-spp need adaptive sampling "
                                        "(not --adaptive off)");
@@ -542,12 +546,16 @@ int iris_cmd_render(int argc, char **argv) {
         snprintf(why, sizeof why, "every pixel below the noise threshold %g", res.adaptive.noise_threshold);
       else if (ao->interrupted)
         snprintf(why, sizeof why, "interrupted");
+      else if (p.time_budget > 0 && !(res.adaptive.target_error > 0) && !(res.adaptive.noise_threshold > 0))
+        snprintf(why, sizeof why, "the --time budget spent (--adaptive off: every pixel the same samples)");
       else
         snprintf(why, sizeof why, "stopped by the %s cap%s", p.time_budget > 0 ? "--time" : "--spp",
                  res.adaptive.target_error > 0 ? " before the target" : "");
-      iris_infof("adaptive (%s): %.1f spp mean (%d..%d) + %.1f scout spp, estimated relMSE %.3g: %s",
-                 iris_adaptive_rule_name(res.adaptive.rule), ao->spp_mean, ao->spp_min, ao->spp_max,
-                 ao->scout_spp_mean, ao->error_estimate, why);
+      char scouts[48] = "";
+      if (ao->scout_spp_mean > 0) snprintf(scouts, sizeof scouts, " + %.1f scout spp", ao->scout_spp_mean);
+      iris_infof("adaptive (%s): %.1f spp mean (%d..%d)%s, estimated relMSE %.3g: %s",
+                 iris_adaptive_rule_name(res.adaptive.rule), ao->spp_mean, ao->spp_min, ao->spp_max, scouts,
+                 ao->error_estimate, why);
     }
     if (res.stats.nan_count)
       iris_warnf("%llu NaN/Inf samples were dropped", (unsigned long long)res.stats.nan_count);

@@ -801,7 +801,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
              * relMSE allocation with the budget alone deciding. No spp cap. */
             rp.adaptive.rule = p.adaptive[k];
             rp.adaptive.noise_threshold = p.adaptive[k] == IRIS_ADAPTIVE_FREEZE ? IRIS_BENCH_ADAPTIVE_THRESHOLD : 0.0;
-            rp.spp = 1 << 20;
+            rp.spp = IRIS_RENDER_BUDGET_ADAPTIVE_CAP;
           }
           if (rp.light_sampler == IRIS_LIGHT_SAMPLER_LEARNED && !rp.guide) { /* the caches' light tables */
             rp.guide = &iris_guiding_provider;

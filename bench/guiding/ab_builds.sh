@@ -1,6 +1,6 @@
 #!/bin/sh
 # Two builds at equal wall time: NEW against BASE (another checkout's build
-# directory), each an `iris render --time T --time-total` (setup counted) per
+# directory), each an `iris render --time T --time-total --adaptive off` (setup counted) per
 # seed and budget, alternating, relMSE (bench/render/relmse, the benchmarks'
 # trimmed metric) against REFDIR/ref_SCENE.exr (made as bench/guiding/portal_ab.sh
 # makes it when missing), 72 rows (door scenes 96 wide, the rest 108), 2
@@ -42,7 +42,7 @@ for sc in $SCENES; do
       for v in new base; do
         if [ "$v" = new ]; then b=$N; extra=${NEW_ARGS:-}; m=${NEW_METHOD:-$METHOD}
         else b=$B; extra=${BASE_ARGS:-}; m=${BASE_METHOD:-$METHOD}; fi
-        if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t --json"; else budget="--time $t --time-total"; fi
+        if [ "${BUDGET:-time}" = spp ]; then budget="--spp $t --json"; else budget="--time $t --time-total --adaptive off"; fi
         # shellcheck disable=SC2086
         "$b/tools/iris" render "$sc" --method "$m" $budget --width "$W" --height 72 --threads 2 \
           --seed "$s" $extra -o "$OUT/img.exr" > "$OUT/run.json" 2>/dev/null

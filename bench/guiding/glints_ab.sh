@@ -30,7 +30,7 @@ for sc in $SCENES; do
       vals=""; spps=""
       for s in $SEEDS; do
         # shellcheck disable=SC2086
-        "$B/tools/iris" render "$sc" --time "$t" --time-total --width 108 --height 72 --threads 2 --seed "$s" $opts \
+        "$B/tools/iris" render "$sc" --time "$t" --time-total --adaptive off --width 108 --height 72 --threads 2 --seed "$s" $opts \
           -o "$OUT/img.exr" > /dev/null 2> "$OUT/log"
         vals="$vals $("$B/bench/render/relmse" "$OUT/img.exr" "$ref")"
         spps="$spps $(sed -n 's/.*, \([0-9]*\) spp.*/\1/p' "$OUT/log" | tail -1)"

@@ -59,7 +59,7 @@ for s in $SCENES; do
   ref="$OUT/ref-$s.exr"
   [ -f "$ref" ] || "$IRIS" render "$s" --method mis --spp 4096 --width 108 --height 72 --threads 2 --seed 1000003 \
     --sampler independent -o "$ref" --quiet
-  e="--time $T --time-total --width 108 --height 72"
+  e="--time $T --time-total --adaptive off --width 108 --height 72"
   echo "== $s: whole path, $T s"
   row "$s" "mis tree" "$ref" "$OUT/e-$s-mis" --method mis $e
   row "$s" "mis learned, photons alone" "$ref" "$OUT/e-$s-mislp" --method mis --light-sampler learned \

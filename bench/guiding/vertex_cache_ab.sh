@@ -30,7 +30,7 @@ REPO=$(cd "$(dirname "$0")/../.." && pwd)
 scratch_build vertex_cache_prototype.patch
 B=$SCRATCH/build
 case "$BUDGET" in
-  *s) budget="--time ${BUDGET%s} --time-total" ;;
+  *s) budget="--time ${BUDGET%s} --time-total --adaptive off" ;;
   *) budget="--spp $BUDGET" ;;
 esac
 for sc in "$@"; do

@@ -6,7 +6,8 @@ NaN, 0, out of range) and contradictory flags are refused with one line naming
 the flag, exit 2 and no output file; --target-error reports the estimate it
 reached and why it stopped (target reached, or the --spp/--time cap: never
 both silently); a threshold render's --json says adaptive, with the per-pixel
-spp range spread (some pixels stop at the minimum, some go further).
+spp range spread (some pixels stop at the minimum, some go further); --time
+alone renders adaptively (relmse, no scouts), --adaptive off uniformly.
 
 usage: test_adaptive_cli.py WORKDIR IRIS
 """
@@ -77,6 +78,20 @@ def main():
         check(a.get("rule") == "relmse" and a.get("stop") in ("threshold", "cap"), f"threshold run {a}")
         check(a.get("spp_min", 0) >= 40 and a.get("spp_max", 0) > a.get("spp_min", 0),
               f"threshold run spp range {a.get('spp_min')}..{a.get('spp_max')}")
+    # under --time without --spp adaptive sampling is the default (relmse, the
+    # neighbours deciding: no scouts, counts spread); --adaptive off keeps every
+    # pixel the same samples, and --spp keeps --time's meaning (refused together)
+    p = run(iris, "env-spheres", "--height", "24", "--method", "mis", "--time", "1", "--json", "-o", out)
+    if check(p.returncode == 0, f"--time run: exit {p.returncode} {p.stderr[-300:]}"):
+        a = json.loads(p.stdout).get("adaptive", {})
+        check(a.get("rule") == "relmse" and a.get("scout_spp_mean") == 0, f"--time run: {a}")
+        check(0 < a.get("spp_min", 0) < a.get("spp_max", 0), f"--time run spp range {a.get('spp_min')}..{a.get('spp_max')}")
+    p = run(iris, "env-spheres", "--height", "24", "--method", "mis", "--time", "1", "-o", out)
+    check(p.returncode == 0 and "the --time budget spent" in p.stderr, f"--time run's summary: {p.stderr[-300:]!r}")
+    p = run(iris, "env-spheres", "--height", "24", "--method", "mis", "--time", "1", "--adaptive", "off", "--json",
+            "-o", out)
+    if check(p.returncode == 0, f"--time --adaptive off run: exit {p.returncode}"):
+        check("adaptive" not in json.loads(p.stdout), "--time --adaptive off rendered adaptively")
     print("render.adaptive_cli:", "ok" if failures == 0 else f"{failures} failures")
     return 1 if failures else 0
 
