@@ -4,11 +4,16 @@
  *    is found by chance: heavy-tailed pixels, fireflies) and on env-spheres
  *    (smooth sky gradients), the mean over many seeds of the adaptive images
  *    agrees with a fixed-spp reference per image and per 8x8 block (z-tests on
- *    the seeds' spread, Bonferroni-corrected). The same test on the variant
- *    that decides from the image's own samples (as Cycles' rule does) finds
- *    its bias: the test can fail.
+ *    the seeds' spread, Bonferroni-corrected), deciding from scouts (freeze at
+ *    a threshold) and from the higher-ranked neighbours' image samples (relmse
+ *    under a budget: a target never reached and a fixed number of rounds).
+ *    The same test on the variant that decides from the image's own samples
+ *    (as Cycles' rule does) finds its bias with either rule: the test can
+ *    fail (and found the bias of a two-colour checkerboard, z = -6.3).
  * 2. Determinism: the same image for 1 and 2 threads, and a window rendered
- *    alone equals the same window of the whole frame (threshold rule).
+ *    alone equals the same window of the whole frame (threshold rule); relmse
+ *    from the neighbours the same for 1 and 2 threads, with uneven counts and
+ *    no scouts.
  * 3. The error estimate is honest: the image's estimated relMSE against its
  *    true relMSE (against a converged reference) at three target errors lies
  *    in [0.7, 1.4] with independent samples on cornell-box and veach-mis
