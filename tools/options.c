@@ -54,7 +54,7 @@ static const iris_option RENDER_ROWS[] = {
     OPT("spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, iris_render_options, spp,
         "samples per pixel (default: the scene's, else 64)"),
     OPT("time", 0, IRIS_OPT_DOUBLE, "SECONDS", 1e-3, 1e7, iris_render_options, time,
-        "whole passes until SECONDS have passed (not with --spp)"),
+        "render until SECONDS have passed, the samples where they\nlower the image's relMSE most (--adaptive off: whole\npasses; not with --spp)"),
     OPT("seed", 0, IRIS_OPT_U64, "N", 0, 0, iris_render_options, seed,
         "random seed (default: the scene's, else 0)"),
     OPT("method", 0, IRIS_OPT_STRING, "M", 0, 0, iris_render_options, method,
