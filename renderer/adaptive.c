@@ -170,24 +170,13 @@ typedef struct state {
 static int rank_of(int x, int y) { return x % 3 + 3 * (y % 3); }
 
 /* The statistics the decisions are made from at scout-window pixel (hx, hy):
- * the scouts', or the image's (deciding from the neighbours; pixels of the
- * halo outside the window have none, n = 0), or, for the biased test variant,
- * the image's own samples. */
+ * the scouts', or the image's (deciding from the neighbours, or, for the
+ * biased test variant, on the pixel's own samples; a halo pixel outside the
+ * window reads the nearest image pixel, which the neighbours' pooling never
+ * uses: pool3 keeps to the window). */
 static void decision_stats(const state *s, int hx, int hy, double mean[3], double var[3], double *n) {
   const iris_adaptive_job *j = s->job;
-  if (s->neighbours) {
-    int x = hx + s->hx0 - j->x0, y = hy + s->hy0 - j->y0;
-    if (x < 0 || y < 0 || x >= s->W || y >= s->H) {
-      for (int c = 0; c < 3; c++) mean[c] = var[c] = 0.0;
-      *n = 0.0;
-      return;
-    }
-    size_t i = (size_t)y * (size_t)s->W + (size_t)x;
-    pixel_stats(j->film, i, mean, var);
-    *n = j->film->count[i];
-    return;
-  }
-  if (j->params.decide_on_image) {
+  if (s->neighbours || j->params.decide_on_image) {
     int x = hx + s->hx0 - j->x0, y = hy + s->hy0 - j->y0;
     if (x < 0) x = 0;
     if (y < 0) y = 0;
@@ -336,13 +325,14 @@ static double plan_round(state *s, double budget, double *cmul) {
       cs[r] = lo;
     }
     *cmul = cs[0];
-    for (size_t i = 0; i < n; i++) {
-      const int r = s->neighbours ? rank_of((int)(i % (size_t)s->W) + j->x0, (int)(i / (size_t)s->W) + j->y0) : 0;
-      double t = cs[r] * s->target[i];
-      if (t < s->min_spp) t = s->min_spp;
-      if (need3 && t > need3[i]) t = need3[i];
-      s->target[i] = t;
-    }
+    for (int r = 0; r < ranks; r++) /* each rank's pixels, or (one rank) all */
+      for (size_t q = s->neighbours ? s->rank_start[r] : 0; q < (s->neighbours ? s->rank_start[r + 1] : n); q++) {
+        const size_t i = s->neighbours ? s->order[q] : q;
+        double t = cs[r] * s->target[i];
+        if (t < s->min_spp) t = s->min_spp;
+        if (need3 && t > need3[i]) t = need3[i];
+        s->target[i] = t;
+      }
   }
   double total = 0.0;
   for (size_t i = 0; i < n; i++) {
