@@ -8,7 +8,7 @@ and prints three forecasts of relMSE(fixed spp) / relMSE(adaptive) at equal
 samples, from each pixel's relative variance per sample v = var / (m^2 + 0.01)
 (m: the two renders' mean, pooled 3 x 3):
   - cross-validated: samples allotted in proportion to w = sqrt(v_A pooled
-    3 x 3), A standing for the scouts iris's relmse rule decides from
+    3 x 3), A standing for the scouts the relmse rule decided from
     (renderer/adaptive.h), and the result judged by B's independent v:
     mean(v_B) / (mean(v_B / w) * mean(w)); also with the 0.1% of pixels of
     largest v_B left out, as bench's relMSE leaves out the largest errors;
@@ -17,7 +17,10 @@ samples, from each pixel's relative variance per sample v = var / (m^2 + 0.01)
     2026-12-05, which chose adaptive sampling for sky-room-pane, where it lost);
   - ideal, unpooled: mean(v_B) / mean(sqrt(v_B))^2.
 A forecast ignores the scouts' cost (~1/9 of the samples) and the sampler's
-loss at uneven sample counts.
+loss at uneven sample counts. It models the scouts' rule, which decided
+budgeted renders until 94a5892; since then the higher-ranked neighbours'
+image samples decide (docs/benchmarks.md, "Adaptive sampling from the
+neighbours"), with no scouts and far more samples behind each decision.
 
 usage: bench/render/adaptive_forecast.py IRIS SCENE[:METHOD]... [--seeds SA,SB]
 (Debian's /usr/bin/python3 with numpy; oiiotool reads the EXRs)

@@ -247,8 +247,8 @@ static void determinism(void) {
       return;
     }
   }
-  CHECK(memcmp(r[0].film.sum, r[1].film.sum, 3 * n * sizeof *a->sum) == 0);
-  CHECK(memcmp(r[0].film.count, r[1].film.count, n * sizeof *a->count) == 0);
+  CHECK(memcmp(r[0].film.sum, r[1].film.sum, 3 * n * sizeof *r[0].film.sum) == 0);
+  CHECK(memcmp(r[0].film.count, r[1].film.count, n * sizeof *r[0].film.count) == 0);
   const iris_adaptive_outcome *o = &r[0].adaptive_outcome;
   CHECK(o->scout_paths == 0 && o->scout_spp_mean == 0.0);
   CHECK(o->rounds == 5 && o->spp_min < o->spp_max);
