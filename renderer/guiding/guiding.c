@@ -826,13 +826,6 @@ static marked_photons count_marked(const iris_photon_map *photons, bool caustic)
   return m;
 }
 
-/* Light focused through glass onto what the guide serves (caustic photons:
- * delta vertices only from the light, one of them a refraction) is light
- * that light sampling cannot reach and the caches can, however little of the
- * scene's light is indirect: where CAUSTIC_MIN such photons carry at least
- * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
- * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
- * The stats then hold that share. */
 /* The pilot's caustic photons carry the share but are fewer than
  * CAUSTIC_MIN: too few to decide on either way (env-spheres with a glass
  * sphere: 14-22 of them in a 16384-path pilot, the share 0.16-0.22 on every
@@ -842,6 +835,13 @@ static bool caustics_undecided(const iris_photon_map *photons) {
   return m.n > 0 && m.n < CAUSTIC_MIN && m.energy >= CAUSTIC_SHARE_MIN * m.indirect;
 }
 
+/* Light focused through glass onto what the guide serves (caustic photons:
+ * delta vertices only from the light, one of them a refraction) is light
+ * that light sampling cannot reach and the caches can, however little of the
+ * scene's light is indirect: where CAUSTIC_MIN such photons carry at least
+ * CAUSTIC_SHARE_MIN of the indirect photon energy, the "lit mostly directly"
+ * rules keep the guide, and `auto` races (docs/guiding.md, "--method auto").
+ * The stats then hold that share. */
 static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) {
   marked_photons m = count_marked(photons, true);
   if (!(m.n >= CAUSTIC_MIN && m.energy >= CAUSTIC_SHARE_MIN * m.indirect)) return false;
