@@ -2,7 +2,9 @@
  *  - it resolves to guided-nee on door and door-shielded and to mis on
  *    veach-mis, furnace-diffuse, a scene without lights and a view of nothing
  *    but mirrors, with the reason recorded in the result; stress-caustic, lit
- *    mostly directly, keeps its guide for the light its glass focuses;
+ *    mostly directly, keeps its guide for the light its glass focuses, and so
+ *    do the glass spheres on every seed, their pilot going on where it holds
+ *    too few caustic photons to decide;
  *  - the pilot traces fewer photon paths than the full pass and takes the
  *    decision the full pass takes (the same build with --pilot 0), and where
  *    guiding goes on the guide is the one built without a pilot (same photon
