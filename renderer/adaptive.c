@@ -325,14 +325,16 @@ static double plan_round(state *s, double budget, double *cmul) {
       cs[r] = lo;
     }
     *cmul = cs[0];
-    for (int r = 0; r < ranks; r++) /* each rank's pixels, or (one rank) all */
-      for (size_t q = s->neighbours ? s->rank_start[r] : 0; q < (s->neighbours ? s->rank_start[r + 1] : n); q++) {
+    for (int r = 0; r < ranks; r++) { /* each rank's pixels, or (one rank) all */
+      const size_t a = s->neighbours ? s->rank_start[r] : 0, b = s->neighbours ? s->rank_start[r + 1] : n;
+      for (size_t q = a; q < b; q++) {
         const size_t i = s->neighbours ? s->order[q] : q;
         double t = cs[r] * s->target[i];
         if (t < s->min_spp) t = s->min_spp;
         if (need3 && t > need3[i]) t = need3[i];
         s->target[i] = t;
       }
+    }
   }
   double total = 0.0;
   for (size_t i = 0; i < n; i++) {
