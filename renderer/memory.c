@@ -129,7 +129,7 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
   size_t punctual = 0;
   for (size_t i = 0; i < s->light_count; i++) punctual += iris_lights_punctual_emits(&s->lights[i]);
   light_groups = iris_lights_group_count(light_groups, punctual + sky);
-  if (guided) { /* the default budget of renderer/guiding/guiding.c (choose_budget) */
+  if (guided) { /* the default budget of renderer/guiding/rules.c (iris_guiding_choose_budget) */
     double pixels = (double)width * height, caches = pixels / 32.0;
     caches = caches < 1024 ? 1024 : (caches > 65536 ? 65536 : caches);
     /* the sky's share of the power at its largest: up to twice the paths */
