@@ -149,6 +149,7 @@ static void put_stats(writer *w, const iris_guiding_stats *s) {
   put_f64(w, s->train_seconds);
   put_f64(w, s->indirect_share);
   put_f64(w, s->seen_indirect_energy);
+  put_f64(w, s->caustic_share);
   put_u8(w, s->skipped);
   size_t n = 0;
   while (n < REASON_MAX && s->reason[n]) ++n;
@@ -389,11 +390,12 @@ static bool get_stats(reader *r, iris_guiding_stats *s) {
   s->train_seconds = get_f64(r);
   s->indirect_share = get_f64(r);
   s->seen_indirect_energy = get_f64(r);
+  s->caustic_share = get_f64(r);
   s->pilot_share = -1.0;
-  s->caustic_share = -1.0;
   uint8_t skipped = get_u8(r);
   if (!(s->indirect_share >= -1.0 && s->indirect_share <= 1.0) ||
-      !(s->seen_indirect_energy >= -1.0 && s->seen_indirect_energy <= 1.0))
+      !(s->seen_indirect_energy >= -1.0 && s->seen_indirect_energy <= 1.0) ||
+      !(s->caustic_share == -1.0 || (s->caustic_share >= 0.0 && s->caustic_share <= 1.0)))
     return false;
   if (s->train_spp < 0 || s->train_iterations < 0) return false;
   uint32_t n = get_u32(r);

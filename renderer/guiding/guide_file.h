@@ -17,7 +17,7 @@
 extern "C" {
 #endif
 
-#define IRIS_GUIDE_FILE_VERSION 7u
+#define IRIS_GUIDE_FILE_VERSION 8u
 
 /* Writes g atomically (a temporary next to path, renamed on success: a
  * failed write leaves no file). Errors: IRIS_ERR_IO naming path. */

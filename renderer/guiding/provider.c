@@ -203,6 +203,19 @@ static bool provider_decision(const void *state, char *why, size_t size, bool *f
     snprintf(why, size, "guiding forced");
     return true;
   }
+  if (g->stats.caustic_share >= 0.0) {
+    /* kept only for light focused through glass: mis finds it as single rare
+     * paths and the race's few paths per pixel rarely carry it (env-spheres
+     * with a glass sphere: the race said 0.71-0.80x on every seed where renders
+     * measure guided-nee 1.2-1.5x mis), so no race (docs/guiding.md,
+     * "--method auto") */
+    *forced = true;
+    snprintf(why, size,
+             "light focused through glass carries %.0f%% of the indirect photon energy, which mis finds only "
+             "by chance and a race too rarely to measure: no race",
+             100.0 * g->stats.caustic_share);
+    return true;
+  }
   if (g->stats.seen_indirect_energy >= 0.0) {
     snprintf(why, size, "%.0f%% of the photon energy on what the camera sees indirect",
              100.0 * g->stats.seen_indirect_energy);

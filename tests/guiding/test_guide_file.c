@@ -142,6 +142,10 @@ static void round_trip(const char *dir, const char *tag, iris_guiding *g) {
   CHECK(same_params(&g->params, &l->params));
   CHECK(memcmp(&g->pick_radius2, &l->pick_radius2, sizeof(float)) == 0);
   CHECK(l->stats.skipped == g->stats.skipped && strcmp(l->stats.reason, g->stats.reason) == 0);
+  /* what --method auto decides from (provider_decision) */
+  CHECK(memcmp(&l->stats.indirect_share, &g->stats.indirect_share, sizeof(double)) == 0 &&
+        memcmp(&l->stats.seen_indirect_energy, &g->stats.seen_indirect_energy, sizeof(double)) == 0 &&
+        memcmp(&l->stats.caustic_share, &g->stats.caustic_share, sizeof(double)) == 0);
   CHECK(l->stats.caches == g->stats.caches && l->stats.empty_caches == g->stats.empty_caches &&
         l->stats.photons_stored == g->stats.photons_stored && l->stats.camera_stride == g->stats.camera_stride);
   if (!g->stats.skipped) {
@@ -256,6 +260,10 @@ static void refusals(const char *dir, iris_guiding *g) {
     uint64_t value;
     const char *want;
   } forges[] = {
+      /* the stats' caustic share (header 48, params 69, then 128 bytes of stats before it) */
+      {48 + 69 + 128, 8, 0x3ff8000000000000ull, "invalid statistics"}, /* 1.5 */
+      {48 + 69 + 128, 8, 0xbfe0000000000000ull, "invalid statistics"}, /* -0.5 */
+      {48 + 69 + 128, 8, 0x7ff8000000000000ull, "invalid statistics"}, /* NaN */
       {count_at, 8, (uint64_t)1 << 40, "do not match its size"},       /* huge count */
       {texels_at, 8, UINT64_MAX / 4, "do not match its size"},         /* huge texel count */
       {count_at, 8, g->cache_count - 1, "do not match its size"},      /* one cache fewer */
@@ -318,6 +326,9 @@ int main(void) {
     round_trip(dir, "door", door);
     round_trip(dir, "holes", holes);
     round_trip(dir, "skipped", skipped);
+    door->stats.caustic_share = 0.25; /* as if light focused through glass had kept it */
+    round_trip(dir, "door-caustic", door);
+    door->stats.caustic_share = -1.0;
     refusals(dir, door);
     printf("door: %zu caches; veach-mis: %zu caches, %llu dropped; skipped: %s\n", door->cache_count,
            holes->cache_count, (unsigned long long)holes->stats.empty_caches, skipped->stats.reason);
