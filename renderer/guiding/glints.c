@@ -90,7 +90,8 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
   ray.tmin = 0.0f;
   ray.tmax = INFINITY;
   iris_vec3 beta = iris_v3(1.0f, 1.0f, 1.0f), y = t;
-  bool smooth_seen = false;
+  const iris_vec3 d0 = ray.d;
+  bool smooth_seen = false, reflected = false;
   for (int bounce = 0; bounce < MAX_BOUNCES; ++bounce) {
     iris_sampler_set_bounce(&rng, bounce + 1);
     iris_hit hit;
@@ -101,8 +102,10 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
     iris_shading_point sp;
     iris_integrator_shade(s->integrator, &si, wo, bounce, &sp);
     if (!iris_photon_smooth(&sp)) {
-      /* landed: a glint if a smooth reflector sent it here */
+      /* landed: a glint if a smooth surface sent it here, not straight on
+       * through a slab of glass (iris_photon.glint) */
       if (!smooth_seen) return;
+      if (!reflected && iris_dot(iris_normalize(d0), iris_normalize(ray.d)) > IRIS_PHOTON_STRAIGHT_COS) return;
       const float e = weight * iris_avg3(beta);
       if (!(e > 0.0f) || !isfinite(e)) return;
       iris_glint_photon g = {si.p, sp.frame.n, y, e};
@@ -113,6 +116,9 @@ static void trace_glint(const trace_ctx *c, uint64_t index, glint_block *out) {
     y = si.p;
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
+    if ((sp.lobes & IRIS_LOBE_TRANSMISSION) && !(ds.lobe & IRIS_LOBE_TRANSMISSION))
+      return; /* what glass reflects is faint (iris_photon.glint) */
+    reflected |= !(ds.lobe & IRIS_LOBE_TRANSMISSION);
     const float cosv = fabsf(iris_dot(ds.wi, sp.frame.n));
     beta = iris_scale(iris_mul(beta, iris_scale(ds.f, cosv)), 1.0f / ds.pdf);
     if (!iris_isfinite3(beta) || !(iris_max3(beta) > 0.0f)) return;

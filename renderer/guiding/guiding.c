@@ -496,7 +496,10 @@ static int by_float(const void *a, const void *b) {
  * glints it finds bring. */
 static iris_status build_glints(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons,
                                 float spacing, iris_error *err) {
-  iris_status st = g->params.glints ? iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err) : IRIS_OK;
+  /* no cache whose photons would give a spot its share: nothing to trace */
+  bool wanted = false;
+  for (size_t i = 0; i < g->cache_count && !wanted; ++i) wanted = g->caches[i].glint_share >= IRIS_GLINT_SHARE_MIN;
+  iris_status st = g->params.glints && wanted ? iris_glints_trace(s, photons, GLINT_PATHS, &g->glints, err) : IRIS_OK;
   if (st != IRIS_OK || g->glints.count == 0) { /* no spot anywhere */
     for (size_t i = 0; i < g->cache_count; ++i) g->caches[i].glint_share = 0.0f;
     return st;

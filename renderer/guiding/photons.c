@@ -14,7 +14,7 @@
 #define SMOOTH_PER_PATH 4
 /* cos of the largest angle between a photon's arrival and emission directions
  * that still counts as travelling straight through glass (0.5 degrees) */
-#define SKY_THROUGH_COS 0.99996f
+#define SKY_THROUGH_COS IRIS_PHOTON_STRAIGHT_COS
 /* Stream offset that keeps photon random numbers apart from camera pixels. */
 #define PHOTON_SAMPLE_INDEX 0x70686f746f6eULL
 
@@ -55,8 +55,8 @@ static void block_push(photon_block *b, const iris_photon *ph) {
 }
 
 bool iris_photon_smooth(const iris_shading_point *sp) {
-  if (sp->lobes & IRIS_LOBE_TRANSMISSION) return false; /* glass: its caustics are the caches' */
-  if (sp->delta) return true;
+  if (sp->delta) return true; /* mirrors, and clear glass: a curved one bends a lamp into a spot too */
+  if (sp->lobes & IRIS_LOBE_TRANSMISSION) return false; /* rough glass: its caustics are the caches' */
   return (sp->lobes & IRIS_LOBE_GLOSSY) && !(sp->lobes & IRIS_LOBE_DIFFUSE) &&
          iris_bsdf_guiding_roughness(&sp->bsdf) <= IRIS_GLINT_ROUGHNESS;
 }
@@ -119,7 +119,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
    * exactly one delta vertex and that bent it (a single glass quad) */
   int deltas = 0;
   float pane[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-  bool smooth_reflected = false; /* the last vertex reflected it off a smooth surface ("Glints") */
+  bool smooth_reflected = false; /* the last vertex sent it off a smooth surface ("Glints") */
   int smooth_seen = 0;           /* smooth vertices recorded as glint targets */
   bool delta_only = true, refracted = false; /* the vertices so far (iris_photon.caustic) */
   for (int bounce = 0; bounce < IRIS_PHOTON_MAX_BOUNCES; ++bounce) {
@@ -147,7 +147,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.lamp_through = lamp_only && straight;
       const bool paned = specular_only && deltas == 1 && !straight && pane[3] > 0.0f;
       for (int k = 0; k < 4; ++k) ph.pane[k] = paned ? pane[k] : 0.0f;
-      ph.glint = smooth_reflected && !ph.sky_through && !ph.lamp_through && !paned;
+      ph.glint = smooth_reflected && !(delta_only && straight) && !paned;
       ph.caustic = delta_only && refracted;
       block_push(out, &ph);
       delta_only = false;
@@ -160,7 +160,9 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
     if (smooth && smooth_seen < SMOOTH_PER_PATH && index < SMOOTH_PATHS) smooth_push(out, si.p), smooth_seen++;
     iris_direction_sample ds;
     if (!iris_integrator_sample_bsdf(&sp, &rng, &ds)) return;
-    smooth_reflected = smooth && !(ds.lobe & IRIS_LOBE_TRANSMISSION);
+    /* off a mirror, or through clear glass (what glass reflects is faint);
+     * straight on through a slab is not a glint (above) */
+    smooth_reflected = smooth && (!(sp.lobes & IRIS_LOBE_TRANSMISSION) || (ds.lobe & IRIS_LOBE_TRANSMISSION));
     refracted |= sp.delta && (ds.lobe & IRIS_LOBE_TRANSMISSION);
     if (sp.delta && specular_only && ++deltas == 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION) && sp.bsdf.ior > 0.0f &&
         sp.bsdf.ior != 1.0f) {

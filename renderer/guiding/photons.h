@@ -37,8 +37,10 @@ typedef struct iris_photon {
   uint8_t caustic : 1;   /* it left its light through delta vertices only, one of them at least
                             a refraction: light focused through glass, which light sampling
                             cannot find ("--method auto", caustics) */
-  uint8_t glint : 1;     /* its last vertex reflected it off a smooth surface (iris_photon_smooth),
-                            and it is none of the kinds below: the light glint spots find (glints.h) */
+  uint8_t glint : 1;     /* its last vertex sent it off a smooth surface (iris_photon_smooth), not
+                            straight on through glass after delta vertices only (a slab's parallel
+                            faces: sky_through, lamp_through) nor through a pane: the light glint
+                            spots find (glints.h) */
   uint8_t sky_through; /* from the environment map after delta vertices only (bounce > 0),
                           arriving along its emission direction (through a flat glass slab):
                           light that sampling the map as a direction finds and light
@@ -72,13 +74,19 @@ iris_status iris_photons_trace(const iris_guide_setup *setup, iris_emission_sele
 iris_status iris_photons_trace_more(const iris_guide_setup *setup, iris_emission_selection by, uint64_t paths,
                                     iris_photon_map *map, iris_error *err);
 void iris_photons_destroy(iris_photon_map *map);
-/* A smooth reflector: no transmission, and a delta BSDF or glossy lobes of
- * roughness <= IRIS_GLINT_ROUGHNESS without a diffuse one (a mirror,
- * near-mirror metal); what turns a light into a glint. Glass is not one: the
- * little it reflects is faint, and what it bends fills much of its surface as
- * seen from the receiver (a lens focuses), which the caches' maps find
- * (measured on lamp-shade and stress-caustic: docs/guiding.md, "Glints"). */
+/* A smooth surface: a delta BSDF (a mirror, clear glass), or glossy lobes of
+ * roughness <= IRIS_GLINT_ROUGHNESS without a diffuse or a transmission one
+ * (near-mirror metal); what turns a light into a glint. Clear glass counts
+ * where it bends the light (a lamp seen through a shade modelled as one
+ * curved surface); light straight on through a slab is not a glint
+ * (iris_photon.glint), the lamp and sky cones find it (docs/guiding.md,
+ * "Glints"). */
 bool iris_photon_smooth(const iris_shading_point *sp);
+
+/* A photon that passed delta vertices only and arrives within this cosine of
+ * its emission direction came straight on through glass (a slab's parallel
+ * faces). */
+#define IRIS_PHOTON_STRAIGHT_COS 0.99996f
 
 #ifdef __cplusplus
 }
