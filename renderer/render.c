@@ -335,13 +335,13 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   }
   if (st == IRIS_OK && resolve) {
     /* --method auto: guided-nee where the guide says it is of use and it wins
-     * the race (or is forced), else mis
+     * the race (or the guide settles it), else mis
      * without keeping any of the guide (docs/guiding.md, "--method auto"). */
     char why[IRIS_METHOD_REASON_SIZE - 32];
     why[0] = 0;
-    bool forced = false;
-    bool use = p.guide->decision(guide_state, why, sizeof why, &forced);
-    if (use && !forced && !p.no_passes) {
+    bool settled = false;
+    bool use = p.guide->decision(guide_state, why, sizeof why, &settled);
+    if (use && !settled && !p.no_passes) {
       /* the rules leave guided-nee: a race against mis decides (method_race.h) */
       st = enter_phase(&p, st, "race", "racing mis against guided-nee", t0, err);
       if (st == IRIS_OK && learned) lights.learned = p.guide->light_select(guide_state);

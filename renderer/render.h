@@ -97,9 +97,10 @@ typedef struct iris_guide_provider {
    * the sampler is BSDF sampling), and in `why` a short phrase saying why,
    * e.g. "75% of the photons indirect" or "the scene has no lights".
    * `--method auto` resolves to mis when false; when true, to guided-nee if
-   * *forced (--force-guiding) and otherwise to the winner of a race of the two
-   * (renderer/method_race.h). */
-  bool (*decision)(const void *state, char *why, size_t size, bool *forced);
+   * *settled (the guide says a race is not needed or cannot measure: e.g.
+   * --force-guiding, or light focused through glass) and otherwise to the
+   * winner of a race of the two (renderer/method_race.h). */
+  bool (*decision)(const void *state, char *why, size_t size, bool *settled);
   /* Optional (NULL: --light-sampler learned chooses with the tree alone).
    * build_lights: a guide built only for learned light selection (methods
    * without a guide of their own: photons and caches, no training);

@@ -12,9 +12,6 @@
 /* Paths whose first SMOOTH_PER_PATH smooth vertices become glint targets (iris_photon_map.smooth). */
 #define SMOOTH_PATHS 262144u
 #define SMOOTH_PER_PATH 4
-/* cos of the largest angle between a photon's arrival and emission directions
- * that still counts as travelling straight through glass (0.5 degrees) */
-#define SKY_THROUGH_COS IRIS_PHOTON_STRAIGHT_COS
 /* Stream offset that keeps photon random numbers apart from camera pixels. */
 #define PHOTON_SAMPLE_INDEX 0x70686f746f6eULL
 
@@ -110,7 +107,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
   iris_ray ray = {e.p, 0.0f, e.dir, INFINITY};
   /* Until the first non-delta vertex: whether a photon of the map still
    * travels along its emission direction having passed only delta vertices
-   * (SKY_THROUGH_COS: a flat slab's faces are parallel). */
+   * (IRIS_PHOTON_STRAIGHT_COS: a flat slab's faces are parallel). */
   bool specular_only = s->lights->envmap && s->lights->environment >= 0 && e.light == (uint32_t)s->lights->environment;
   /* The same for a lamp (an emissive triangle): from a wall behind a glass
    * shade, the bulb is where it would be without the glass ("Lamps behind glass"). */
@@ -142,7 +139,7 @@ static void trace_path(const iris_guide_setup *s, const iris_distrib1d *select, 
       ph.bounce = (uint8_t)(bounce > 255 ? 255 : bounce);
       ph.transmits = (sp.lobes & IRIS_LOBE_TRANSMISSION) ? 1 : 0;
       ph.light = e.light;
-      const bool straight = bounce > 0 && iris_dot(wo, e.dir) < -SKY_THROUGH_COS;
+      const bool straight = bounce > 0 && iris_dot(wo, e.dir) < -IRIS_PHOTON_STRAIGHT_COS;
       ph.sky_through = specular_only && straight;
       ph.lamp_through = lamp_only && straight;
       const bool paned = specular_only && deltas == 1 && !straight && pane[3] > 0.0f;

@@ -85,7 +85,7 @@ bool iris_photon_smooth(const iris_shading_point *sp);
 
 /* A photon that passed delta vertices only and arrives within this cosine of
  * its emission direction came straight on through glass (a slab's parallel
- * faces). */
+ * faces): 0.5 degrees. */
 #define IRIS_PHOTON_STRAIGHT_COS 0.99996f
 
 #ifdef __cplusplus

@@ -187,9 +187,9 @@ static iris_light_learned provider_light_select(const void *state) {
 
 static void provider_destroy(void *state) { iris_guiding_destroy(state); }
 
-static bool provider_decision(const void *state, char *why, size_t size, bool *forced) {
+static bool provider_decision(const void *state, char *why, size_t size, bool *settled) {
   const iris_guiding *g = state;
-  *forced = false;
+  *settled = false;
   if (!g) {
     snprintf(why, size, "no guide");
     return false;
@@ -199,7 +199,7 @@ static bool provider_decision(const void *state, char *why, size_t size, bool *f
     return false;
   }
   if (g->params.force) {
-    *forced = true;
+    *settled = true;
     snprintf(why, size, "guiding forced");
     return true;
   }
@@ -209,7 +209,7 @@ static bool provider_decision(const void *state, char *why, size_t size, bool *f
      * with a glass sphere: the race said 0.71-0.80x on every seed where renders
      * measure guided-nee 1.2-1.5x mis), so no race (docs/guiding.md,
      * "--method auto") */
-    *forced = true;
+    *settled = true;
     snprintf(why, size,
              "light focused through glass carries %.0f%% of the indirect photon energy, which mis finds only "
              "by chance and a race too rarely to measure: no race",

@@ -39,8 +39,8 @@ static iris_status keep_build(const iris_guide_setup *setup, iris_direction_samp
   return st;
 }
 static void keep_destroy(void *state) { iris_guiding_provider.destroy(state); }
-static bool keep_decision(const void *state, char *why, size_t size, bool *forced) {
-  return iris_guiding_provider.decision(state, why, size, forced);
+static bool keep_decision(const void *state, char *why, size_t size, bool *settled) {
+  return iris_guiding_provider.decision(state, why, size, settled);
 }
 static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision, NULL, NULL};
 
