@@ -733,11 +733,18 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   iris_guiding_params *p = &g->params;
   double t0 = iris_time_now();
   iris_guiding_phase(s, "photons", "tracing photons", -1.0);
+  /* the camera caches' points, which the pilot checks first (one pass for both) */
+  int cols, rows;
+  size_t ncam = 0;
+  iris_guide_seed_point *points = iris_guiding_camera_points(s, stride, &cols, &rows, &ncam);
+  if (!points)
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %dx%d camera cache points", cols, rows);
   iris_photon_map photons;
-  iris_status st = iris_guiding_pilot(g, s, stride, &photons, err);
+  iris_status st = iris_guiding_pilot(g, s, ncam, &photons, err);
   if (st == IRIS_OK && !g->stats.skipped)
     st = iris_photons_trace_more(s, p->photon_lights, (uint64_t)p->photons, &photons, err);
   if (st != IRIS_OK || g->stats.skipped) {
+    free(points);
     iris_photons_destroy(&photons);
     return st;
   }
@@ -747,27 +754,18 @@ static iris_status build_caches(iris_guiding *g, const iris_guide_setup *s, int 
   double t1 = iris_time_now();
   g->stats.photon_seconds = t1 - t0;
   if (photons.count == 0 && !p->force) {
+    free(points);
     iris_photons_destroy(&photons);
     iris_guiding_skip(g, "no photon reached a non-specular surface");
     return IRIS_OK;
   }
   if (iris_guiding_declines(g, s, &photons)) {
+    free(points);
     iris_photons_destroy(&photons);
     return IRIS_OK;
   }
-  if (iris_cancel_requested()) {
-    iris_photons_destroy(&photons);
-    return iris_cancel_error(err);
-  }
   iris_guiding_phase(s, "caches", "building the irradiance caches", -1.0);
   /* Camera caches. */
-  int cols, rows;
-  size_t ncam = 0;
-  iris_guide_seed_point *points = iris_guiding_camera_points(s, stride, &cols, &rows, &ncam);
-  if (!points) {
-    iris_photons_destroy(&photons);
-    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for %dx%d camera cache points", cols, rows);
-  }
   if (iris_cancel_requested()) {
     free(points);
     iris_photons_destroy(&photons);

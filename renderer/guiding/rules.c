@@ -203,18 +203,13 @@ uint64_t iris_guiding_pilot_paths(uint64_t photons) {
  * run alone first) and a scene lit mostly directly (the 30% rule on a pilot,
  * the first paths of the photon pass) are skipped before the full pass is
  * traced. `photons` keeps the pilot's photons, which the full pass extends. */
-iris_status iris_guiding_pilot(iris_guiding *g, const iris_guide_setup *s, int stride, iris_photon_map *photons,
-                               iris_error *err) {
+iris_status iris_guiding_pilot(iris_guiding *g, const iris_guide_setup *s, size_t camera_points,
+                               iris_photon_map *photons, iris_error *err) {
   iris_guiding_params *p = &g->params;
   memset(photons, 0, sizeof *photons);
   if (!p->use_nee || p->force || p->pilot_paths == 0) return IRIS_OK;
   double t0 = iris_time_now();
-  int cols, rows;
-  size_t ncam = 0;
-  iris_guide_seed_point *points = iris_guiding_camera_points(s, stride, &cols, &rows, &ncam);
-  if (!points) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, "guiding", "out of memory for the pilot's %dx%d camera points", cols, rows);
-  free(points);
-  if (ncam == 0) {
+  if (camera_points == 0) {
     iris_guiding_skip(g, "every visible surface is a perfect mirror or glass (or nothing is visible)");
     return IRIS_OK;
   }

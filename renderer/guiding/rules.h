@@ -39,9 +39,11 @@ void iris_guiding_choose_budget(iris_guiding_params *p, const iris_guide_setup *
 void iris_guiding_skip(iris_guiding *g, const char *why);
 /* Decides before paying: traces the pilot's photons into *photons (which the
  * full pass extends; empty and destroyed when the guide is skipped, or when
- * nothing decides) and skips the guide where a rule says so. */
-iris_status iris_guiding_pilot(iris_guiding *g, const iris_guide_setup *s, int stride, iris_photon_map *photons,
-                               iris_error *err);
+ * nothing decides) and skips the guide where a rule says so. camera_points:
+ * the valid seed points of the camera caches (iris_guiding_camera_points; 0:
+ * the camera sees nothing but mirrors and glass). */
+iris_status iris_guiding_pilot(iris_guiding *g, const iris_guide_setup *s, size_t camera_points,
+                               iris_photon_map *photons, iris_error *err);
 /* The same rules on the full pass's photons (for a build without a pilot):
  * true when the guide was skipped. Sets the stats' indirect share. */
 bool iris_guiding_declines(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons);
