@@ -10,6 +10,7 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "renderer/camera_path.h"
+#include "renderer/light_trace.h"
 
 #define TILE 8
 #define SQRT_2_OVER_PI 0.79788456080286535588 /* E|Z| of a standard normal */
@@ -164,6 +165,9 @@ typedef struct state {
   bool neighbours;  /* decide from higher-ranked pixels' image samples, no scouts */
   uint32_t *order;  /* deciding from the neighbours: image pixels by rank, */
   size_t rank_start[RANKS + 1]; /* rank r at order[rank_start[r] .. rank_start[r + 1]) */
+  uint64_t light_owed; /* light tracing: image paths times paths per index, not yet traced (x window pixels) */
+  iris_status light_status;
+  iris_error *err;
 } state;
 
 /* Rank of full-frame pixel (x, y): its place on a 3x3 lattice. */
@@ -384,17 +388,29 @@ static void run_scouts(state *s) {
   run_pass(&c, j->threads);
 }
 
-static void run_image(state *s) {
-  const iris_adaptive_job *j = s->job;
-  pass_ctx c = {j->it, j->cam, j->film, j->seed, j->sample_offset, j->x0, j->y0, j->x1, j->y1, 0,
-                s->take, s->first, j->stats};
-  run_pass(&c, j->threads);
-}
-
 static uint64_t total_paths(const iris_adaptive_job *j) {
   uint64_t p = 0;
   for (int i = 0; i < j->threads; i++) p += j->stats[i].paths;
   return p;
+}
+
+static void run_image(state *s) {
+  const iris_adaptive_job *j = s->job;
+  pass_ctx c = {j->it, j->cam, j->film, j->seed, j->sample_offset, j->x0, j->y0, j->x1, j->y1, 0,
+                s->take, s->first, j->stats};
+  const uint64_t before = total_paths(j);
+  run_pass(&c, j->threads);
+  iris_light_trace *lt = j->light_trace;
+  if (!lt || s->light_status != IRIS_OK) return;
+  /* light paths per image sample as in a whole-frame render: per_index for
+   * each sample of every pixel of the frame, so per_index / window pixels
+   * per sample here (the remainder carried to the next round) */
+  const uint64_t pixels = (uint64_t)s->W * (uint64_t)s->H;
+  s->light_owed += (total_paths(j) - before) * lt->per_index;
+  const uint64_t count = s->light_owed / pixels;
+  s->light_owed -= count * pixels;
+  s->light_status = iris_light_trace_run(lt, j->it, lt->next, count, j->film, s->err);
+  lt->next += count;
 }
 
 /* The first round's image samples under a time budget: every pixel the same
@@ -445,6 +461,8 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
   state s;
   memset(&s, 0, sizeof s);
   s.job = j;
+  s.err = err;
+  s.light_status = IRIS_OK;
   s.W = j->x1 - j->x0;
   s.H = j->y1 - j->y0;
   s.hx0 = j->x0 > 0 ? j->x0 - 1 : 0;
@@ -564,6 +582,10 @@ iris_status iris_adaptive_run(const iris_adaptive_job *j, iris_adaptive_outcome 
     image_paths += mid - before;
     scout_paths += after - mid;
     planned = round == 0 ? (double)image_paths : planned + budget;
+    if (s.light_status != IRIS_OK) {
+      state_free(&s);
+      return s.light_status;
+    }
     double dt = iris_time_now() - tr;
     if (after > before) sec_per_path = dt / (double)(after - before);
     out->rounds = round + 1;

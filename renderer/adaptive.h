@@ -112,6 +112,10 @@ typedef struct iris_adaptive_job {
   void (*progress)(void *ctx, const iris_adaptive_progress *p);
   void *progress_ctx;
   iris_adaptive_params params;
+  /* Light tracing (light_trace.h; NULL: none): after each round's image
+   * samples, light paths in proportion to them, as many per sample as a
+   * whole-frame render traces, their indices on from its `next`. */
+  struct iris_light_trace *light_trace;
 } iris_adaptive_job;
 
 typedef struct iris_adaptive_outcome {

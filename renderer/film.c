@@ -23,8 +23,22 @@ iris_status iris_film_create(iris_film *film, int width, int height, iris_error 
   return IRIS_OK;
 }
 
+iris_status iris_film_light_paths_enable(iris_film *film, iris_error *err) {
+  const size_t n = (size_t)film->width * (size_t)film->height;
+  film->light_sum = calloc(3 * n, sizeof(double));
+  film->light_sum2 = calloc(3 * n, sizeof(double));
+  film->light_paths = 0.0;
+  if (film->light_sum && film->light_sum2) return IRIS_OK;
+  free(film->light_sum), free(film->light_sum2);
+  film->light_sum = film->light_sum2 = NULL;
+  return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory for light-path sums of a %dx%d film",
+                        film->width, film->height);
+}
+
 void iris_film_destroy(iris_film *film) {
   if (!film) return;
+  free(film->light_sum);
+  free(film->light_sum2);
   free(film->sum);
   free(film->sum2);
   free(film->count);
@@ -39,8 +53,18 @@ void iris_film_pixel(const iris_film *film, int x, int y, iris_vec3 *mean, iris_
     double mu = n > 0 ? film->sum[3 * i + c] / n : 0.0;
     double s2 = n > 1 ? (film->sum2[3 * i + c] - n * mu * mu) / (n - 1.0) : 0.0;
     if (s2 < 0.0) s2 = 0.0; /* cancellation */
+    double var = n > 1 ? s2 / n : 0.0;
+    const double L = film->light_paths;
+    if (film->light_sum && L > 0.0) {
+      /* what one light path adds to this pixel: mean and variance of that mean */
+      const double lm = film->light_sum[3 * i + c] / L;
+      double ls2 = L > 1.0 ? (film->light_sum2[3 * i + c] - L * lm * lm) / (L - 1.0) : 0.0;
+      if (ls2 < 0.0) ls2 = 0.0;
+      mu += lm;
+      var += ls2 / L;
+    }
     m[c] = (float)mu;
-    v[c] = n > 1 ? (float)(s2 / n) : 0.0f;
+    v[c] = (float)var;
   }
   if (mean) *mean = iris_v3(m[0], m[1], m[2]);
   if (var) *var = iris_v3(v[0], v[1], v[2]);

@@ -21,6 +21,12 @@ typedef struct iris_film {
   double *sum;   /* 3 per pixel */
   double *sum2;  /* 3 per pixel */
   uint32_t *count; /* samples per pixel */
+  /* Light tracing (renderer/light_trace.h), NULL without it: per pixel the
+   * sums of what light paths added and of its squares (a path adds to one
+   * pixel at most), and how many paths were traced. A pixel's value is its
+   * samples' mean plus light_sum / light_paths, an estimator of its own. */
+  double *light_sum, *light_sum2;
+  double light_paths;
 } iris_film;
 
 iris_status iris_film_create(iris_film *film, int width, int height, iris_error *err);
@@ -39,8 +45,19 @@ static inline void iris_film_add(iris_film *film, int x, int y, iris_vec3 L) {
   film->count[i]++;
 }
 
+/* Gives the film its light-path sums (zero). */
+iris_status iris_film_light_paths_enable(iris_film *film, iris_error *err);
+
+/* Adds what one light path brought to pixel i (row-major in the film). */
+static inline void iris_film_add_light_path(iris_film *film, uint32_t i, const float c[3]) {
+  for (int k = 0; k < 3; k++) {
+    film->light_sum[3 * (size_t)i + (size_t)k] += c[k];
+    film->light_sum2[3 * (size_t)i + (size_t)k] += (double)c[k] * (double)c[k];
+  }
+}
+
 /* Mean of pixel (x, y) and the variance of that mean (sample variance / n;
- * 0 with fewer than two samples). */
+ * 0 with fewer than two samples), with light tracing's part added to both. */
 void iris_film_pixel(const iris_film *film, int x, int y, iris_vec3 *mean, iris_vec3 *var);
 
 /* Image with channels R, G, B and, when `variance`, var.R, var.G, var.B. */

@@ -1,5 +1,6 @@
 /* The path tracer; see integrator.h and docs/rendering.md. */
 #include "renderer/integrator.h"
+#include "renderer/light_trace.h"
 
 #include <string.h>
 
@@ -378,13 +379,32 @@ static float power_heuristic(float pa, float pb) {
   return a / (a + b);
 }
 
+/* The power heuristic over three strategies (the camera's two and light
+ * tracing's, at a reflector light paths start from), for the first. */
+static float power3(float pa, float pb, float pc) {
+  if (!(pa > 0.0f)) return 0.0f;
+  if (!isfinite(pa)) return 1.0f;
+  float a = pa * pa;
+  return a / (a + pb * pb + pc * pc);
+}
+
+/* Light tracing's density for the camera's path through reflector y (its
+ * shading point, seen from x0) with light from wi, in the units of the
+ * camera's light-sampling density there, per unit of that density: K (from
+ * x0, set where y was hit) times the density with which y's BSDF, lit from
+ * wi, reflects towards x0 (light_trace.c draws wout so). */
+static float light_trace_ratio(const iris_shading_point *y, float K, iris_vec3 wi) {
+  if (!(K > 0.0f)) return 0.0f;
+  return K * iris_bsdf_pdf(&y->bsdf, iris_frame_to_local(&y->frame, wi), y->wo_local);
+}
+
 /* Direct light at a shading point by light sampling (NEE), MIS-weighted
  * against the path's direction sampler when `mis`. The light was chosen at
  * the hit with the vertex's IRIS_SLOT_LIGHT_CHOICE (`choice`, see the path loop). */
 static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_point *sp,
                                const iris_light_choice *choice, const iris_sampler *rng, bool mis,
                                float p_light, iris_path_stats *stats, int8_t *outcome, float *value,
-                               const iris_vcache_params *vp, float sky_g) {
+                               const iris_vcache_params *vp, float sky_g, float lt_K) {
   float u0, u1;
   iris_sampler_slot2(rng, IRIS_SLOT_LIGHT_POS, &u0, &u1);
   iris_light_sample ls;
@@ -434,7 +454,12 @@ static iris_vec3 sample_direct(const iris_integrator *it, const iris_shading_poi
   const iris_vec3 fl = iris_mul(f, ls.L);
   *value = iris_avg3(fl) * fabsf(wl.z) / pdf;
   float w = 1.0f;
-  if (mis && !ls.delta) w = power_heuristic(pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
+  if (lt_K > 0.0f) { /* with light tracing (a delta light: the three share its discrete choice) */
+    const float pl = ls.delta ? 1.0f : pdf;
+    w = power3(pl, ls.delta ? 0.0f : iris_integrator_direction_pdf(it, sp, ls.wi), pl * light_trace_ratio(sp, lt_K, ls.wi));
+  } else if (mis && !ls.delta) {
+    w = power_heuristic(pdf, iris_integrator_direction_pdf(it, sp, ls.wi));
+  }
   return iris_scale(fl, fabsf(wl.z) * w * keep / pdf);
 }
 
@@ -483,6 +508,16 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
    * 0 where it does not */
   float sky_g = 0.0f, prev_sky_g = 0.0f;
   iris_vec3 L_connect = iris_v3(0, 0, 0);
+  /* Light tracing (light_trace.h): a path camera -> x0 -> y -> light with
+   * y a reflector light paths start from is light tracing's too. At x0 the
+   * camera's density of the hit (lt_W0) and of its bounce (lt_px0); at y,
+   * lt_K, the ratio of light tracing's density to the camera's for that path
+   * but for the parts that depend on the light's direction (light_trace_ratio). */
+  const iris_light_trace *lt = it->light_trace && !rec && mis ? it->light_trace : NULL;
+  float lt_W0 = 0.0f, lt_px0 = 0.0f, lt_K = 0.0f, prev_lt_K = 0.0f;
+  iris_vec3 lt_ng0 = {0, 0, 0};
+  bool lt_x0 = false; /* x0 not delta, nor its bounce */
+  iris_shading_point lt_y; /* y, while prev_lt_K > 0 */
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
     /* The map's tables load while the ray is traced and the hit shaded
@@ -513,7 +548,10 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         }
         env_pdf *= prev_light * prev_env_q;
         float w = 1.0f;
-        if (!prev_delta && nee) w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
+        if (!prev_delta && prev_lt_K > 0.0f)
+          w = power3(prev_pdf, env_pdf, env_pdf * light_trace_ratio(&lt_y, prev_lt_K, iris_normalize(ray.d)));
+        else if (!prev_delta && nee)
+          w = mis ? power_heuristic(prev_pdf, env_pdf) : 0.0f;
         L = iris_add(L, iris_scale(iris_mul(beta, le), w * sky_keep));
         if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
       }
@@ -527,9 +565,13 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     iris_vec3 le = iris_lights_emitted(it->lights, &si, ray.d);
     if (le.x > 0.0f || le.y > 0.0f || le.z > 0.0f) {
       float w = 1.0f;
-      if (!prev_delta && nee)
+      if (!prev_delta && prev_lt_K > 0.0f) {
+        const float pt = prev_light * iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si);
+        w = power3(prev_pdf, pt, pt * light_trace_ratio(&lt_y, prev_lt_K, iris_normalize(ray.d)));
+      } else if (!prev_delta && nee) {
         w = mis ? power_heuristic(prev_pdf, prev_light * iris_lights_pdf_triangle(it->lights, prev_p, prev_n, &si))
                 : 0.0f;
+      }
       if (!(vc_phase == 1 && vc_made)) L = iris_add(L, iris_scale(iris_mul(beta, le), w));
       if (last) last->miss = iris_scale(iris_mul(beta, le), 1.0f - w);
     }
@@ -538,6 +580,21 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
 
     iris_shading_point sp;
     iris_integrator_shade(it, &si, iris_neg(iris_normalize(ray.d)), bounce, &sp);
+    lt_K = 0.0f;
+    if (lt && bounce == 0) {
+      lt_W0 = si.front ? iris_light_trace_camera_density(lt, si.p, si.ng) : 0.0f;
+      lt_ng0 = si.ng;
+    } else if (lt && bounce == 1 && lt_x0 && si.front && lt->member[si.prim] && iris_light_trace_starts(&sp) &&
+               lt_W0 > 0.0f && lt_px0 > 0.0f) {
+      /* rho p_A |ng_x0.w0| / (W0 p_x0 |ng_y.w0|): light_trace.c's q over the
+       * light's density and the reflection's */
+      const iris_vec3 w0 = iris_normalize(ray.d);
+      const float cx = fabsf(iris_dot(w0, lt_ng0)), cy = fabsf(iris_dot(w0, si.ng));
+      if (cy > 0.0f && iris_dot(sp.wo, si.ng) > 0.0f) {
+        lt_K = lt->rho * lt->inv_area * cx / (lt_W0 * lt_px0 * cy);
+        lt_y = sp;
+      }
+    }
     if (vpool) {
       const bool in_a = iris_vcache_in_a(vp, si.p, iris_neg(ray.d)), plain = iris_vcache_plain(&sp, si.ng);
       if (vc_phase == 0 && in_a) {
@@ -603,7 +660,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       if (p_eff >= 1.0f || iris_sampler_slot(rng, IRIS_SLOT_LIGHT_SKIP) < p_eff)
       {
         const iris_vec3 dl = iris_mul(beta, sample_direct(it, &sp, &choice, rng, mis, p_eff, stats,
-                                                          &light_outcome, &light_value, vp, sky_g));
+                                                          &light_outcome, &light_value, vp, sky_g, lt_K));
         if (!(vc_phase == 1 && vc_made && it->lights->entries[choice.light].kind == IRIS_LIGHT_KIND_TRIANGLE))
           L = iris_add(L, dl);
       }
@@ -676,6 +733,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->light_id = choice.light;
       last->light_value = light_value;
     }
+    if (lt && bounce == 0) lt_x0 = !sp.delta && !ds.delta && iris_dot(ds.wi, si.ng) > 0.0f, lt_px0 = ds.pdf;
+    prev_lt_K = lt_K;
     prev_delta = ds.delta;
     prev_sky_g = sky_g;
     sky_g = 0.0f;

@@ -189,6 +189,9 @@ typedef struct iris_integrator {
   int rr_depth;       /* Russian roulette from this bounce on (default 3) */
   iris_direction_sampler guide; /* used by the guided methods; sample == NULL: BSDF */
   struct iris_vcache *vcache;   /* connections to a light-vertex cache (renderer/vcache.h); NULL: none */
+  /* light tracing of glossy caustics (renderer/light_trace.h; mis only):
+   * the camera's MIS weights at a reflector it starts from count it; NULL: none */
+  const struct iris_light_trace *light_trace;
   iris_material default_material; /* for meshes with material -1 (diffuse 0.8) */
 } iris_integrator;
 

@@ -14,6 +14,7 @@
 #include "core/rng.h"
 #include "renderer/camera_path.h"
 #include "renderer/memory.h"
+#include "renderer/light_trace.h"
 #include "renderer/merge.h"
 
 #define TILE 8
@@ -166,6 +167,9 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     if (p.connect != IRIS_CONNECT_AUTO) res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.connect, 0xc0ecULL, 3);
     if (p.connect_sky_map_q > 0.0f)
       res->config_hash = iris_hash4(res->config_hash, (uint64_t)(p.connect_sky_map_q * 1e9), 0xc0ecULL, 4);
+    /* light tracing refused: parts must agree (the default keeps the hash) */
+    if (p.light_trace != IRIS_LIGHT_TRACE_AUTO)
+      res->config_hash = iris_hash4(res->config_hash, (uint64_t)p.light_trace, 0x11e7ULL, 5);
   }
   /* What the render will need against what the machine has, before any of it
    * is built (docs/performance.md, "Memory estimate"). Logged (with the
@@ -403,6 +407,19 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   }
   /* every pixel holds the same number of training samples (whole passes) */
   if (st == IRIS_OK && res->film.count) res->train_spp = (int)res->film.count[0];
+  /* Light tracing of glossy caustics (light_trace.h): with mis, where a
+   * reflector qualifies; the light paths of sample index s are [s P, (s + 1) P)
+   * (uniform passes) or follow the rounds' samples from offset P (adaptive). */
+  iris_light_trace *light_trace = NULL;
+  if (st == IRIS_OK && p.light_trace != IRIS_LIGHT_TRACE_OFF && !p.no_passes)
+    st = iris_light_trace_create(&it, &res->camera, b.x0, b.y0, b.x1, b.y1, p.seed, p.threads, &light_trace, err);
+  if (st == IRIS_OK && light_trace) st = iris_film_light_paths_enable(&res->film, err);
+  if (st == IRIS_OK && light_trace) {
+    it.light_trace = light_trace;
+    light_trace->next = p.sample_offset * light_trace->per_index;
+    iris_infof("light tracing: %llu light paths per sample index from %zu reflector triangles (%.3g m^2)",
+               (unsigned long long)light_trace->per_index, light_trace->select.count, 1.0 / light_trace->inv_area);
+  }
   if (st == IRIS_OK) {
     stats = calloc((size_t)p.threads, sizeof *stats);
     if (!stats) st = iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory");
@@ -422,7 +439,7 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     iris_adaptive_job job = {&it, &res->camera, &res->film, p.seed, p.sample_offset, b.x0, b.y0, b.x1, b.y1,
                              p.threads, stats, p.spp + res->train_spp,
                              timed ? p.time_budget - (p.budget_includes_setup ? res->setup_seconds : 0.0) : 0.0,
-                             p.adaptive_progress, p.progress_ctx, p.adaptive};
+                             p.adaptive_progress, p.progress_ctx, p.adaptive, light_trace};
     if (timed && job.budget <= 0.0) job.budget = 1e-3; /* at least one round */
     iris_phase_begin("first-pass", "rendering the first image pass");
     if (p.phase) p.phase(p.phase_ctx, "rendering the first image pass", iris_time_now() - t0, 0.0);
@@ -489,6 +506,11 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
       uint64_t grain = tiles / (uint64_t)(8 * p.threads) + 1;
       if (grain > 4) grain = 4;
       iris_parallel_for(tiles, grain, p.threads, render_tiles, &c);
+      if (light_trace) { /* the light paths of these sample indices */
+        st = iris_light_trace_run(light_trace, &it, c.s0 * light_trace->per_index,
+                                  (uint64_t)n * light_trace->per_index, &res->film, err);
+        if (st != IRIS_OK) break;
+      }
       double dt = iris_time_now() - tp;
       if (done == 0) iris_phase_begin("image", "rendering image passes");
       done += n;
@@ -507,6 +529,16 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
     for (int i = 0; i < p.threads; i++) iris_path_stats_add(&res->stats, &stats[i]);
   }
   free(stats);
+  if (light_trace) { /* the light paths' rays count with the render's */
+    res->light_trace_rays = light_trace->rays;
+    iris_infof("light tracing: %.0f light paths, %llu (%.2f%%) added to a pixel, %.4g per pixel and path",
+               res->film.light_paths, (unsigned long long)light_trace->splats,
+               res->film.light_paths > 0 ? 100.0 * (double)light_trace->splats / res->film.light_paths : 0.0,
+               res->film.light_paths > 0 ? light_trace->energy / res->film.light_paths /
+                                              ((double)(b.x1 - b.x0) * (double)(b.y1 - b.y0)) : 0.0);
+    res->stats.rays += light_trace->rays;
+    iris_light_trace_destroy(light_trace);
+  }
   if (vcache) { /* the light paths' rays count with the render's */
     res->connect_rays = iris_vcache_rays(vcache);
     res->stats.rays += res->connect_rays;
@@ -549,6 +581,7 @@ iris_status iris_render_write_exr(const iris_render_result *r, const char *path,
   META("light_sampling", "%s", iris_triangle_sampling_name(r->light_sampling));
   META("light_sampler", "%s", iris_light_sampler_name(r->light_sampler));
   META("connect", "%s", r->connect_rays > 0 ? "on" : "off"); /* connections to a light-vertex cache ran */
+  META("light_paths", "%.0f", r->film.light_paths); /* light tracing's paths (0: none ran) */
   META("spp", "%d", r->spp);
   META("train_spp", "%d", r->train_spp);
   META("seed", "%llu", (unsigned long long)r->seed);

@@ -154,6 +154,9 @@ typedef struct iris_render_params {
    * one from its share (0, the default); tests set it to make that branch,
    * and its density, weigh. */
   float connect_sky_map_q;
+  /* Light tracing of glossy caustics (light_trace.h) with mis: AUTO where
+   * a surface qualifies and the scene places no instanced mesh, OFF never. */
+  enum { IRIS_LIGHT_TRACE_AUTO = 0, IRIS_LIGHT_TRACE_OFF } light_trace;
   const iris_guide_provider *guide; /* needed by the guided methods */
   const void *guide_options;        /* handed to guide->build (guiding: iris_guiding_params) */
   /* Partitioned renders (docs/distributed.md): sample indices sample_offset ..
@@ -192,6 +195,8 @@ typedef struct iris_render_result {
                                                   indirect)"; otherwise "" */
   bool raced;                   /* auto ran the race of mis against guided-nee */
   uint64_t connect_rays;        /* rays of the light paths the connections drew on (0: none ran; in stats.rays too) */
+  uint64_t light_trace_rays;    /* rays of light tracing's paths (0: none ran; in stats.rays too); the
+                                   paths are film.light_paths */
   iris_race_outcome race;       /* its measurements (when raced) */
   iris_sampler_kind sampler;
   iris_triangle_sampling light_sampling;

@@ -218,6 +218,7 @@ int iris_cmd_bench(int argc, char **argv) {
   iris_triangle_sampling light_sampling = (iris_triangle_sampling)ro.light_sampling;
   iris_light_sampler light_sampler = (iris_light_sampler)ro.light_sampler;
   p.connect = ro.connect;
+  p.light_trace = ro.light_trace;
   if (iris_options_seen(&rb, "max-depth")) p.max_depth = ro.max_depth;
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;

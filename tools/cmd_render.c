@@ -295,6 +295,7 @@ int iris_cmd_render(int argc, char **argv) {
   p.light_sampling = (iris_triangle_sampling)ro.light_sampling;
   p.light_sampler = (iris_light_sampler)ro.light_sampler;
   p.connect = ro.connect;
+  p.light_trace = ro.light_trace;
   if (iris_options_seen(rb, "max-depth")) p.max_depth = ro.max_depth;
   if (iris_options_seen(rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(rb, "width")) p.width = ro.width;

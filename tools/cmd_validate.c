@@ -206,6 +206,7 @@ int iris_cmd_validate(int argc, char **argv) {
   p.sampler = (iris_sampler_kind)ro.sampler; /* 0 (sobol) unless given */
   p.light_sampler = (iris_light_sampler)ro.light_sampler;
   p.connect = ro.connect;
+  p.light_trace = ro.light_trace;
   if (iris_options_seen(&rb, "threads")) p.threads = ro.threads;
   if (iris_options_seen(&rb, "width")) p.width = ro.width;
   if (iris_options_seen(&rb, "height")) p.height = ro.height;

@@ -50,6 +50,7 @@ static const char *const SAMPLER_CHOICES[] = {"sobol", "independent", NULL};
 static const char *const LIGHT_SAMPLING_CHOICES[] = {"solid-angle", "area", NULL};
 static const char *const LIGHT_SAMPLER_CHOICES[] = {"power", "tree", "learned", NULL}; /* iris_light_sampler */
 static const char *const CONNECT_CHOICES[] = {"auto", "off", "on", NULL}; /* iris_render_params.connect */
+static const char *const LIGHT_TRACE_CHOICES[] = {"auto", "off", NULL};    /* iris_render_params.light_trace */
 static const iris_option RENDER_ROWS[] = {
     OPT("spp", 0, IRIS_OPT_INT, "N", 1, 1 << 24, iris_render_options, spp,
         "samples per pixel (default: the scene's, else 64)"),
@@ -67,6 +68,8 @@ static const iris_option RENDER_ROWS[] = {
            "NEE's light choice: tree (default: the light tree) | power"),
     CHOICE("connect", "M", iris_render_options, connect, CONNECT_CHOICES,
            "guided methods: connections to light paths kept behind the\nopening the guide found, or of the sky through its windows:\nauto (default: where enough of the caches' light came\nthrough them) | off | on"),
+    CHOICE("light-trace", "M", iris_render_options, light_trace, LIGHT_TRACE_CHOICES,
+           "mis: light paths off glossy reflectors (roughness <= 0.3)\ninto the camera, their caustics' light shared with the\ncamera by MIS: auto (default: where such a reflector is) | off"),
     OPT("max-depth", 0, IRIS_OPT_INT, "B", 0, 1000000, iris_render_options, max_depth,
         "bounces as Cycles counts them, 0 = direct light (default 64)"),
     OPT("threads", 0, IRIS_OPT_INT, "N", 1, 4096, iris_render_options, threads,

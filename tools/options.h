@@ -114,6 +114,7 @@ typedef struct iris_render_options {
   int light_sampling; /* iris_triangle_sampling */
   int light_sampler;  /* iris_light_sampler; commands set IRIS_LIGHT_SAMPLER_DEFAULT before parsing */
   int connect;        /* iris_render_params.connect (0: auto) */
+  int light_trace;    /* iris_render_params.light_trace (0: auto) */
   int max_depth;
   int threads;
   int width, height;

@@ -796,6 +796,7 @@ iris_status iris_bench_run(const iris_bench_params *params, iris_bench_result *r
           rp.keep_training = p.keep_training[k];
           rp.light_sampler = p.light_samplers[k];
           rp.connect = p.connect;
+          rp.light_trace = p.light_trace;
           if (p.adaptive[k] != IRIS_ADAPTIVE_OFF) {
             /* @freeze: Cycles' rule at Blender's threshold; @adaptive: the
              * relMSE allocation with the budget alone deciding. No spp cap. */

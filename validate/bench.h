@@ -56,6 +56,7 @@ typedef struct iris_bench_params {
   bool keep_training[IRIS_BENCH_MAX_METHODS];
   iris_light_sampler light_samplers[IRIS_BENCH_MAX_METHODS]; /* NEE's light choice (@power, @tree) */
   int connect; /* iris_render_params.connect for every row (--connect) */
+  int light_trace; /* iris_render_params.light_trace for every row (--light-trace) */
   iris_adaptive_rule adaptive[IRIS_BENCH_MAX_METHODS]; /* @adaptive: relmse allocation, the budget
                                                            deciding; @freeze: Cycles' rule at
                                                            IRIS_BENCH_ADAPTIVE_THRESHOLD, the budget a cap */

@@ -613,6 +613,7 @@ iris_status iris_validate_run(const iris_validate_params *params, iris_validate_
     rp.sampler = p.sampler;
     rp.light_sampler = p.light_sampler;
     rp.connect = p.connect;
+    rp.light_trace = p.light_trace;
     rp.seed = p.seed;
     rp.threads = p.threads;
     rp.method = p.methods[k];

@@ -65,6 +65,7 @@ typedef struct iris_validate_params {
   iris_sampler_kind sampler; /* iris's sampler (default sobol) */
   iris_light_sampler light_sampler; /* NEE's light choice (default IRIS_LIGHT_SAMPLER_DEFAULT) */
   int connect;                      /* iris_render_params.connect (--connect) */
+  int light_trace; /* iris_render_params.light_trace (--light-trace) */
   int spp;                  /* iris samples per pixel (0: IRIS_VALIDATE_DEFAULT_SPP) */
   uint64_t seed;
   int threads;              /* <= 0: all cores (iris and Blender) */

@@ -1,0 +1,294 @@
+/* Light tracing of glossy caustics into the camera; see light_trace.h. */
+#include "renderer/light_trace.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/parallel.h"
+#include "core/log.h"
+#include "core/rng.h"
+#include "renderer/bsdf.h"
+#include "renderer/lights.h"
+
+#define BLOCK 256 /* light paths per block: a block's splats are added in its order */
+#define SALT 0x11e7a7ace5ULL
+
+void iris_light_trace_destroy(iris_light_trace *lt) {
+  if (!lt) return;
+  free(lt->member);
+  free(lt->tris);
+  iris_distrib1d_destroy(&lt->select);
+  free(lt);
+}
+
+static iris_status pilot_splats(iris_light_trace *lt, const iris_integrator *it, uint64_t count, uint64_t *splats,
+                                iris_error *err);
+
+iris_status iris_light_trace_create(const iris_integrator *it, const iris_pinhole *cam, int x0, int y0, int x1,
+                                    int y1, uint64_t seed, int threads, iris_light_trace **out, iris_error *err) {
+  *out = NULL;
+  if (it->method != IRIS_METHOD_MIS || it->lights->count == 0 || it->max_depth < 1) return IRIS_OK;
+  size_t unique = 0, placed = 0;
+  iris_accel_stats(it->accel, &unique, &placed);
+  if (placed > 0) return IRIS_OK;
+  const uint32_t n = iris_accel_triangle_count(it->accel);
+  if (n == 0) return IRIS_OK;
+  iris_light_trace *lt = calloc(1, sizeof *lt);
+  float *w = lt ? malloc((size_t)n * sizeof *w) : NULL;
+  if (lt) {
+    lt->member = calloc(n, 1);
+    lt->tris = malloc((size_t)n * sizeof *lt->tris);
+  }
+  if (!lt || !w || !lt->member || !lt->tris) {
+    free(w);
+    iris_light_trace_destroy(lt);
+    return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (light tracing)");
+  }
+  uint32_t m = 0;
+  double area = 0.0;
+  for (uint32_t i = 0; i < n; ++i) {
+    iris_interaction si;
+    iris_accel_surface_at(it->accel, i, 1.0f / 3.0f, 1.0f / 3.0f, &si);
+    iris_shading_point sp;
+    iris_integrator_shade(it, &si, si.ns, 1, &sp);
+    /* a triangle whose centroid qualifies; each point is asked again
+     * (iris_light_trace_starts: a texture may make parts rougher) */
+    if (!iris_light_trace_starts(&sp)) continue;
+    iris_vec3 v[3];
+    iris_accel_triangle(it->accel, i, v);
+    const float a = 0.5f * iris_length(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));
+    if (!(a > 0.0f) || !isfinite(a)) continue;
+    lt->member[i] = 1;
+    lt->tris[m] = i;
+    w[m++] = a;
+    area += a;
+  }
+  iris_status st = IRIS_OK;
+  if (m > 0) st = iris_distrib1d_create(&lt->select, w, m, err);
+  free(w);
+  if (m == 0 || st != IRIS_OK || !(area > 0.0)) {
+    iris_light_trace_destroy(lt);
+    return st;
+  }
+  lt->cam = *cam;
+  lt->x0 = x0, lt->y0 = y0, lt->x1 = x1, lt->y1 = y1;
+  lt->inv_area = (float)(1.0 / area);
+  const double per = ceil((double)cam->width * (double)cam->height * IRIS_LIGHT_TRACE_PER_SAMPLE);
+  lt->per_index = (uint64_t)per;
+  lt->rho = (float)per;
+  lt->pixel_area = (2.0f * cam->tan_half_yfov * cam->aspect / (float)cam->width) *
+                   (2.0f * cam->tan_half_yfov / (float)cam->height);
+  lt->seed = seed;
+  lt->threads = threads;
+  /* Where the reflectors' light seldom reaches what the camera sees (veach-mis's
+   * plates send the lamps out of the frame: 0.03% of the paths land), the
+   * light paths would only cost: a pilot of the first paths decides. */
+  const uint64_t pn = 4 * lt->per_index < IRIS_LIGHT_TRACE_PILOT ? 4 * lt->per_index : IRIS_LIGHT_TRACE_PILOT;
+  uint64_t hits = 0;
+  st = pilot_splats(lt, it, pn, &hits, err);
+  lt->pilot_paths = pn, lt->pilot_splats = hits;
+  if (st != IRIS_OK || (double)hits < IRIS_LIGHT_TRACE_PILOT_SHARE * (double)pn) {
+    iris_light_trace_destroy(lt);
+    if (st == IRIS_OK) iris_infof("light tracing: off (%llu of %llu light paths of a pilot reached the camera, < %.0f%%)",
+                                  (unsigned long long)hits, (unsigned long long)pn, 100.0 * IRIS_LIGHT_TRACE_PILOT_SHARE);
+    return st;
+  }
+  *out = lt;
+  return IRIS_OK;
+}
+
+/* What one light path adds to one pixel. */
+typedef struct splat {
+  uint32_t pixel; /* in the window */
+  float c[3];
+} splat;
+
+typedef struct block_out {
+  splat *v;
+  size_t n, cap;
+  uint64_t rays;
+  bool oom;
+} block_out;
+
+static void push(block_out *b, uint32_t pixel, iris_vec3 c) {
+  if (b->n == b->cap) {
+    size_t cap = b->cap ? 2 * b->cap : 64;
+    splat *v = realloc(b->v, cap * sizeof *v);
+    if (!v) {
+      b->oom = true;
+      return;
+    }
+    b->v = v, b->cap = cap;
+  }
+  b->v[b->n++] = (splat){pixel, {c.x, c.y, c.z}};
+}
+
+/* The power heuristic over three strategies, for the first. */
+static float power3(float a, float b, float c) {
+  if (!(a > 0.0f)) return 0.0f;
+  if (!isfinite(a)) return 1.0f;
+  return a * a / (a * a + b * b + c * c);
+}
+
+/* Light path `index`: y on a reflector, a light sample there, the reflection
+ * to x0, x0 into the camera (the formulas: docs/rendering.md). */
+static void trace_one(const iris_light_trace *lt, const iris_integrator *it, uint64_t index, block_out *out) {
+  const iris_sampler r = iris_sampler_start(lt->seed ^ SALT, index, 0);
+  float pmf, u_rest;
+  const size_t k = iris_distrib1d_sample(&lt->select, iris_sampler_get(&r, 0), &pmf, &u_rest);
+  float b1 = iris_sampler_get(&r, 1), b2 = iris_sampler_get(&r, 2);
+  if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+  iris_interaction ys;
+  iris_accel_surface_at(it->accel, lt->tris[k], b1, b2, &ys);
+  /* the light as next-event estimation at y draws it (light_normal there:
+   * the geometric normal of a reflect-only BSDF) */
+  iris_light_choice choice;
+  iris_lights_choose(it->lights, ys.p, ys.ng, iris_sampler_get(&r, 3), &choice);
+  iris_light_sample ls;
+  if (!iris_lights_sample_choice(it->lights, ys.p, &choice, iris_sampler_get(&r, 4), iris_sampler_get(&r, 5), &ls))
+    return;
+  const iris_vec3 wl = ls.wi; /* towards the light */
+  if (!(iris_dot(wl, ys.ng) > 0.0f) || !(ls.pdf > 0.0f)) return;
+  /* y lit from wl reflects towards wout, drawn by its BSDF with wl as the
+   * outgoing direction (reciprocity) */
+  iris_shading_point yl;
+  iris_integrator_shade(it, &ys, wl, 1, &yl);
+  if (!iris_light_trace_starts(&yl)) return;
+  iris_direction_sample ds;
+  if (!iris_integrator_sample_bsdf_u(&yl, iris_sampler_get(&r, 6), iris_sampler_get(&r, 7), iris_sampler_get(&r, 8),
+                                     &ds) ||
+      ds.delta || !(ds.pdf > 0.0f))
+    return;
+  const iris_vec3 wout = ds.wi;
+  const float cos_yg = iris_dot(wout, ys.ng);
+  if (!(cos_yg > 0.0f)) return;
+  iris_ray ray = iris_spawn_ray(&ys, wout);
+  iris_hit hit;
+  out->rays++;
+  if (!iris_accel_intersect(it->accel, &ray, &hit)) return;
+  iris_interaction xs;
+  iris_accel_interaction(it->accel, ray.d, &hit, &xs);
+  if (!xs.front) return; /* x0 lit from its front, as the camera's bounce leaves it (no medium between) */
+  /* x0's pixel: the pinhole's projection (camera.c's ray, inverted) */
+  const iris_pinhole *cam = &lt->cam;
+  const iris_vec3 v = iris_sub(xs.p, cam->origin);
+  const float dist = iris_length(v);
+  if (!(dist > 0.0f)) return;
+  const iris_vec3 dir = iris_scale(v, 1.0f / dist);
+  const float zc = iris_dot(dir, cam->forward);
+  if (!(zc > 0.0f) || !(iris_dot(dir, xs.ng) < 0.0f)) return; /* seen from its front */
+  const float rx = (iris_dot(dir, cam->right) / zc / (cam->tan_half_yfov * cam->aspect) + 1.0f) * 0.5f * (float)cam->width;
+  const float ry = (1.0f - iris_dot(dir, cam->up) / zc / cam->tan_half_yfov) * 0.5f * (float)cam->height;
+  if (!(rx >= (float)lt->x0 && rx < (float)lt->x1 && ry >= (float)lt->y0 && ry < (float)lt->y1)) return;
+  const int px = (int)rx, py = (int)ry;
+  if (px < lt->x0 || px >= lt->x1 || py < lt->y0 || py >= lt->y1) return;
+  iris_shading_point xp;
+  iris_integrator_shade(it, &xs, iris_neg(dir), 0, &xp);
+  if (xp.delta) return;
+  const iris_vec3 w0 = iris_neg(wout); /* at x0, towards y */
+  const iris_vec3 f0 = iris_integrator_bsdf_eval(&xp, w0);
+  const float cos_x0g = fabsf(iris_dot(w0, xs.ng));
+  const float W = iris_light_trace_camera_density(lt, xs.p, xs.ng);
+  if (!(iris_max3(f0) > 0.0f) || !(cos_x0g > 0.0f) || !(W > 0.0f)) return;
+  const iris_vec3 fy = iris_integrator_bsdf_eval(&yl, wout);
+  if (!(iris_max3(fy) > 0.0f)) return;
+  /* the camera's densities for the same path: its direction sampler at x0
+   * towards y, and at y (seen from x0) its BSDF sampling towards the light */
+  iris_integrator_prepare_direction(it, &xp);
+  const float p_x0 = iris_integrator_direction_pdf(it, &xp, w0);
+  iris_shading_point yc;
+  iris_integrator_shade(it, &ys, wout, 1, &yc);
+  if (!iris_light_trace_starts(&yc)) return; /* the camera's test, at its own shading of y */
+  iris_integrator_prepare_direction(it, &yc);
+  const float p_l = ls.delta ? 1.0f : ls.pdf;
+  const float p_b = ls.delta ? 0.0f : iris_integrator_direction_pdf(it, &yc, wl);
+  /* this strategy's density in the camera's units (light_trace.h's rho
+   * paths per sample index against one camera sample of the pixel) */
+  const float q = p_x0 > 0.0f ? lt->rho * lt->inv_area * p_l * ds.pdf * cos_x0g / (W * p_x0 * cos_yg) : INFINITY;
+  const float weight = isfinite(q) ? power3(q, p_l, p_b) : 1.0f;
+  if (!(weight > 0.0f)) return;
+  /* unoccluded: y to the light, x0 to the camera */
+  iris_ray sh;
+  if (isfinite(ls.dist) && !ls.delta) {
+    sh = iris_spawn_ray_to(ys.p, ys.ng, ls.p, ls.n);
+  } else {
+    sh = iris_spawn_ray(&ys, wl);
+    if (isfinite(ls.dist)) sh.tmax = ls.dist * (1.0f - 1e-5f);
+  }
+  out->rays++;
+  if (iris_accel_occluded(it->accel, &sh)) return;
+  const iris_ray sc = iris_spawn_ray_to(xs.p, xs.ng, cam->origin, iris_v3(0, 0, 0));
+  out->rays++;
+  if (iris_accel_occluded(it->accel, &sc)) return;
+  iris_lights_sample_radiance(it->lights, &ls);
+  /* L f_y |ns_y.wl| |ng_y.wout| / (p_A p_l p_y) * f_x0 |ns_x0.w0| / |ng_x0.w0| * W */
+  const float s = fabsf(iris_dot(wl, ys.ns)) * cos_yg / (lt->inv_area * p_l * ds.pdf) *
+                  fabsf(iris_dot(w0, xs.ns)) / cos_x0g * W * weight;
+  const iris_vec3 c = iris_scale(iris_mul(iris_mul(ls.L, fy), f0), s);
+  if (!iris_isfinite3(c) || !(iris_max3(c) > 0.0f)) return;
+  push(out, (uint32_t)((py - lt->y0) * (lt->x1 - lt->x0) + (px - lt->x0)), c);
+}
+
+typedef struct run_ctx {
+  const iris_light_trace *lt;
+  const iris_integrator *it;
+  uint64_t first, count;
+  block_out *blocks;
+} run_ctx;
+
+static void run_blocks(void *vctx, uint64_t begin, uint64_t end, int thread) {
+  (void)thread;
+  run_ctx *c = (run_ctx *)vctx;
+  for (uint64_t b = begin; b < end; ++b) {
+    const uint64_t i0 = b * BLOCK, i1 = i0 + BLOCK < c->count ? i0 + BLOCK : c->count;
+    for (uint64_t i = i0; i < i1; ++i) trace_one(c->lt, c->it, c->first + i, &c->blocks[b]);
+  }
+}
+
+/* The pilot (iris_light_trace_create): how many of the first light paths
+ * add to a pixel anywhere in the frame (a function of the scene, camera and
+ * seed alone: every window and part decides alike). */
+static iris_status pilot_splats(iris_light_trace *lt, const iris_integrator *it, uint64_t count, uint64_t *splats,
+                                iris_error *err) {
+  const int x0 = lt->x0, y0 = lt->y0, x1 = lt->x1, y1 = lt->y1;
+  lt->x0 = 0, lt->y0 = 0, lt->x1 = lt->cam.width, lt->y1 = lt->cam.height;
+  const uint64_t nb = (count + BLOCK - 1) / BLOCK;
+  run_ctx c = {lt, it, 0, count, calloc((size_t)nb, sizeof(block_out))};
+  if (c.blocks) iris_parallel_for(nb, 1, lt->threads, run_blocks, &c);
+  *splats = 0;
+  bool oom = !c.blocks;
+  for (uint64_t b = 0; c.blocks && b < nb; ++b) {
+    *splats += c.blocks[b].n;
+    oom |= c.blocks[b].oom;
+    free(c.blocks[b].v);
+  }
+  free(c.blocks);
+  lt->x0 = x0, lt->y0 = y0, lt->x1 = x1, lt->y1 = y1;
+  return oom ? iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (light tracing)") : IRIS_OK;
+}
+
+iris_status iris_light_trace_run(iris_light_trace *lt, const iris_integrator *it, uint64_t first, uint64_t count,
+                                 iris_film *film, iris_error *err) {
+  if (count == 0) return IRIS_OK;
+  const uint64_t nb = (count + BLOCK - 1) / BLOCK;
+  run_ctx c = {lt, it, first, count, calloc((size_t)nb, sizeof(block_out))};
+  if (!c.blocks) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (light tracing)");
+  iris_parallel_for(nb, 1, lt->threads, run_blocks, &c);
+  bool oom = false;
+  for (uint64_t b = 0; b < nb; ++b) { /* in index order: the same sums for any threads */
+    const block_out *o = &c.blocks[b];
+    oom |= o->oom;
+    lt->rays += o->rays;
+    lt->splats += o->n;
+    for (size_t j = 0; j < o->n; ++j) {
+      iris_film_add_light_path(film, o->v[j].pixel, o->v[j].c);
+      lt->energy += ((double)o->v[j].c[0] + o->v[j].c[1] + o->v[j].c[2]) / 3.0;
+    }
+    free(o->v);
+  }
+  free(c.blocks);
+  if (oom) return iris_error_set(err, IRIS_ERR_NOMEM, NULL, 0, NULL, "out of memory (light tracing)");
+  film->light_paths += (double)count;
+  return IRIS_OK;
+}
