@@ -85,6 +85,10 @@ typedef struct iris_guide_setup {
   /* --light-sampler learned: the guide also learns which lights its caches
    * see (renderer/guiding/light_select.h) for iris_guide_provider.light_select. */
   bool learn_lights;
+  /* --method auto: mis would trace light paths off glossy reflectors that
+   * reach the camera (light_trace.h): the rule that keeps the guide for
+   * light focused through glass yields to it (docs/guiding.md, "--method auto"). */
+  bool mis_light_traces;
 } iris_guide_setup;
 
 /* Builds a direction sampler (and its state) for the guided methods;

@@ -147,6 +147,22 @@ static bool keeps_for_caustics(iris_guiding *g, const iris_photon_map *photons) 
   return true;
 }
 
+/* The caustic exception, but not for `auto` where mis traces light paths
+ * off glossy reflectors that reach the camera (s->mis_light_traces,
+ * renderer/light_trace.h): there mis carries the reflectors' caustics, which
+ * the guide finds only through its glint spots, and on env-spheres with a
+ * glass sphere it had 1.9x less relMSE than guided-nee at 4 s (docs/guiding.md,
+ * "--method auto"). */
+static bool caustics_keep(iris_guiding *g, const iris_guide_setup *s, const iris_photon_map *photons) {
+  if (s->deciding && s->mis_light_traces) return false;
+  return keeps_for_caustics(g, photons);
+}
+
+/* What a skip's reason adds where light tracing made the caustic exception yield. */
+static const char *light_trace_note(const iris_guide_setup *s) {
+  return s->deciding && s->mis_light_traces ? "; mis traces light paths off the glossy reflectors" : "";
+}
+
 /* --method auto only (s->deciding; an explicit guided-nee is built anyway):
  * skips the guide where what the camera sees is lit mostly directly, on the
  * first photons it is given (the pilot's, or the full pass's without one). */
@@ -154,10 +170,10 @@ static bool auto_declines(iris_guiding *g, const iris_guide_setup *s, const iris
   if (!s->deciding || g->params.force || g->stats.seen_indirect_energy >= 0.0) return false;
   g->stats.seen_indirect_energy = seen_indirect_energy(s, photons);
   if (!(g->stats.seen_indirect_energy >= 0.0 && g->stats.seen_indirect_energy < IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN)) return false;
-  if (keeps_for_caustics(g, photons)) return false;
+  if (caustics_keep(g, s, photons)) return false;
   char why[160];
-  snprintf(why, sizeof why, "what the camera sees is lit mostly directly: %.0f%% of its photon energy indirect (< %.0f%%)",
-           100.0 * g->stats.seen_indirect_energy, 100.0 * IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN);
+  snprintf(why, sizeof why, "what the camera sees is lit mostly directly: %.0f%% of its photon energy indirect (< %.0f%%)%s",
+           100.0 * g->stats.seen_indirect_energy, 100.0 * IRIS_GUIDING_AUTO_SEEN_INDIRECT_MIN, light_trace_note(s));
   iris_guiding_skip(g, why);
   return true;
 }
@@ -230,10 +246,10 @@ iris_status iris_guiding_pilot(iris_guiding *g, const iris_guide_setup *s, size_
   g->stats.pilot_share = indirect_share(s, photons);
   g->stats.pilot_seconds = iris_time_now() - t0;
   if (photons->count > 0 && g->stats.pilot_share < INDIRECT_MIN && !keeps_for_glints(g, s, photons) &&
-      !keeps_for_caustics(g, photons)) {
+      !caustics_keep(g, s, photons)) {
     char why[160];
-    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons in a %llu-path pilot",
-             100.0 * g->stats.pilot_share, (unsigned long long)photons->paths);
+    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons in a %llu-path pilot%s",
+             100.0 * g->stats.pilot_share, (unsigned long long)photons->paths, light_trace_note(s));
     iris_guiding_skip(g, why);
     iris_photons_destroy(photons);
     return IRIS_OK;
@@ -248,10 +264,10 @@ bool iris_guiding_declines(iris_guiding *g, const iris_guide_setup *s, const iri
    * (docs/guiding.md, benchmark). Door 75%, Cornell 65%. */
   g->stats.indirect_share = indirect_share(s, photons);
   if (p->use_nee && !p->force && g->stats.indirect_share < INDIRECT_MIN && !keeps_for_glints(g, s, photons) &&
-      !keeps_for_caustics(g, photons)) {
+      !caustics_keep(g, s, photons)) {
     char why[160];
-    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons",
-             100.0 * g->stats.indirect_share);
+    snprintf(why, sizeof why, "the scene is lit mostly directly: %.0f%% indirect photons%s",
+             100.0 * g->stats.indirect_share, light_trace_note(s));
     iris_guiding_skip(g, why);
     return true;
   }

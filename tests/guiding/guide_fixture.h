@@ -69,7 +69,7 @@ static inline bool test_guide_builtin_open(const char *name, iris_method method,
  * no time budget, not deciding for auto, no film, no phases. */
 static inline iris_guide_setup test_guide_setup(const iris_scene *s, test_guide_scene *t, uint64_t seed, int threads,
                                                 int spp) {
-  iris_guide_setup gs = {s, t->acc, &t->lights, &t->tx, &t->cam, &t->it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false};
+  iris_guide_setup gs = {s, t->acc, &t->lights, &t->tx, &t->cam, &t->it, seed, threads, NULL, spp, 0.0, IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, false, false};
   return gs;
 }
 

@@ -3,8 +3,10 @@
  *    veach-mis, furnace-diffuse, a scene without lights and a view of nothing
  *    but mirrors, with the reason recorded in the result; stress-caustic, lit
  *    mostly directly, keeps its guide for the light its glass focuses, and so
- *    do the glass spheres on every seed, their pilot going on where it holds
- *    too few caustic photons to decide; both render guided-nee without a race;
+ *    do the glass spheres on every seed (with light tracing off), their pilot
+ *    going on where it holds too few caustic photons to decide; both render
+ *    guided-nee without a race; with light tracing the glass spheres render
+ *    mis, which traces light off their metal spheres;
  *  - the pilot traces fewer photon paths than the full pass and takes the
  *    decision the full pass takes (the same build with --pilot 0), and where
  *    guiding goes on the guide is the one built without a pilot (same photon
@@ -44,10 +46,13 @@ static bool keep_decision(const void *state, char *why, size_t size, bool *settl
 }
 static const iris_guide_provider KEEP = {keep_build, keep_destroy, keep_decision, NULL, NULL};
 
+static bool g_light_trace_off; /* renders with --light-trace off */
+
 /* Renders `s` with `method` (spp samples, w x h); pilot: -1 auto, 0 none. */
 static bool render(const iris_scene *s, iris_method method, int w, int h, int spp, uint64_t seed, int64_t pilot,
                    iris_render_result *r) {
   iris_render_params p = iris_test_params(w, h, spp, method, seed);
+  p.light_trace = g_light_trace_off ? IRIS_LIGHT_TRACE_OFF : IRIS_LIGHT_TRACE_AUTO;
   iris_guiding_params gp = iris_guiding_params_default();
   gp.pilot_paths = pilot;
   p.threads = 2;
@@ -187,10 +192,23 @@ static void test_decisions(void) {
  * seed keeps the guide (without that, seeds whose pilot held 14 or 15 went to
  * mis without a race). The light the guide was kept for is what a race's few
  * paths per pixel rarely carry (the race said mis on one seed of eight at
- * 108 x 72), so guided-nee renders without one. */
+ * 108 x 72), so guided-nee renders without one. All that with light tracing
+ * off; with it (the default) mis traces light paths off the metal spheres
+ * and the caustic rule yields: mis on every seed, with light tracing. */
 static void test_caustic_pilot(void) {
   iris_scene *s = make_scene("spheres-glass");
   if (!CHECK(s != NULL)) return;
+  int traced = 0;
+  for (int seed = 0; seed < 4; seed++) {
+    iris_render_result r;
+    if (!CHECK(render(s, IRIS_METHOD_AUTO, 32, 24, 1, (uint64_t)seed, -1, &r))) continue;
+    printf("spheres-glass seed %d with light tracing: %s\n", seed, r.method_reason);
+    traced += r.method == IRIS_METHOD_MIS && !r.raced && r.film.light_sum != NULL &&
+              strstr(r.method_reason, "mis traces light paths off the glossy reflectors") != NULL;
+    iris_render_result_destroy(&r);
+  }
+  iris_check_record(traced == 4, __FILE__, __LINE__, "mis with light tracing on %d of 4 seeds", traced);
+  g_light_trace_off = true;
   int kept = 0, extended = 0, unraced = 0;
   const int seeds = 8;
   for (int seed = 0; seed < seeds; seed++) {
@@ -210,6 +228,7 @@ static void test_caustic_pilot(void) {
   iris_check_record(extended >= 1, __FILE__, __LINE__, "no seed's pilot went on (%d)", extended);
   iris_check_record(unraced == seeds, __FILE__, __LINE__, "guided-nee without a race on %d of %d seeds", unraced,
                     seeds);
+  g_light_trace_off = false;
   iris_scene_destroy(s);
 }
 

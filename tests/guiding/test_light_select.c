@@ -99,7 +99,7 @@ static bool world_build_trained(world *w, const char *name, int threads, int tra
   gp.train_spp = train_spp;
   gp.pilot_paths = 0;
   iris_guide_setup gs = {w->s, w->accel, &w->lights, &w->tex, &w->cam, &it, 7, threads, NULL, 16, 0.0,
-                         IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true};
+                         IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true, false};
   if (!ok(iris_guiding_build(&gs, &gp, &w->g, &err), &err)) return false;
   w->lights.learned = iris_light_select_hooks(&w->g->lights);
   return CHECK(w->lights.learned.choose != NULL);
@@ -335,7 +335,7 @@ int main(void) {
         gp.light_samples = samples != 0;
         gp.train_spp = 4; /* the render's 16 spp would give 5% of them: none */
         iris_guide_setup gs = {w.s, w.accel, &w.lights, &w.tex, &w.cam, &it, 7, 2, &gp, 16, 0.0,
-                               IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true};
+                               IRIS_SAMPLER_SOBOL, false, NULL, NULL, 0.0, NULL, {0, 0, 0, 0}, true, false};
         iris_error err;
         iris_error_clear(&err);
         void *state = NULL;
