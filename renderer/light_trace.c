@@ -55,6 +55,11 @@ iris_status iris_light_trace_create(const iris_integrator *it, const iris_pinhol
     /* a triangle whose centroid qualifies; each point is asked again
      * (iris_light_trace_starts: a texture may make parts rougher) */
     if (!iris_light_trace_starts(&sp)) continue;
+    /* cut-out and see-through surfaces are not where a camera ray always
+     * stops: left to the camera */
+    const int32_t mi = iris_accel_triangle_material(it->accel, i);
+    if (mi >= 0 && (size_t)mi < it->scene->material_count && it->scene->materials[mi].alpha_mode != IRIS_ALPHA_OPAQUE)
+      continue;
     iris_vec3 v[3];
     iris_accel_triangle(it->accel, i, v);
     const float a = 0.5f * iris_length(iris_cross(iris_sub(v[1], v[0]), iris_sub(v[2], v[0])));

@@ -1,5 +1,6 @@
 /* Memory estimate and availability; see memory.h. */
 #include "renderer/memory.h"
+#include "renderer/light_trace.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -151,6 +152,15 @@ void iris_memory_estimate_scene(const iris_scene *s, int width, int height, bool
       }
   }
   out->film = (uint64_t)(FILM_BYTES_PER_PIXEL * (double)width * height);
+  /* light tracing's sums (light_trace.h: 6 doubles per pixel) where a
+   * material may be a glossy reflector; its tables, 5 bytes per triangle,
+   * are not counted (a few percent of the BVH's) */
+  for (size_t m = 0; m < s->material_count; m++)
+    if (s->materials[m].type != IRIS_MATERIAL_DIFFUSE &&
+        (s->materials[m].roughness <= IRIS_LIGHT_TRACE_ROUGHNESS || s->materials[m].metallic_roughness_texture >= 0)) {
+      out->film += (uint64_t)(48.0 * (double)width * height);
+      break;
+    }
   out->base = (uint64_t)BASE_BYTES;
   out->total = out->scene + out->accel + out->textures + out->lights + out->guide + out->film + out->base;
 }
