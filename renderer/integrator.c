@@ -518,6 +518,9 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_vec3 lt_ng0 = {0, 0, 0};
   bool lt_x0 = false; /* x0 not delta, nor its bounce */
   iris_shading_point lt_y; /* y, while prev_lt_K > 0 */
+  /* The second kind (light through clear glass and mirrors): delta vertices
+   * since x0 while the path may be one of its light paths, -1 when not. */
+  int lt_chain = -1;
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
     /* The map's tables load while the ray is traced and the hit shaded
@@ -535,6 +538,10 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         sky_keep = iris_vcache_sky_keep(vp, prev_p, ray.d, prev_n, prev_sky_g);
         if (!(sky_keep > 0.0f)) break;
       }
+      /* the sun through glass or off a mirror seen from x0: the light paths' (light_trace.h) */
+      if (lt_chain >= 1 && prev_delta &&
+          iris_envmap_pdf(it->lights->envmap, iris_normalize(ray.d)) >= lt->sun_pdf)
+        break;
       float env_pdf = 0.0f, st[2];
       iris_vec3 le = iris_lights_environment_pdf(it->lights, ray.d, prev_p, prev_n,
                                                  !prev_delta && mis ? &env_pdf : NULL, st);
@@ -584,8 +591,8 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (lt && bounce == 0) {
       lt_W0 = si.front ? iris_light_trace_camera_density(lt, si.p, si.ng) : 0.0f;
       lt_ng0 = si.ng;
-    } else if (lt && bounce == 1 && lt_x0 && si.front && lt->member[si.prim] && iris_light_trace_starts(&sp) &&
-               lt_W0 > 0.0f && lt_px0 > 0.0f) {
+    } else if (lt && bounce == 1 && lt_x0 && si.front && lt->member[si.prim] == IRIS_LIGHT_TRACE_GLOSSY &&
+               iris_light_trace_starts(&sp) && lt_W0 > 0.0f && lt_px0 > 0.0f) {
       /* rho p_A |ng_x0.w0| / (W0 p_x0 |ng_y.w0|): light_trace.c's q over the
        * light's density and the reflection's */
       const iris_vec3 w0 = iris_normalize(ray.d);
@@ -595,6 +602,9 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         lt_y = sp;
       }
     }
+    if (lt_chain >= 0 && bounce >= 1) /* on through delta surfaces the light paths start from */
+      lt_chain = lt->member[si.prim] == IRIS_LIGHT_TRACE_DELTA && sp.delta && lt_chain < IRIS_LIGHT_TRACE_CHAIN
+                     ? lt_chain + 1 : -1;
     if (vpool) {
       const bool in_a = iris_vcache_in_a(vp, si.p, iris_neg(ray.d)), plain = iris_vcache_plain(&sp, si.ng);
       if (vc_phase == 0 && in_a) {
@@ -733,7 +743,10 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
       last->light_id = choice.light;
       last->light_value = light_value;
     }
-    if (lt && bounce == 0) lt_x0 = !sp.delta && !ds.delta && iris_dot(ds.wi, si.ng) > 0.0f, lt_px0 = ds.pdf;
+    if (lt && bounce == 0) {
+      lt_x0 = !sp.delta && !ds.delta && iris_dot(ds.wi, si.ng) > 0.0f, lt_px0 = ds.pdf;
+      lt_chain = lt->delta && lt_x0 && lt_W0 > 0.0f && lt->member[si.prim] != IRIS_LIGHT_TRACE_DELTA ? 0 : -1;
+    }
     prev_lt_K = lt_K;
     prev_delta = ds.delta;
     prev_sky_g = sky_g;

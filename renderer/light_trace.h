@@ -10,7 +10,8 @@
  * after BSDF sampling at x0; the three are combined by the power heuristic
  * (renderer/integrator.c): a sun's highlight in a metal sphere seen from the
  * ground, which the camera finds only when its bounce at x0 happens to hit
- * the highlight, is the light path's. With `mis` only.
+ * the highlight, is the light path's. A second kind carries the sun
+ * through clear glass and off mirrors (below). With `mis` only.
  *
  * Deterministic: light path i draws from a hash of (seed, i); each call's
  * paths go in blocks whose splats are added in index order, whatever the
@@ -45,13 +46,32 @@ extern "C" {
 #define IRIS_LIGHT_TRACE_PILOT 16384u
 #define IRIS_LIGHT_TRACE_PILOT_SHARE 0.01
 
+/* The second kind: the sun focused by clear glass or a mirror (delta
+ * surfaces) onto what the camera sees. A light path starts at a point y of
+ * a delta surface (by area), takes a light sample of the environment map
+ * there in a direction where the map's density is at least
+ * IRIS_LIGHT_TRACE_SUN times the uniform one (the sun), and follows y's and
+ * the next delta surfaces' reflections and refractions (at most
+ * IRIS_LIGHT_TRACE_CHAIN of them) to the first other surface x0. These paths
+ * (camera -> x0 -> delta surfaces only -> the map in such a direction) are
+ * the light paths' alone: the camera leaves them out (a partition, no MIS:
+ * the camera cannot aim through glass). */
+#define IRIS_LIGHT_TRACE_SUN 16.0f
+#define IRIS_LIGHT_TRACE_CHAIN 8
+enum { IRIS_LIGHT_TRACE_GLOSSY = 1, IRIS_LIGHT_TRACE_DELTA = 2 }; /* iris_light_trace.member bits */
+
 typedef struct iris_light_trace {
   iris_pinhole cam;
   int x0, y0, x1, y1;   /* the render's window (full-frame pixels) */
-  uint8_t *member;      /* per triangle: 1 where light paths start (the camera's MIS asks) */
-  uint32_t *tris;       /* the member triangles, in order */
-  iris_distrib1d select; /* a member triangle, by area */
-  float inv_area;       /* 1 / the members' area: the starting point's density */
+  uint8_t *member;      /* per triangle: IRIS_LIGHT_TRACE_GLOSSY / _DELTA where light paths start (the camera asks) */
+  uint32_t *tris;       /* the glossy reflectors' triangles, in order */
+  iris_distrib1d select; /* a reflector triangle, by area */
+  float inv_area;       /* 1 / the reflectors' area: the starting point's density */
+  bool glossy, delta;   /* which kinds run (each its pilot) */
+  uint32_t *dtris;      /* the delta surfaces' triangles (the second kind) */
+  iris_distrib1d dselect;
+  float inv_darea;
+  float sun_pdf;        /* the map's density from which a direction is the sun's (IRIS_LIGHT_TRACE_SUN / 4 pi) */
   float rho;            /* light paths per sample index: the MIS ratio's count */
   float pixel_area;     /* one pixel's area on the image plane at distance 1 */
   uint64_t per_index;   /* light paths per sample index (rho, whole) */
@@ -60,7 +80,7 @@ typedef struct iris_light_trace {
   uint64_t next;        /* the next light path's index (adaptive rounds) */
   uint64_t rays;        /* rays the light paths traced */
   uint64_t splats;      /* light paths that added to a pixel */
-  uint64_t pilot_paths, pilot_splats; /* the pilot's paths, and those that reached the camera */
+  uint64_t pilot_paths, pilot_splats[2]; /* the pilot's paths, and those of each kind that reached the camera */
   double energy;        /* what they added, summed over the pixels (mean of R, G, B) */
 } iris_light_trace;
 

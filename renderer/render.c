@@ -430,8 +430,14 @@ static iris_status render(const iris_scene *scene, const iris_render_params *par
   if (st == IRIS_OK && light_trace) {
     it.light_trace = light_trace;
     light_trace->next = p.sample_offset * light_trace->per_index;
-    iris_infof("light tracing: %llu light paths per sample index from %zu reflector triangles (%.3g m^2)",
-               (unsigned long long)light_trace->per_index, light_trace->select.count, 1.0 / light_trace->inv_area);
+    char kinds[240] = "", *k = kinds;
+    if (light_trace->glossy)
+      k += snprintf(k, 120, "off %zu glossy reflector triangles (%.3g m^2)", light_trace->select.count,
+                    1.0 / light_trace->inv_area);
+    if (light_trace->delta)
+      snprintf(k, 120, "%sthe sun through %zu glass or mirror triangles (%.3g m^2)", light_trace->glossy ? ", and " : "",
+               light_trace->dselect.count, 1.0 / light_trace->inv_darea);
+    iris_infof("light tracing: %llu light paths per sample index %s", (unsigned long long)light_trace->per_index, kinds);
   }
   if (st == IRIS_OK) {
     stats = calloc((size_t)p.threads, sizeof *stats);

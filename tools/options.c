@@ -69,7 +69,7 @@ static const iris_option RENDER_ROWS[] = {
     CHOICE("connect", "M", iris_render_options, connect, CONNECT_CHOICES,
            "guided methods: connections to light paths kept behind the\nopening the guide found, or of the sky through its windows:\nauto (default: where enough of the caches' light came\nthrough them) | off | on"),
     CHOICE("light-trace", "M", iris_render_options, light_trace, LIGHT_TRACE_CHOICES,
-           "mis: light paths off glossy reflectors (roughness <= 0.3)\ninto the camera, their caustics' light shared with the\ncamera by MIS: auto (default: where such a reflector is) | off"),
+           "mis: light paths off glossy reflectors (roughness <= 0.3)\nand of the sun through clear glass into the camera, for\ncaustics the camera finds by chance: auto (default: where\nsuch surfaces are) | off"),
     OPT("max-depth", 0, IRIS_OPT_INT, "B", 0, 1000000, iris_render_options, max_depth,
         "bounces as Cycles counts them, 0 = direct light (default 64)"),
     OPT("threads", 0, IRIS_OPT_INT, "N", 1, 4096, iris_render_options, threads,

@@ -12,6 +12,8 @@
  * scenes with nothing to start from (the Cornell box), whose reflectors send
  * their light out of the frame (veach-mis: the pilot) or another method get
  * no light tracing. */
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -19,6 +21,7 @@
 #include "film_stats.h"
 #include "render_run.h"
 #include "core/fileio.h"
+#include "core/image.h"
 #include "renderer/render.h"
 #include "scenes/builtin.h"
 #include "scenes/sky.h"
@@ -34,13 +37,60 @@ static bool render(const iris_scene *s, bool light_trace, int w, int h, int spp,
 
 static const iris_pixel_bounds WHOLE = {0, 0, 0, 0};
 
-/* mis with light tracing against mis without, z-tested per image and block */
-static void compare(const char *scene, int spp, double z_max) {
-  enum { W = 48, H = 32 };
+static char g_big_sun[1200]; /* the map of write_big_sun, for "spheres-glass-big-sun" */
+
+/* A built-in scene, or "spheres-glass": env-spheres with its matte sphere
+ * clear glass (the sun focused through it onto the ground: the second kind). */
+static iris_scene *make_scene(const char *name) {
   iris_scene *s = NULL;
   iris_error err;
   iris_error_clear(&err);
-  if (!CHECK(iris_builtin_create(scene, &s, &err) == IRIS_OK)) return;
+  const bool glass = !strncmp(name, "spheres-glass", 13);
+  if (iris_builtin_create(glass ? "env-spheres" : name, &s, &err) != IRIS_OK) return NULL;
+  if (!strcmp(name, "spheres-glass-big-sun") && !iris_scene_set_environment_map(s, g_big_sun, 1.0f, 0.0f)) {
+    iris_scene_destroy(s);
+    return NULL;
+  }
+  for (size_t i = 0; glass && i < s->material_count; i++)
+    if (!strcmp(s->materials[i].name, "matte")) {
+      s->materials[i].type = IRIS_MATERIAL_GLASS;
+      s->materials[i].roughness = 0.0f;
+      s->materials[i].ior = 1.5f;
+      for (int k = 0; k < 3; k++) s->materials[i].color[k] = 1.0f;
+    }
+  return s;
+}
+
+/* A 256 x 128 map of a dim sky (0.2) and a sun of 8 degrees' radius (20),
+ * 45 degrees up: large enough that the camera's bounces through the glass
+ * find it often, so that the light paths' share of the sun through glass can
+ * be told from the camera's (written as EXR at `path`). */
+static bool write_big_sun(const char *path) {
+  enum { MW = 256, MH = 128 };
+  static const char *const names[3] = {"R", "G", "B"};
+  iris_image img;
+  iris_error err;
+  iris_error_clear(&err);
+  if (iris_image_create(&img, MW, MH, 3, names, &err) != IRIS_OK) return false;
+  const double th0 = 0.25 * IRIS_PI;
+  const double c0[3] = {sin(th0), cos(th0), 0.0};
+  for (int y = 0; y < MH; y++)
+    for (int x = 0; x < MW; x++) {
+      const double th = (y + 0.5) / MH * IRIS_PI, ph = ((x + 0.5) / MW - 0.5) * 2.0 * IRIS_PI;
+      const double d[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
+      const bool sun = d[0] * c0[0] + d[1] * c0[1] + d[2] * c0[2] > cos(8.0 * IRIS_PI / 180.0);
+      for (int k = 0; k < 3; k++) img.data[3 * ((size_t)y * MW + (size_t)x) + (size_t)k] = sun ? 20.0f : 0.2f;
+    }
+  bool ok = iris_exr_write(path, &img, NULL, 0, &err) == IRIS_OK;
+  iris_image_destroy(&img);
+  return ok;
+}
+
+/* mis with light tracing against mis without, z-tested per image and block */
+static void compare(const char *scene, int spp, double z_max) {
+  enum { W = 48, H = 32 };
+  iris_scene *s = make_scene(scene);
+  if (!CHECK(s != NULL)) return;
   iris_render_result a, b;
   bool ok_a = CHECK(render(s, true, W, H, spp, 41, 2, WHOLE, &a));
   bool ok_b = CHECK(render(s, false, W, H, spp, 42, 2, WHOLE, &b));
@@ -128,13 +178,20 @@ static void determinism(void) {
 
 int main(void) {
   if (!iris_path_exists(iris_sky_map_path())) return TEST_SKIP("the shared environment map is missing");
-  /* 3 scenes, 3 channels x (image + 24 blocks) */
-  const int n_tests = 3 * 3 * (1 + 6 * 4);
+  /* 5 scenes, 3 channels x (image + 24 blocks) */
+  const int n_tests = 5 * 3 * (1 + 6 * 4);
   const double z_max = z_for_alpha(1e-3 / n_tests);
   printf("%d tests, |z| < %.2f\n", n_tests, z_max);
   compare("env-objects", 1024, z_max);
   compare("stress-glossy-room", 512, z_max);
   compare("stress-firefly", 1024, z_max);
+  compare("spheres-glass", 2048, z_max);
+  char dir[1024];
+  if (CHECK(iris_test_tmpdir(dir, sizeof dir, "light-trace") == 0)) {
+    snprintf(g_big_sun, sizeof g_big_sun, "%s/big-sun.exr", dir);
+    if (CHECK(write_big_sun(g_big_sun))) compare("spheres-glass-big-sun", 1024, z_max);
+    iris_test_rmtree(dir);
+  }
   determinism();
   return iris_check_summary("render.light_trace");
 }
