@@ -520,7 +520,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
   iris_shading_point lt_y; /* y, while prev_lt_K > 0 */
   /* The second kind (light through clear glass and mirrors): delta vertices
    * since x0 while the path may be one of its light paths, -1 when not. */
-  int lt_chain = -1;
+  int lt_chain = -1, lt_refr = 0; /* ... and the refractions among them */
   for (int bounce = 0;; bounce++) {
     iris_sampler_set_bounce(rng, bounce);
     /* The map's tables load while the ray is traced and the hit shaded
@@ -539,7 +539,7 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
         if (!(sky_keep > 0.0f)) break;
       }
       /* the sun through glass or off a mirror seen from x0: the light paths' (light_trace.h) */
-      if (lt_chain >= 1 && prev_delta &&
+      if (lt_chain >= 1 && prev_delta && lt_refr % 2 == 0 &&
           iris_envmap_pdf(it->lights->envmap, iris_normalize(ray.d)) >= lt->sun_pdf)
         break;
       float env_pdf = 0.0f, st[2];
@@ -746,6 +746,9 @@ static iris_vec3 trace_path(const iris_integrator *it, iris_ray ray, iris_sample
     if (lt && bounce == 0) {
       lt_x0 = !sp.delta && !ds.delta && iris_dot(ds.wi, si.ng) > 0.0f, lt_px0 = ds.pdf;
       lt_chain = lt->delta && lt_x0 && lt_W0 > 0.0f && lt->member[si.prim] != IRIS_LIGHT_TRACE_DELTA ? 0 : -1;
+      lt_refr = 0;
+    } else if (lt_chain >= 1 && (ds.lobe & IRIS_LOBE_TRANSMISSION)) {
+      lt_refr++;
     }
     prev_lt_K = lt_K;
     prev_delta = ds.delta;

@@ -313,6 +313,7 @@ static void trace_delta(const iris_light_trace *lt, const iris_integrator *it, u
   iris_vec3 beta = iris_scale(ls.L, cos_l / (lt->inv_darea * ls.pdf));
   iris_interaction cur = ys;
   iris_vec3 wo = wl; /* at the current vertex, towards where the light came from */
+  int refractions = 0;
   for (int depth = 1;; ++depth) {
     if (depth > IRIS_LIGHT_TRACE_CHAIN || depth > it->max_depth) return;
     if (lt->member[cur.prim] != IRIS_LIGHT_TRACE_DELTA) return;
@@ -327,6 +328,7 @@ static void trace_delta(const iris_light_trace *lt, const iris_integrator *it, u
       return;
     beta = iris_mul(beta, iris_scale(ds.f, fabsf(iris_dot(ds.wi, sp.si.ns)) / ds.pdf));
     if (!(iris_max3(beta) > 0.0f) || !iris_isfinite3(beta)) return;
+    refractions += (ds.lobe & IRIS_LOBE_TRANSMISSION) != 0;
     iris_ray ray = iris_spawn_ray(&sp.si, ds.wi);
     iris_hit hit;
     out->rays++;
@@ -341,8 +343,11 @@ static void trace_delta(const iris_light_trace *lt, const iris_integrator *it, u
       cur = next;
       continue;
     }
-    /* x0: the first other surface, lit on its front, seen by the camera */
-    if (!next.front) return;
+    /* x0: the first other surface, lit on its front, seen by the camera;
+     * after an even number of refractions only (in and out of the glass:
+     * their n^2 cancel; a pane of one surface bends the light once, and its
+     * light stays the camera's) */
+    if (!next.front || refractions % 2 != 0) return;
     iris_vec3 dir;
     int px, py;
     if (!project(lt, &next, &dir, &px, &py)) return;
