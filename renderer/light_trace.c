@@ -188,16 +188,23 @@ static bool project(const iris_light_trace *lt, const iris_interaction *xs, iris
   return *px >= lt->x0 && *px < lt->x1 && *py >= lt->y0 && *py < lt->y1;
 }
 
+/* A light path's start: a triangle of `tris` by area (`select`), a uniform
+ * point on it (the sampler's dimensions 0-2). */
+static void start_point(const iris_integrator *it, const iris_distrib1d *select, const uint32_t *tris,
+                        const iris_sampler *r, iris_interaction *y) {
+  float pmf, u_rest;
+  const size_t k = iris_distrib1d_sample(select, iris_sampler_get(r, 0), &pmf, &u_rest);
+  float b1 = iris_sampler_get(r, 1), b2 = iris_sampler_get(r, 2);
+  if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
+  iris_accel_surface_at(it->accel, tris[k], b1, b2, y);
+}
+
 /* Light path `index`: y on a reflector, a light sample there, the reflection
  * to x0, x0 into the camera (the formulas: docs/rendering.md). */
 static void trace_glossy(const iris_light_trace *lt, const iris_integrator *it, uint64_t index, block_out *out) {
   const iris_sampler r = iris_sampler_start(lt->seed ^ SALT, index, 0);
-  float pmf, u_rest;
-  const size_t k = iris_distrib1d_sample(&lt->select, iris_sampler_get(&r, 0), &pmf, &u_rest);
-  float b1 = iris_sampler_get(&r, 1), b2 = iris_sampler_get(&r, 2);
-  if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
   iris_interaction ys;
-  iris_accel_surface_at(it->accel, lt->tris[k], b1, b2, &ys);
+  start_point(it, &lt->select, lt->tris, &r, &ys);
   /* the light as next-event estimation at y draws it (light_normal there:
    * the geometric normal of a reflect-only BSDF) */
   iris_light_choice choice;
@@ -288,12 +295,8 @@ static void trace_glossy(const iris_light_trace *lt, const iris_integrator *it, 
  * vertex's f |cos| / p, then f_x0 |n_s(x0).w_0| / |n_g(x0).w_0| W(x0). */
 static void trace_delta(const iris_light_trace *lt, const iris_integrator *it, uint64_t index, block_out *out) {
   const iris_sampler r = iris_sampler_start(lt->seed ^ SALT ^ 0xde17aULL, index, 0);
-  float pmf, u_rest;
-  const size_t k = iris_distrib1d_sample(&lt->dselect, iris_sampler_get(&r, 0), &pmf, &u_rest);
-  float b1 = iris_sampler_get(&r, 1), b2 = iris_sampler_get(&r, 2);
-  if (b1 + b2 > 1.0f) b1 = 1.0f - b1, b2 = 1.0f - b2;
   iris_interaction ys;
-  iris_accel_surface_at(it->accel, lt->dtris[k], b1, b2, &ys);
+  start_point(it, &lt->dselect, lt->dtris, &r, &ys);
   /* the map, as light sampling draws it, in a sun's direction only */
   iris_light_choice choice;
   iris_lights_choose(it->lights, ys.p, iris_v3(0, 0, 0), iris_sampler_get(&r, 3), &choice);
